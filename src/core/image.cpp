@@ -1,0 +1,128 @@
+#include "core/image.h"
+
+#include <png.h>
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfStandardAttributes.h>
+#include <ImfStringAttribute.h>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+#include "core/error.h"
+
+namespace ub {
+
+Rgb Image::mean() const {
+    double s[3] = {0, 0, 0};
+    for (const auto& p : pixels)
+        for (int c = 0; c < 3; ++c) s[c] += p[c];
+    double n = std::max<size_t>(1, pixels.size());
+    return {float(s[0] / n), float(s[1] / n), float(s[2] / n)};
+}
+
+Image readExr(const std::string& path, ImageMetadata* metadata) {
+    if (!std::filesystem::exists(path)) throw InputError(path, "image file does not exist");
+    try {
+        Imf::InputFile file(path.c_str());
+        const Imf::Header& h = file.header();
+        Imath::Box2i dw = h.dataWindow();
+        int w = dw.max.x - dw.min.x + 1, ht = dw.max.y - dw.min.y + 1;
+        if (w <= 0 || ht <= 0) throw InputError(path, "OpenEXR image has an empty data window");
+        const Imf::ChannelList& ch = h.channels();
+        bool hasRgb = ch.findChannel("R") && ch.findChannel("G") && ch.findChannel("B");
+        bool hasY = ch.findChannel("Y");
+        if (!hasRgb && !hasY)
+            throw InputError(path, "OpenEXR image has neither R,G,B nor Y channels");
+        Image img(w, ht);
+        Imf::FrameBuffer fb;
+        char* base = reinterpret_cast<char*>(img.pixels.data()) -
+                     (size_t(dw.min.x) + size_t(dw.min.y) * w) * sizeof(Rgb);
+        size_t xs = sizeof(Rgb), ys = sizeof(Rgb) * w;
+        if (hasRgb) {
+            fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+            fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+            fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+        } else {
+            fb.insert("Y", Imf::Slice(Imf::FLOAT, base, xs, ys));
+        }
+        file.setFrameBuffer(fb);
+        file.readPixels(dw.min.y, dw.max.y);
+        if (!hasRgb)
+            for (auto& p : img.pixels) p = Rgb(p.x);
+        if (metadata) {
+            for (auto it = h.begin(); it != h.end(); ++it) {
+                if (auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+                    (*metadata)[it.name()] = s->value();
+            }
+        }
+        for (const auto& p : img.pixels)
+            if (!isFinite(p)) throw InputError(path, "OpenEXR image contains non-finite pixel values");
+        return img;
+    } catch (const InputError&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw InputError(path, std::string("cannot read OpenEXR image: ") + e.what());
+    }
+}
+
+void writeExr(const std::string& path, const Image& img, const ImageMetadata& metadata) {
+    Imf::Header h(img.width, img.height);
+    h.channels().insert("R", Imf::Channel(Imf::FLOAT));
+    h.channels().insert("G", Imf::Channel(Imf::FLOAT));
+    h.channels().insert("B", Imf::Channel(Imf::FLOAT));
+    for (const auto& [k, v] : metadata) h.insert(k, Imf::StringAttribute(v));
+    try {
+        Imf::OutputFile file(path.c_str(), h);
+        Imf::FrameBuffer fb;
+        char* base = const_cast<char*>(reinterpret_cast<const char*>(img.pixels.data()));
+        size_t xs = sizeof(Rgb), ys = sizeof(Rgb) * img.width;
+        fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+        fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+        fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+        file.setFrameBuffer(fb);
+        file.writePixels(img.height);
+    } catch (const std::exception& e) {
+        throw std::runtime_error("cannot write OpenEXR image '" + path + "': " + e.what());
+    }
+}
+
+static unsigned char toSrgb8(float v) {
+    v = std::clamp(v, 0.0f, 1.0f);
+    float s = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+    return (unsigned char)std::clamp(int(s * 255.0f + 0.5f), 0, 255);
+}
+
+void writePng(const std::string& path, const Image& img, float exposure) {
+    FILE* fp = std::fopen(path.c_str(), "wb");
+    if (!fp) throw std::runtime_error("cannot open '" + path + "' for writing");
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    png_infop info = png ? png_create_info_struct(png) : nullptr;
+    if (!png || !info || setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        std::fclose(fp);
+        throw std::runtime_error("cannot write PNG image '" + path + "'");
+    }
+    png_init_io(png, fp);
+    png_set_IHDR(png, info, img.width, img.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_write_info(png, info);
+    float scale = std::exp2(exposure);
+    std::vector<unsigned char> row(size_t(img.width) * 3);
+    for (int y = 0; y < img.height; ++y) {
+        for (int x = 0; x < img.width; ++x) {
+            Rgb c = img.at(x, y) * scale;
+            for (int k = 0; k < 3; ++k) row[size_t(x) * 3 + k] = toSrgb8(c[k]);
+        }
+        png_write_row(png, row.data());
+    }
+    png_write_end(png, nullptr);
+    png_destroy_write_struct(&png, &info);
+    if (std::fclose(fp) != 0) throw std::runtime_error("cannot write PNG image '" + path + "'");
+}
+
+}  // namespace ub

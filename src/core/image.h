@@ -1,0 +1,35 @@
+// RGB float images and their files: OpenEXR (32-bit float RGB, with string
+// metadata) and sRGB tone-mapped PNG. Reading errors throw InputError naming
+// the file and what was expected.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/vec.h"
+
+namespace ub {
+
+struct Image {
+    int width = 0, height = 0;
+    std::vector<Rgb> pixels;  ///< row-major, row 0 at the top
+
+    Image() = default;
+    Image(int w, int h) : width(w), height(h), pixels(size_t(w) * h) {}
+    Rgb& at(int x, int y) { return pixels[size_t(y) * width + x]; }
+    const Rgb& at(int x, int y) const { return pixels[size_t(y) * width + x]; }
+    Rgb mean() const;
+};
+
+using ImageMetadata = std::map<std::string, std::string>;
+
+/// Reads the R, G, B channels of an OpenEXR file (Y only is replicated to RGB).
+/// Throws InputError if the file is missing, not an EXR, or has no colour channels.
+Image readExr(const std::string& path, ImageMetadata* metadata = nullptr);
+/// Writes 32-bit float RGB with the given string attributes. Throws std::runtime_error on I/O failure.
+void writeExr(const std::string& path, const Image& img, const ImageMetadata& metadata = {});
+/// Writes an 8-bit sRGB PNG of img * 2^exposure (clamped). Throws std::runtime_error on failure.
+void writePng(const std::string& path, const Image& img, float exposure = 0.0f);
+
+}  // namespace ub

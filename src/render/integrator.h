@@ -1,0 +1,48 @@
+// Integrator interface: a progressive renderer runs iterations of one
+// sample per pixel each (and, for bidirectional methods, one light subpath per
+// pixel). The virtual call is per iteration, never per sample.
+//
+// Determinism: iteration i of a render with seed s must produce bit-identical
+// output regardless of thread count and scheduling. Use Rng::forPath(seed, i,
+// pixelIndex, salt) per pixel/path, and accumulate light-tracing splats into a
+// fixed number of chunk buffers (see SplatBuffer) summed in a fixed order.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/image.h"
+#include "scene/scene.h"
+
+namespace ub {
+
+enum class MisHeuristic { Power, Balance };
+
+struct RenderOptions {
+    std::string algorithm = "pt";
+    int maxPathLength = 10;         ///< segments (SmallVCM semantics), from scene or CLI
+    int minPathLength = 0;
+    uint64_t seed = 1;
+    MisHeuristic heuristic = MisHeuristic::Power;
+    /// Merging radius: if radiusIsRelative, multiplied by the scene bounding sphere radius.
+    float radius = 0.003f;
+    bool radiusIsRelative = true;
+    float alpha = 0.75f;            ///< progressive radius reduction exponent
+};
+
+class Integrator {
+public:
+    virtual ~Integrator() = default;
+    /// Renders iteration `iteration` (0-based) into `out` (width x height of the camera),
+    /// overwriting it with this iteration's estimate (one sample per pixel).
+    virtual void renderIteration(int iteration, Image& out) = 0;
+};
+
+/// Names accepted by makeIntegrator, for help texts and error messages.
+std::vector<std::string> integratorNames();
+/// Creates the integrator named options.algorithm. Throws InputError naming the valid
+/// algorithms if the name is unknown or the scene does not support it.
+std::unique_ptr<Integrator> makeIntegrator(const Scene& scene, const RenderOptions& options);
+
+}  // namespace ub

@@ -1,0 +1,89 @@
+// BSDF at a surface point, built from a Material (SmallVCM-style interface,
+// extended with GGX microfacet models).
+//
+// Direction conventions (used everywhere in unibeam):
+//  * All directions point AWAY from the surface point.
+//  * `dirFix` is the direction towards the previous vertex of the subpath being
+//    traced (i.e. -ray.dir of the incoming ray). It is fixed when the BSDF is set up.
+//  * `dirGen` is a direction being generated (sampled) or evaluated: towards
+//    the next vertex.
+//  * On a camera subpath, dirFix points to the camera side, dirGen to the light side;
+//    on a light subpath the reverse. `fromLight` records which: it selects the
+//    adjoint BSDF for refraction (radiance vs importance; Veach 1997, Sec. 5.2,
+//    the (eta_i/eta_t)^2 factor applies only to radiance transport).
+//  * Pdfs in solid angle measure (suffix W). directPdfW = p(dirGen | dirFix),
+//    reversePdfW = p(dirFix | dirGen). Neither includes Russian roulette.
+//  * evaluate() returns f_s (without any cosine); cosThetaGen is |cos| between
+//    dirGen and the shading normal.
+//  * Shading normals: the shading normal is flipped to the side of dirFix for
+//    two-sided opaque materials. For dielectrics the normal's side defines inside
+//    (the normal points outside).
+#pragma once
+
+#include <cstdint>
+
+#include "core/vec.h"
+#include "scene/material.h"
+
+namespace ub {
+
+/// Which lobe sample() picked (for MIS bookkeeping and debugging).
+enum BsdfEvent : uint32_t {
+    kEventNone = 0,
+    kEventDiffuse = 1,
+    kEventGlossy = 2,
+    kEventReflect = 4,   ///< specular (delta) reflection
+    kEventRefract = 8,   ///< specular (delta) refraction
+    kEventSpecular = kEventReflect | kEventRefract,
+};
+
+class Bsdf {
+public:
+    Bsdf() = default;
+    /// Sets up the BSDF at a hit. dirFix = -incoming ray direction (unit).
+    /// geoNormal/shadingNormal: unit normals as stored on the surface (not flipped).
+    /// Returns false (isValid() false) if the configuration is degenerate, e.g. dirFix
+    /// grazing the shading hemisphere (|cos| < 1e-6); callers then stop the path.
+    bool setup(const Material& mat, const Vec3& dirFix, const Vec3& geoNormal,
+               const Vec3& shadingNormal, bool fromLight);
+
+    /// f_s(dirFix, dirGen) for the non-delta lobes; 0 for pure delta materials.
+    /// Any of the out pointers may be null.
+    Rgb evaluate(const Vec3& dirGen, float* cosThetaGen, float* directPdfW,
+                 float* reversePdfW) const;
+    /// Samples dirGen from rnd in [0,1)^3 and returns f_s for it. *pdfW is the solid-angle
+    /// pdf including lobe selection. For a delta lobe *pdfW is the discrete lobe probability
+    /// and the returned value is the lobe weight / |cos|, so f_s * cosThetaGen / pdfW is the
+    /// throughput factor in every case. Returns black and *pdfW = 0 if sampling failed.
+    Rgb sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
+               uint32_t* sampledEvent) const;
+    /// Pdf of dirGen given dirFix (reverse=false) or of dirFix given dirGen (reverse=true),
+    /// for the non-delta lobes.
+    float pdf(const Vec3& dirGen, bool reverse = false) const;
+
+    bool isValid() const { return valid_; }
+    /// True if every lobe is a delta (mirror, smooth dielectric).
+    bool isDelta() const { return isDelta_; }
+    /// Russian-roulette continuation probability: max over RGB of the albedo
+    /// estimate, clamped to [0,1] (SmallVCM's mContinuationProb).
+    float continuationProb() const { return contProb_; }
+    /// |cos| between dirFix and the shading normal.
+    float cosThetaFix() const { return std::fabs(localDirFix_.z); }
+    const Vec3& shadingNormal() const { return frame_.n; }
+    const Material* material() const { return mat_; }
+
+private:
+    const Material* mat_ = nullptr;
+    Frame frame_;        ///< shading frame (normal possibly flipped, see above)
+    Vec3 localDirFix_;   ///< dirFix in frame_
+    Vec3 geoNormal_;     ///< geometric normal, same side convention as frame_.n
+    bool fromLight_ = false;
+    bool valid_ = false;
+    bool isDelta_ = false;
+    float contProb_ = 0.0f;
+    // Lobe selection probabilities (Phong: diffuse vs glossy; dielectrics: reflect vs refract).
+    float probDiffuse_ = 0.0f, probGlossy_ = 0.0f;
+    float etaRatio_ = 1.0f;   ///< for dielectrics: eta_outside_of_dirFix / eta_other_side
+};
+
+}  // namespace ub

@@ -1,0 +1,58 @@
+#include "scene/camera.h"
+
+#include "core/sampling.h"
+
+namespace ub {
+
+void Camera::setup(const Vec3& position, const Vec3& target, const Vec3& up, float fovYDeg,
+                   int width, int height, float lensRadius, float focusDistance) {
+    position_ = position;
+    forward_ = normalize(target - position);
+    right_ = normalize(cross(forward_, up));
+    up_ = cross(right_, forward_);
+    fovYDeg_ = fovYDeg;
+    width_ = width;
+    height_ = height;
+    lensRadius_ = lensRadius;
+    focusDistance_ = focusDistance;
+    float tanHalf = std::tan(0.5f * fovYDeg * kPi / 180.0f);
+    imagePlaneDist_ = float(height) / (2.0f * tanHalf);
+}
+
+Ray Camera::generateRay(const Vec2& raster, const Vec2& lensU) const {
+    float px = raster.x - 0.5f * float(width_);
+    float py = 0.5f * float(height_) - raster.y;
+    Vec3 d = normalize(forward_ * imagePlaneDist_ + right_ * px + up_ * py);
+    Ray ray;
+    ray.org = position_;
+    ray.dir = d;
+    if (lensRadius_ > 0.0f) {
+        // Thin lens: all rays through the pinhole direction meet at the focus plane.
+        float ft = focusDistance_ / dot(d, forward_);
+        Vec3 focus = position_ + d * ft;
+        Vec2 l = sampleConcentricDisk(lensU);
+        ray.org = position_ + right_ * (l.x * lensRadius_) + up_ * (l.y * lensRadius_);
+        ray.dir = normalize(focus - ray.org);
+    }
+    return ray;
+}
+
+bool Camera::worldToRaster(const Vec3& p, Vec2* raster) const {
+    Vec3 v = p - position_;
+    float z = dot(v, forward_);
+    if (z <= 0.0f) return false;
+    float s = imagePlaneDist_ / z;
+    float x = dot(v, right_) * s + 0.5f * float(width_);
+    float y = 0.5f * float(height_) - dot(v, up_) * s;
+    if (!(x >= 0.0f && x < float(width_) && y >= 0.0f && y < float(height_))) return false;
+    *raster = Vec2(x, y);
+    return true;
+}
+
+float Camera::pdfW(const Vec3& dir) const {
+    float c = dot(dir, forward_);
+    if (c <= 0.0f) return 0.0f;
+    return imagePlaneDist_ * imagePlaneDist_ / (c * c * c);
+}
+
+}  // namespace ub

@@ -1,0 +1,58 @@
+// Pinhole camera with optional thin lens. Raster space: x right in [0,W),
+// y down in [0,H); pixel (i,j) covers [i,i+1)x[j,j+1).
+//
+// The image plane sits at distance imagePlaneDist() from the eye, chosen so
+// that one pixel has unit area on it. Then the solid-angle pdf of a camera
+// ray through a uniformly sampled pixel point is
+//     p_cam,W = imagePlaneDist^2 / cos^3(theta)        (SmallVCM, TR Sec. 5.2)
+// and light tracing divides by the "surface to image" factor built from it.
+#pragma once
+
+#include "core/vec.h"
+
+namespace ub {
+
+struct Ray {
+    Vec3 org;
+    Vec3 dir;          ///< unit length
+    float tMin = 0.0f;
+    float tMax = kInf;
+};
+
+class Camera {
+public:
+    /// fovYDeg: vertical field of view in degrees, in (0, 180).
+    /// lensRadius 0 means pinhole; focusDistance must be > 0 when lensRadius > 0.
+    void setup(const Vec3& position, const Vec3& target, const Vec3& up, float fovYDeg, int width,
+               int height, float lensRadius = 0.0f, float focusDistance = 1.0f);
+
+    /// Primary ray through raster position `raster` (e.g. pixel + jitter); lensU in [0,1)^2
+    /// picks the lens point (ignored for a pinhole).
+    Ray generateRay(const Vec2& raster, const Vec2& lensU = Vec2(0.5f, 0.5f)) const;
+    /// Projects world point p to raster coordinates; false if behind the camera or
+    /// outside the image. Pinhole only (light tracing requires isPinhole()).
+    bool worldToRaster(const Vec3& p, Vec2* raster) const;
+    /// Solid-angle pdf of sampling direction `dir` (unit, world) from the eye (pinhole).
+    float pdfW(const Vec3& dir) const;
+
+    bool isPinhole() const { return lensRadius_ <= 0.0f; }
+    int width() const { return width_; }
+    int height() const { return height_; }
+    const Vec3& position() const { return position_; }
+    const Vec3& forward() const { return forward_; }
+    const Vec3& up() const { return up_; }
+    const Vec3& right() const { return right_; }
+    float fovYDeg() const { return fovYDeg_; }
+    float lensRadius() const { return lensRadius_; }
+    float focusDistance() const { return focusDistance_; }
+    /// Distance of the unit-pixel-area image plane from the eye.
+    float imagePlaneDist() const { return imagePlaneDist_; }
+
+private:
+    Vec3 position_, forward_, up_, right_;
+    float fovYDeg_ = 45.0f, imagePlaneDist_ = 1.0f;
+    float lensRadius_ = 0.0f, focusDistance_ = 1.0f;
+    int width_ = 0, height_ = 0;
+};
+
+}  // namespace ub
