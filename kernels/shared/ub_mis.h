@@ -1,0 +1,226 @@
+/* Recursive MIS weights for the surface bidirectional family (lt, bpt, ppm,
+ * bpm, vcm), shared by host C++ and OpenCL C.
+ *
+ * A NOTE ON THE MIS PARTIALS (dVCM, dVC, dVM)
+ * -------------------------------------------
+ * Georgiev et al. 2012, "Light Transport Simulation with Vertex Connection and
+ * Merging", and its technical report "Implementing Vertex Connection and
+ * Merging" (cited below as [TR (n)], n the equation number) show that the MIS
+ * weight of a full path built by vertex connection (VC) or vertex merging (VM)
+ * can be evaluated from three floats carried along each subpath, so that no
+ * weight computation ever walks a path:
+ *
+ *   dVCM  the pdf ratio shared by connection and merging. After the subpath
+ *         reaches vertex x_i (and the hit update below) it is 1/p(x_i), the
+ *         inverse area pdf with which the subpath sampled its last vertex
+ *         (for i = 1 on a light subpath: p_direct(x_0) / (p(x_0) p(x_1))).
+ *   dVC   the sum over the techniques that would have sampled more vertices
+ *         of this subpath from the other side by connection, as ratios of
+ *         their pdfs to the current technique's pdf, with the last reverse
+ *         pdf left out (it is only known once the next direction is fixed).
+ *   dVM   the same sum for the merging techniques.
+ *
+ * Each weight is w = 1 / (w_light + 1 + w_camera)  [TR (37)], where w_light and
+ * w_camera are the partial weights of the two subpaths, built from these
+ * quantities and the pdfs available at the two ends of the new edge.
+ *
+ * With eta_VCM = N_L * pi * r^2 [TR (20)] (N_L light subpaths per iteration,
+ * one connection per camera subpath), the two switched constants are
+ *   vmWeightFactor = Mis(eta_VCM)   if merging is enabled, else 0,
+ *   vcWeightFactor = Mis(1/eta_VCM) if connection is enabled, else 0.
+ * Mis(x) is x^beta: beta = 2 (power heuristic) or 1 (balance heuristic),
+ * applied to every ratio factor, including eta and the pdfs (TR Sec. 3).
+ *
+ * Conventions: solid-angle pdfs end in W, area pdfs in A. Every BSDF pdf passed
+ * here already includes the Russian-roulette continuation probability of the
+ * vertex where the sampling would happen. "dir" pdfs sample the direction in
+ * which the subpath is being extended; "rev" pdfs sample the opposite way.
+ * Light pdfs (directPdfA, emissionPdfW) include the light selection
+ * probability. See shared/notes/mis.md for a derivation-level summary.
+ */
+#ifndef UB_MIS_H
+#define UB_MIS_H
+
+#include "ub_defs.h"
+
+#define UB_MIS_BALANCE 0u
+#define UB_MIS_POWER 1u
+
+/* The three MIS partials of a subpath (state while tracing, stored at light vertices). */
+typedef struct {
+    float dVCM;
+    float dVC;
+    float dVM;
+} ub_mis_partials;
+
+/* Per-iteration constants. */
+typedef struct {
+    float vmWeightFactor;    /* Mis(eta_VCM) or 0 [TR (20)] */
+    float vcWeightFactor;    /* Mis(1 / eta_VCM) or 0 [TR (20)] */
+    float lightSubPathCount; /* N_L, not raised to beta */
+    ub_uint heuristic;       /* UB_MIS_POWER or UB_MIS_BALANCE */
+} ub_mis_constants;
+
+/* Mis(x): the heuristic's exponent applied to one ratio factor. */
+UB_INLINE float ub_mis(ub_mis_constants c, float x) {
+    return c.heuristic == UB_MIS_POWER ? x * x : x;
+}
+
+/* Constants of one iteration with merging radius `radius`. useVC / useVM enable
+ * the connection (incl. light tracing and NEE) and merging techniques. */
+UB_INLINE ub_mis_constants ub_mis_make_constants(float radius, float lightSubPathCount, int useVC,
+                                                 int useVM, ub_uint heuristic) {
+    ub_mis_constants c;
+    c.heuristic = heuristic;
+    c.lightSubPathCount = lightSubPathCount;
+    /* eta_VCM = n_VM / n_VC * pi r^2, with n_VC = 1, n_VM = N_L [TR (20)] */
+    float etaVCM = UB_PI * radius * radius * lightSubPathCount;
+    c.vmWeightFactor = useVM ? ub_mis(c, etaVCM) : 0.0f;
+    c.vcWeightFactor = useVC ? ub_mis(c, 1.0f / etaVCM) : 0.0f;
+    return c;
+}
+
+/* ---- Initialisation ---------------------------------------------------------------- */
+
+/* Light subpath start at x_0 sampled by emission.
+ * directPdfA: pdf of NEE choosing x_0 (area, or solid angle for environments),
+ * emissionPdfW: pdf of emitting (x_0, direction); both times the light pick probability.
+ * cosLight: cosine at x_0 (ignored for lights at infinity). */
+UB_INLINE ub_mis_partials ub_mis_init_light(ub_mis_constants c, float directPdfA,
+                                            float emissionPdfW, float cosLight, int isDelta,
+                                            int isFinite) {
+    ub_mis_partials p;
+    /* dVCM_1 = p_direct(x_0) / p_emit(x_0, w) [TR (31)] */
+    p.dVCM = ub_mis(c, directPdfA / emissionPdfW);
+    /* dVC_1 = cos(x_0) / p_emit(x_0, w) [TR (32)]; 0 for delta lights, which camera
+     * paths cannot hit; cos := 1 for lights at infinity [TR Sec. 5.1] */
+    float usedCos = isFinite ? cosLight : 1.0f;
+    p.dVC = isDelta ? 0.0f : ub_mis(c, usedCos / emissionPdfW);
+    /* dVM_1 = dVC_1 / eta_VCM [TR (33)] */
+    p.dVM = p.dVC * c.vcWeightFactor;
+    return p;
+}
+
+/* Camera subpath start; cameraPdfW = solid-angle pdf of the primary ray direction
+ * per unit image-plane area (imagePlaneDist^2 / cos^3). Completed by the first
+ * ub_mis_at_hit [TR (31)-(33)]: the camera vertex is technique "light tracing"
+ * with N_L samples, so dVCM_1 = N_L / p_cam(x_1). */
+UB_INLINE ub_mis_partials ub_mis_init_camera(ub_mis_constants c, float cameraPdfW) {
+    ub_mis_partials p;
+    p.dVCM = ub_mis(c, c.lightSubPathCount / cameraPdfW); /* [TR (31)] */
+    p.dVC = 0.0f;                                         /* [TR (32)] */
+    p.dVM = 0.0f;                                         /* [TR (33)] */
+    return p;
+}
+
+/* ---- Updates ------------------------------------------------------------------------ */
+
+/* After tracing a segment of length `dist` to a new vertex with |cos| `cosFix` between
+ * the segment and the surface normal: converts the solid-angle pdf of the last
+ * direction to area measure, completing [TR (31)-(33)] or [TR (34)-(36)].
+ * applyDistSqr is 0 only on the first segment of a light at infinity, whose
+ * emission pdf is already in a planar measure [TR Sec. 5.1]. */
+UB_INLINE ub_mis_partials ub_mis_at_hit(ub_mis_constants c, ub_mis_partials p, float dist,
+                                        float cosFix, int applyDistSqr) {
+    if (applyDistSqr) p.dVCM *= ub_mis(c, dist * dist);
+    float invCos = 1.0f / ub_mis(c, cosFix);
+    p.dVCM *= invCos;
+    p.dVC *= invCos;
+    p.dVM *= invCos;
+    return p;
+}
+
+/* Scattering at a vertex: the new direction was sampled with dirPdfW, the reverse
+ * direction would be sampled with revPdfW (both times the continuation probability),
+ * cosOut = |cos| of the new direction. isSpecular: a delta lobe was sampled. */
+UB_INLINE ub_mis_partials ub_mis_scatter(ub_mis_constants c, ub_mis_partials p, float cosOut,
+                                         float dirPdfW, float revPdfW, int isSpecular) {
+    ub_mis_partials q;
+    if (isSpecular) {
+        /* For a delta lobe the forward and reverse pdfs are equal and cancel;
+         * no connection or merging can use this vertex [TR (53)-(55)]. */
+        q.dVCM = 0.0f;                               /* [TR (53)] */
+        q.dVC = p.dVC * ub_mis(c, cosOut);           /* [TR (54)] */
+        q.dVM = p.dVM * ub_mis(c, cosOut);           /* [TR (55)] */
+        return q;
+    }
+    float g = ub_mis(c, cosOut / dirPdfW);
+    float rev = ub_mis(c, revPdfW);
+    q.dVC = g * (p.dVC * rev + p.dVCM + c.vmWeightFactor);          /* [TR (34)] */
+    q.dVM = g * (p.dVM * rev + p.dVCM * c.vcWeightFactor + 1.0f);  /* [TR (35)] */
+    q.dVCM = ub_mis(c, 1.0f / dirPdfW);                             /* [TR (36)] */
+    return q;
+}
+
+/* ---- Weights -------------------------------------------------------------------------- */
+
+/* Vertex connection between light vertex y (partials l) and camera vertex z (partials e).
+ * cameraDirPdfA: camera BSDF at z sampling y, in area measure at y;
+ * lightRevPdfW: light BSDF at y sampling its previous vertex given the direction to z;
+ * lightDirPdfA: light BSDF at y sampling z, in area measure at z;
+ * cameraRevPdfW: camera BSDF at z sampling its previous vertex given the direction to y. */
+UB_INLINE float ub_mis_weight_connect(ub_mis_constants c, ub_mis_partials l, ub_mis_partials e,
+                                      float cameraDirPdfA, float lightRevPdfW, float lightDirPdfA,
+                                      float cameraRevPdfW) {
+    /* Partial light subpath weight [TR (40)] */
+    float wLight = ub_mis(c, cameraDirPdfA) *
+                   (c.vmWeightFactor + l.dVCM + l.dVC * ub_mis(c, lightRevPdfW));
+    /* Partial camera subpath weight [TR (41)] */
+    float wCamera = ub_mis(c, lightDirPdfA) *
+                    (c.vmWeightFactor + e.dVCM + e.dVC * ub_mis(c, cameraRevPdfW));
+    return 1.0f / (wLight + 1.0f + wCamera); /* [TR (37)] */
+}
+
+/* Next-event estimation from camera vertex z (partials e) to a light sample.
+ * bsdfDirPdfW: camera BSDF sampling the light direction (0 for delta lights);
+ * bsdfRevPdfW: camera BSDF sampling its previous vertex given the light direction;
+ * lightPickProb, directPdfW (illuminate's solid-angle pdf, without pick probability),
+ * emissionPdfW (without pick probability), cosToLight at z, cosAtLight at the light. */
+UB_INLINE float ub_mis_weight_nee(ub_mis_constants c, ub_mis_partials e, float bsdfDirPdfW,
+                                  float bsdfRevPdfW, float lightPickProb, float directPdfW,
+                                  float emissionPdfW, float cosToLight, float cosAtLight) {
+    /* Partial light subpath weight [TR (44)]: hitting the light by BSDF sampling */
+    float wLight = ub_mis(c, bsdfDirPdfW / (lightPickProb * directPdfW));
+    /* Partial camera subpath weight [TR (45)]: the light emitted towards z; the pick
+     * probability cancels in the ratio emissionPdfW / directPdfW */
+    float wCamera = ub_mis(c, emissionPdfW * cosToLight / (directPdfW * cosAtLight)) *
+                    (c.vmWeightFactor + e.dVCM + e.dVC * ub_mis(c, bsdfRevPdfW));
+    return 1.0f / (wLight + 1.0f + wCamera); /* [TR (37)] */
+}
+
+/* A camera subpath (partials e, after ub_mis_at_hit) hits an emitter, with pdfs of
+ * the hit point/direction for NEE (directPdfA) and emission (emissionPdfW), both
+ * times the light pick probability. Not for directly visible lights (weight 1). */
+UB_INLINE float ub_mis_weight_hit_light(ub_mis_constants c, ub_mis_partials e, float directPdfA,
+                                        float emissionPdfW) {
+    /* Partial camera subpath weight [TR (43)]; the light part is 0 [TR (42)] */
+    float wCamera = ub_mis(c, directPdfA) * e.dVCM + ub_mis(c, emissionPdfW) * e.dVC;
+    return 1.0f / (1.0f + wCamera); /* [TR (37)] */
+}
+
+/* Light tracing: light vertex y (partials l) connected to the camera.
+ * cameraPdfA: pdf of the camera sampling y, area measure (p_cam,W |cos_y| / d^2);
+ * bsdfRevPdfW: light BSDF at y sampling its previous vertex given the camera direction. */
+UB_INLINE float ub_mis_weight_light_trace(ub_mis_constants c, ub_mis_partials l,
+                                          float cameraPdfA, float bsdfRevPdfW) {
+    /* Partial light subpath weight [TR (46)]; the camera part is 0 [TR (47)] */
+    float wLight = ub_mis(c, cameraPdfA / c.lightSubPathCount) *
+                   (c.vmWeightFactor + l.dVCM + l.dVC * ub_mis(c, bsdfRevPdfW));
+    return 1.0f / (wLight + 1.0f); /* [TR (37)] */
+}
+
+/* Vertex merging of light vertex y (partials l) at camera vertex z (partials e).
+ * cameraDirPdfW: camera BSDF sampling the light vertex's incoming direction, times the
+ * camera vertex's continuation probability; cameraRevPdfW: camera BSDF sampling the
+ * camera's previous vertex given that direction, times the LIGHT vertex's continuation
+ * probability (the light subpath would have continued there). */
+UB_INLINE float ub_mis_weight_merge(ub_mis_constants c, ub_mis_partials l, ub_mis_partials e,
+                                    float cameraDirPdfW, float cameraRevPdfW) {
+    /* Partial light subpath weight [TR (38)] */
+    float wLight = l.dVCM * c.vcWeightFactor + l.dVM * ub_mis(c, cameraDirPdfW);
+    /* Partial camera subpath weight [TR (39)] */
+    float wCamera = e.dVCM * c.vcWeightFactor + e.dVM * ub_mis(c, cameraRevPdfW);
+    return 1.0f / (wLight + 1.0f + wCamera); /* [TR (37)] */
+}
+
+#endif /* UB_MIS_H */

@@ -1,0 +1,39 @@
+// Hashed grid build: counting sort of point indices by bucket (see hash_grid.h).
+#include "estimators/hash_grid.h"
+
+#include <cmath>
+
+namespace ub {
+
+void HashGrid::build(const Vec3* positions, size_t count, size_t stride, float radius,
+                     size_t cellCount) {
+    radius_ = radius;
+    radiusSqr_ = radius * radius;
+    invCellSize_ = 1.0f / (2.0f * radius);
+    if (cellCount == 0) cellCount = count > 0 ? count : 1;
+    cellEnds_.assign(cellCount, 0);
+    indices_.resize(count);
+    lo_ = Vec3(kInf);
+    for (size_t i = 0; i < count; ++i) lo_ = vmin(lo_, at(positions, stride, i));
+    if (count == 0) return;
+
+    auto bucketOf = [&](const Vec3& p) {
+        Vec3 d = (p - lo_) * invCellSize_;
+        return cellIndex(int(std::floor(d.x)), int(std::floor(d.y)), int(std::floor(d.z)));
+    };
+    // Histogram, exclusive prefix sum, scatter (stable: indices stay ascending per bucket).
+    for (size_t i = 0; i < count; ++i) ++cellEnds_[bucketOf(at(positions, stride, i))];
+    uint32_t sum = 0;
+    for (auto& e : cellEnds_) {
+        uint32_t n = e;
+        e = sum;
+        sum += n;
+    }
+    for (size_t i = 0; i < count; ++i) {
+        uint32_t b = bucketOf(at(positions, stride, i));
+        indices_[cellEnds_[b]++] = uint32_t(i);
+    }
+    // cellEnds_[b] now holds the end of bucket b.
+}
+
+}  // namespace ub

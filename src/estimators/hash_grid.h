@@ -1,0 +1,94 @@
+// Hashed uniform grid for fixed-radius range queries over points (surface
+// photons / light vertices for vertex merging). After Teschner et al. 2003,
+// "Optimized Spatial Hashing for Collision Detection of Deformable Objects",
+// as used by SmallVCM and Georgiev et al. 2012 for VCM.
+//
+// Cells have edge 2r, so the ball of radius r around a query point overlaps at
+// most the 2x2x2 block of cells nearest to it. Cells are hashed into `cellCount`
+// buckets; a counting sort lays the point indices out bucket by bucket. Unlike a
+// plain hashed lookup, a query visits each distinct bucket of its 8 cells only
+// once (two cells may hash to the same bucket), so every point within r is
+// reported exactly once. Build is O(N), a query is O(points in 8 buckets).
+// The grid stores indices only; positions stay with the caller.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/vec.h"
+
+namespace ub {
+
+class HashGrid {
+public:
+    /// Builds the grid over positions[0..count) (the pointer is read during build only;
+    /// `stride` is the distance in bytes between consecutive positions, so callers can
+    /// pass a member of an array of structs). cellCount 0 picks max(count, 1).
+    void build(const Vec3* positions, size_t count, size_t stride, float radius,
+               size_t cellCount = 0);
+    template <class T>
+    void build(const std::vector<T>& items, const Vec3 T::*member, float radius) {
+        const Vec3* first = items.empty() ? nullptr : &(items[0].*member);
+        build(first, items.size(), sizeof(T), radius);
+    }
+
+    /// Calls visit(index) for every point i with |positions[i] - q| <= radius, each once.
+    /// `positions` must be the data the grid was built from.
+    template <class Visit>
+    void query(const Vec3& q, const Vec3* positions, size_t stride, Visit&& visit) const;
+    template <class T, class Visit>
+    void query(const Vec3& q, const std::vector<T>& items, const Vec3 T::*member,
+               Visit&& visit) const {
+        if (items.empty()) return;
+        query(q, &(items[0].*member), sizeof(T), visit);
+    }
+
+    float radius() const { return radius_; }
+    size_t cellCount() const { return cellEnds_.size(); }
+
+private:
+    /// Hash of integer cell coordinates (Teschner et al. 2003) into [0, cellCount).
+    uint32_t cellIndex(int x, int y, int z) const {
+        uint32_t h = (uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^
+                     (uint32_t(z) * 83492791u);
+        return h % uint32_t(cellEnds_.size());
+    }
+    static const Vec3& at(const Vec3* base, size_t stride, size_t i) {
+        return *reinterpret_cast<const Vec3*>(reinterpret_cast<const char*>(base) + i * stride);
+    }
+
+    Vec3 lo_;                          ///< bounding box corner of the points
+    float radius_ = 0, radiusSqr_ = 0, invCellSize_ = 0;
+    std::vector<uint32_t> indices_;    ///< point indices sorted by bucket
+    std::vector<uint32_t> cellEnds_;   ///< end offset in indices_ of each bucket
+};
+
+template <class Visit>
+void HashGrid::query(const Vec3& q, const Vec3* positions, size_t stride, Visit&& visit) const {
+    if (indices_.empty()) return;
+    // Cell coordinates relative to lo_; the 2x2x2 block whose centre is nearest q.
+    Vec3 d = (q - lo_) * invCellSize_;
+    int base[3];
+    for (int a = 0; a < 3; ++a) {
+        float f = std::floor(d[a]);
+        base[a] = int(f) - (d[a] - f < 0.5f ? 1 : 0);
+    }
+    uint32_t buckets[8];
+    int nb = 0;
+    for (int k = 0; k < 8; ++k) {
+        uint32_t b = cellIndex(base[0] + (k & 1), base[1] + ((k >> 1) & 1), base[2] + (k >> 2));
+        bool seen = false;
+        for (int j = 0; j < nb; ++j) seen |= buckets[j] == b;
+        if (!seen) buckets[nb++] = b;
+    }
+    for (int j = 0; j < nb; ++j) {
+        uint32_t b = buckets[j];
+        uint32_t begin = b == 0 ? 0 : cellEnds_[b - 1], end = cellEnds_[b];
+        for (uint32_t i = begin; i < end; ++i) {
+            uint32_t idx = indices_[i];
+            if (lengthSqr(at(positions, stride, idx) - q) <= radiusSqr_) visit(idx);
+        }
+    }
+}
+
+}  // namespace ub

@@ -1,0 +1,72 @@
+// HashGrid range queries against brute force: every point within the radius is
+// reported exactly once and nothing farther away, for clustered and spread
+// points, small and large radii (many cells share buckets), and an empty grid.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "core/rng.h"
+#include "estimators/hash_grid.h"
+
+using namespace ub;
+
+namespace {
+
+struct Photon {
+    float pad;  // the position is not the first member: exercises the stride path
+    Vec3 pos;
+};
+
+void checkAgainstBruteForce(const std::vector<Photon>& pts, float radius, size_t cellCount,
+                            uint64_t seed) {
+    HashGrid grid;
+    grid.build(&pts[0].pos, pts.size(), sizeof(Photon), radius, cellCount);
+    Rng rng(seed, 1);
+    for (int q = 0; q < 300; ++q) {
+        // Half the queries sit on a point, the others anywhere in a slightly larger box.
+        Vec3 x = (q % 2 == 0) ? pts[rng.nextU32() % pts.size()].pos
+                              : Vec3(rng.uniform() * 1.2f - 0.1f, rng.uniform() * 1.2f - 0.1f,
+                                     rng.uniform() * 1.2f - 0.1f);
+        std::vector<uint32_t> found, expected;
+        grid.query(x, &pts[0].pos, sizeof(Photon), [&](uint32_t i) { found.push_back(i); });
+        for (uint32_t i = 0; i < pts.size(); ++i)
+            if (lengthSqr(pts[i].pos - x) <= radius * radius) expected.push_back(i);
+        std::sort(found.begin(), found.end());
+        ASSERT_EQ(found, expected) << "radius " << radius << " cells " << cellCount;
+    }
+}
+
+}  // namespace
+
+TEST(HashGrid, RangeQueryEqualsBruteForce) {
+    Rng rng(5, 5);
+    std::vector<Photon> pts(3000);
+    for (auto& p : pts) p.pos = Vec3(rng.uniform(), rng.uniform(), rng.uniform());
+    // Clustered points on a plane (photons on a floor) with duplicates.
+    for (int i = 0; i < 500; ++i) pts[i].pos = Vec3(0.3f + 0.01f * rng.uniform(), 0.5f, 0.2f);
+    for (float r : {0.003f, 0.02f, 0.1f, 0.6f})
+        for (size_t cells : {size_t(0), size_t(1), size_t(7), size_t(100000)})
+            checkAgainstBruteForce(pts, r, cells, 11);
+}
+
+TEST(HashGrid, EmptyGridFindsNothing) {
+    HashGrid grid;
+    std::vector<Photon> none;
+    grid.build(nullptr, 0, sizeof(Photon), 0.1f);
+    int n = 0;
+    grid.query(Vec3(0, 0, 0), nullptr, sizeof(Photon), [&](uint32_t) { ++n; });
+    EXPECT_EQ(n, 0);
+}
+
+TEST(HashGrid, VectorOfStructsOverload) {
+    std::vector<Photon> pts(3);
+    pts[0].pos = Vec3(0, 0, 0);
+    pts[1].pos = Vec3(0.05f, 0, 0);
+    pts[2].pos = Vec3(1, 1, 1);
+    HashGrid grid;
+    grid.build(pts, &Photon::pos, 0.1f);
+    std::vector<uint32_t> found;
+    grid.query(Vec3(0.01f, 0, 0), pts, &Photon::pos, [&](uint32_t i) { found.push_back(i); });
+    std::sort(found.begin(), found.end());
+    EXPECT_EQ(found, (std::vector<uint32_t>{0, 1}));
+}

@@ -1,0 +1,169 @@
+// The recursive MIS weights of kernels/shared/ub_mis.h (Georgiev et al. 2012,
+// tech. report "Implementing VCM") against weights computed from the explicit
+// area pdfs of every technique that could have sampled a path
+// (tests/support/mis_path.h, shared/notes/mis.md Sec. 4).
+//
+// Tolerance: the recursion runs in float, the reference in double. Each weight
+// is a ratio of sums of products of < 20 positive factors, each rounded with
+// relative error 2^-24, so the float error stays far below 1e-5 for the
+// ranges drawn here (pdfs, cosines and distances within [0.05, 5]); 1e-4
+// (absolute, weights lie in [0,1]) leaves a 10x margin and still catches any
+// missing factor (those change weights by O(0.01..1)).
+#include <gtest/gtest.h>
+
+#include "core/rng.h"
+#include "tests/support/mis_path.h"
+
+using namespace ub;
+using namespace ub::test;
+
+namespace {
+
+float uniformIn(Rng& rng, float lo, float hi) { return lo + (hi - lo) * rng.uniform(); }
+
+// A random path with k segments and primitives in moderate ranges. Specular
+// vertices use equal forward/reverse lobe probabilities, as delta BSDFs do.
+MisPath randomPath(Rng& rng, int k, MisLightKind kind, float specularProb) {
+    MisPath p;
+    p.lightKind = kind;
+    p.lightPickProb = 1.0f / float(1 + int(rng.uniform() * 3));
+    p.emitPosPdf = uniformIn(rng, 0.1f, 5.0f);
+    p.emitDirPdfW = uniformIn(rng, 0.05f, 2.0f);
+    p.directPdfA = uniformIn(rng, 0.1f, 5.0f);
+    p.cosLight = uniformIn(rng, 0.1f, 1.0f);
+    if (kind == MisLightKind::Point) {
+        p.emitPosPdf = 1;
+        p.directPdfA = 1;
+        p.cosLight = 1;
+        p.emitDirPdfW = 0.25f / kPi;
+    } else if (kind == MisLightKind::Directional) {
+        p.emitDirPdfW = 1;
+        p.directPdfA = 1;
+        p.cosLight = 1;
+    } else if (kind == MisLightKind::Environment) {
+        p.directPdfA = p.emitDirPdfW;  // illuminate and emit share the direction pdf
+        p.cosLight = 1;
+    }
+    p.dist.assign(k + 1, 0);
+    for (int i = 1; i <= k; ++i) p.dist[i] = uniformIn(rng, 0.2f, 3.0f);
+    p.v.assign(k, MisVertex{});
+    for (int i = 1; i < k; ++i) {
+        MisVertex& x = p.v[i];
+        x.cosIn = uniformIn(rng, 0.1f, 1.0f);
+        x.cosOut = uniformIn(rng, 0.1f, 1.0f);
+        x.cont = uniformIn(rng, 0.5f, 1.0f);
+        x.specular = rng.uniform() < specularProb;
+        if (x.specular) {
+            x.pdfFwdW = x.pdfRevW = uniformIn(rng, 0.3f, 1.0f);
+        } else {
+            x.pdfFwdW = uniformIn(rng, 0.05f, 3.0f);
+            x.pdfRevW = uniformIn(rng, 0.05f, 3.0f);
+        }
+    }
+    p.cameraPdfW = uniformIn(rng, 0.5f, 4.0f) * 1000.0f;  // d_img^2 / cos^3 ~ 10^3 at 64x64
+    return p;
+}
+
+struct NamedConfig {
+    const char* name;
+    MisConfig cfg;
+};
+
+std::vector<NamedConfig> configs() {
+    std::vector<NamedConfig> out;
+    for (ub_uint h : {UB_MIS_POWER, UB_MIS_BALANCE}) {
+        MisConfig bpt, bpm, vcm;
+        bpt.useVM = false;
+        bpm.useVC = false;
+        bpt.heuristic = bpm.heuristic = vcm.heuristic = h;
+        // Radius chosen so that eta = N_L pi r^2 ~ 8: merging and connection pdfs compete.
+        vcm.radius = bpm.radius = bpt.radius = 0.05f;
+        out.push_back({h == UB_MIS_POWER ? "bpt/power" : "bpt/balance", bpt});
+        out.push_back({h == UB_MIS_POWER ? "bpm/power" : "bpm/balance", bpm});
+        out.push_back({h == UB_MIS_POWER ? "vcm/power" : "vcm/balance", vcm});
+    }
+    return out;
+}
+
+const MisLightKind kKinds[] = {MisLightKind::Area, MisLightKind::Point,
+                               MisLightKind::Directional, MisLightKind::Environment};
+
+}  // namespace
+
+TEST(MisBruteForce, RecursiveWeightsEqualExplicitPdfWeights) {
+    Rng rng(42, 7);
+    int compared = 0;
+    for (const NamedConfig& nc : configs()) {
+        for (int n = 0; n < 3000; ++n) {
+            int k = 2 + int(rng.uniform() * 7);
+            MisLightKind kind = kKinds[n % 4];
+            MisPath p = randomPath(rng, k, kind, 0.3f);
+            auto ref = bruteForceWeights(p, nc.cfg);
+            auto rec = recursiveWeights(p, nc.cfg);
+            ASSERT_EQ(ref.size(), rec.size());
+            for (size_t t = 0; t < ref.size(); ++t) {
+                ASSERT_NEAR(rec[t].weight, ref[t].weight, 1e-4)
+                    << nc.name << " k=" << k << " light kind " << int(kind) << " technique "
+                    << ref[t].name() << " (path " << n << ")";
+                ++compared;
+            }
+        }
+    }
+    EXPECT_GT(compared, 50000);
+}
+
+TEST(MisBruteForce, WeightsOfOnePathSumToOne) {
+    Rng rng(43, 7);
+    for (const NamedConfig& nc : configs()) {
+        for (int n = 0; n < 3000; ++n) {
+            int k = 2 + int(rng.uniform() * 7);
+            MisPath p = randomPath(rng, k, kKinds[n % 4], 0.3f);
+            auto rec = recursiveWeights(p, nc.cfg);
+            if (rec.empty()) continue;  // e.g. delta light seen only through mirrors
+            double sum = 0;
+            for (const auto& t : rec) sum += t.weight;
+            ASSERT_NEAR(sum, 1.0, 1e-4) << nc.name << " k=" << k << " path " << n;
+        }
+    }
+}
+
+// With both connection and merging enabled, dVM = dVC / eta at every vertex (same
+// initial ratio [TR (33)], same linear recursion [TR (34), (35)] scaled by 1/eta).
+TEST(MisBruteForce, MergePartialIsConnectionPartialOverEta) {
+    Rng rng(44, 7);
+    ub_mis_constants c = ub_mis_make_constants(0.05f, 1000.0f, 1, 1, UB_MIS_POWER);
+    for (int n = 0; n < 1000; ++n) {
+        MisPath p = randomPath(rng, 8, MisLightKind::Area, 0.3f);
+        ub_mis_partials lp = ub_mis_init_light(c, p.directPdfA, p.emitPosPdf * p.emitDirPdfW,
+                                               p.cosLight, 0, 1);
+        for (int i = 1; i < 8; ++i) {
+            const MisVertex& x = p.v[i];
+            lp = ub_mis_at_hit(c, lp, p.dist[i], x.cosIn, 1);
+            ASSERT_NEAR(lp.dVM, lp.dVC * c.vcWeightFactor, 1e-5f * lp.dVM + 1e-30f);
+            lp = ub_mis_scatter(c, lp, x.cosOut, x.pdfFwdW * x.cont, x.pdfRevW * x.cont,
+                                x.specular);
+        }
+    }
+}
+
+// Hand-checked special cases of the technique sets.
+TEST(MisBruteForce, TechniqueSetsFollowSmallVcm) {
+    MisPath p;
+    p.dist = {0, 1, 1, 1};
+    p.v.assign(3, MisVertex{});
+    p.v[1].specular = true;
+    MisConfig bpm;
+    bpm.useVC = false;
+    // x_1 specular, x_2 diffuse: BPM merges at x_2 only; the camera hit is not a BPM technique.
+    auto t = validTechniques(p, bpm);
+    ASSERT_EQ(t.size(), 1u);
+    EXPECT_TRUE(t[0].merge);
+    EXPECT_EQ(t[0].index, 2);
+    // BPT: camera hit, NEE impossible (x_1 specular), s=2 impossible, light tracing from x_2.
+    MisConfig bpt;
+    bpt.useVM = false;
+    t = validTechniques(p, bpt);
+    ASSERT_EQ(t.size(), 2u);
+    EXPECT_EQ(t[0].index, 0);
+    EXPECT_EQ(t[1].index, 3);
+}

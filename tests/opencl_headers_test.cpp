@@ -1,0 +1,103 @@
+// Every header in kernels/shared/ must compile as OpenCL C (DESIGN.md: the math
+// shared by host and kernels is written once). Each header is built as its own
+// OpenCL C 1.2 program on the first available OpenCL device (PoCL on the CPU by
+// default, installed by scripts/setup.sh), with a probe kernel so the program is
+// not empty. A missing OpenCL platform is a failure with a clear message, never a skip.
+#include <gtest/gtest.h>
+
+#define CL_TARGET_OPENCL_VERSION 120
+#include <CL/cl.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct ClDevice {
+    cl_platform_id platform = nullptr;
+    cl_device_id device = nullptr;
+    std::string description;
+    std::string error;
+};
+
+// First platform with any device; prefers a CPU device (PoCL) so results do not
+// depend on which GPU driver happens to be installed.
+ClDevice findDevice() {
+    ClDevice out;
+    cl_uint np = 0;
+    if (clGetPlatformIDs(0, nullptr, &np) != CL_SUCCESS || np == 0) {
+        out.error = "no OpenCL platform found (install PoCL: scripts/setup.sh installs "
+                    "pocl-opencl-icd; check /etc/OpenCL/vendors)";
+        return out;
+    }
+    std::vector<cl_platform_id> platforms(np);
+    clGetPlatformIDs(np, platforms.data(), nullptr);
+    for (cl_device_type type : {cl_device_type(CL_DEVICE_TYPE_CPU), cl_device_type(CL_DEVICE_TYPE_ALL)}) {
+        for (cl_platform_id p : platforms) {
+            cl_device_id d = nullptr;
+            cl_uint nd = 0;
+            if (clGetDeviceIDs(p, type, 1, &d, &nd) == CL_SUCCESS && nd > 0) {
+                char name[256] = {0}, pname[256] = {0};
+                clGetDeviceInfo(d, CL_DEVICE_NAME, sizeof(name) - 1, name, nullptr);
+                clGetPlatformInfo(p, CL_PLATFORM_NAME, sizeof(pname) - 1, pname, nullptr);
+                out.platform = p;
+                out.device = d;
+                out.description = std::string(pname) + " / " + name;
+                return out;
+            }
+        }
+    }
+    out.error = "OpenCL platforms exist but none has a device";
+    return out;
+}
+
+std::vector<std::string> sharedHeaders() {
+    namespace fs = std::filesystem;
+    std::vector<std::string> out;
+    fs::path dir = fs::path(UNIBEAM_SOURCE_DIR) / "kernels" / "shared";
+    for (const auto& e : fs::directory_iterator(dir))
+        if (e.path().extension() == ".h") out.push_back(e.path().filename().string());
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+}  // namespace
+
+TEST(OpenClHeaders, EverySharedHeaderBuildsAsOpenClC) {
+    ClDevice dev = findDevice();
+    ASSERT_TRUE(dev.error.empty()) << dev.error;
+    cl_int err = CL_SUCCESS;
+    cl_context ctx = clCreateContext(nullptr, 1, &dev.device, nullptr, nullptr, &err);
+    ASSERT_EQ(err, CL_SUCCESS) << "clCreateContext failed on " << dev.description;
+
+    const std::string includeDir = std::string(UNIBEAM_SOURCE_DIR) + "/kernels/shared";
+    ASSERT_EQ(includeDir.find(' '), std::string::npos)
+        << "the OpenCL include path must not contain spaces: " << includeDir;
+    const std::vector<std::string> headers = sharedHeaders();
+    ASSERT_FALSE(headers.empty()) << "no headers found in " << includeDir;
+    for (const std::string& h : headers) {
+        SCOPED_TRACE(h);
+        std::string src = "#include \"" + h + "\"\n__kernel void ub_header_probe(__global int* o) { o[0] = 1; }\n";
+        const char* s = src.c_str();
+        size_t len = src.size();
+        cl_program prog = clCreateProgramWithSource(ctx, 1, &s, &len, &err);
+        ASSERT_EQ(err, CL_SUCCESS);
+        // PoCL does not strip quotes from -I; the source path must not contain spaces.
+        std::string options = "-cl-std=CL1.2 -I" + includeDir;
+        cl_int buildErr = clBuildProgram(prog, 1, &dev.device, options.c_str(), nullptr, nullptr);
+        size_t logSize = 0;
+        clGetProgramBuildInfo(prog, dev.device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &logSize);
+        std::string log(logSize, '\0');
+        if (logSize > 0)
+            clGetProgramBuildInfo(prog, dev.device, CL_PROGRAM_BUILD_LOG, logSize, log.data(),
+                                  nullptr);
+        while (!log.empty() && log.back() == '\0') log.pop_back();
+        EXPECT_EQ(buildErr, CL_SUCCESS)
+            << "kernels/shared/" << h << " does not build as OpenCL C on " << dev.description
+            << ":\n" << log;
+        clReleaseProgram(prog);
+    }
+    clReleaseContext(ctx);
+}

@@ -1,0 +1,222 @@
+// Test support for the surface MIS weights (kernels/shared/ub_mis.h): a full
+// path x_0 (light) ... x_k (pinhole camera) described by the primitive
+// quantities the renderer sees (solid-angle pdfs, cosines, distances), and two
+// ways to compute the MIS weight of every technique that could have produced it:
+//
+//  * bruteForceWeights: from explicit area pdfs of every technique (Veach 1997,
+//    Ch. 10; shared/notes/mis.md Sec. 4), in double precision:
+//      connection s (s light vertices): P_s = (prod_{j<s} a~_j) (prod_{j>=s} b_j),
+//      merging at x_i:                  M_i = (prod_{j<=i} a_j) (prod_{j>=i} b_j) eta,
+//    with a~_0 = a_0^NEE for s = 1, eta = N_L pi r^2, counts n = 1 (connections),
+//    N_L (light tracing), and w_T = (n_T p_T)^beta / sum_T' (n_T' p_T')^beta.
+//  * recursiveWeights: the dVCM/dVC/dVM recursion of ub_mis.h run along the two
+//    subpaths exactly as the renderer runs it.
+//
+// Only tests use this file.
+#pragma once
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "kernels/shared/ub_mis.h"
+
+namespace ub::test {
+
+/// Intermediate vertex x_i, 1 <= i <= k-1. "Fwd" is the light direction
+/// (x_{i-1} -> x_i -> x_{i+1}), "Rev" the camera direction.
+struct MisVertex {
+    float cosIn = 1;    ///< |cos| at x_i of the segment to x_{i-1}
+    float cosOut = 1;   ///< |cos| at x_i of the segment to x_{i+1}
+    float pdfFwdW = 1;  ///< p(dir to x_{i+1} | from x_{i-1}), without continuation probability
+    float pdfRevW = 1;  ///< p(dir to x_{i-1} | from x_{i+1}), without continuation probability
+    float cont = 1;     ///< Russian-roulette continuation probability at x_i
+    bool specular = false;  ///< delta lobe: pdfs are the discrete lobe probability (equal)
+};
+
+enum class MisLightKind { Area, Point, Directional, Environment };
+
+struct MisPath {
+    MisLightKind lightKind = MisLightKind::Area;
+    float lightPickProb = 1;
+    /// Emission: position pdf (area; scene disk for lights at infinity) and direction pdf
+    /// (solid angle), without pick probability. emissionPdfW = posPdf * dirPdf.
+    float emitPosPdf = 1, emitDirPdfW = 1;
+    /// NEE: illuminate()'s pdf of choosing x_0 in area measure (finite lights) or solid
+    /// angle (environment), without pick probability; 1 for delta lights.
+    float directPdfA = 1;
+    float cosLight = 1;           ///< cosine at x_0 of the segment x_0 x_1 (finite area lights)
+    std::vector<float> dist;      ///< dist[i] = |x_i - x_{i-1}|, i = 1..k (dist[0] unused)
+    std::vector<MisVertex> v;     ///< v[i], i = 1..k-1 (v[0] unused)
+    float cameraPdfW = 1;         ///< p_cam,W of the direction from the camera to x_{k-1}
+    int k() const { return int(dist.size()) - 1; }
+    bool lightIsDelta() const {
+        return lightKind == MisLightKind::Point || lightKind == MisLightKind::Directional;
+    }
+    bool lightIsFinite() const {
+        return lightKind == MisLightKind::Area || lightKind == MisLightKind::Point;
+    }
+};
+
+struct MisConfig {
+    bool useVC = true, useVM = true;
+    float radius = 0.05f;
+    float lightSubPathCount = 1000;
+    ub_uint heuristic = UB_MIS_POWER;
+};
+
+/// A technique: connection with s light vertices (s = 0: camera hits the light,
+/// s = 1: NEE, s = k: light tracing), or merging at x_i.
+struct MisTechnique {
+    bool merge = false;
+    int index = 0;  ///< s for connections, i for merges
+    double weight = 0;
+    std::string name() const {
+        return (merge ? "merge@x" : "connect s=") + std::to_string(index);
+    }
+};
+
+/// Which techniques the renderer has for `path` under `cfg` (SmallVCM's semantics: BPM/PPM
+/// count a camera subpath hitting a light only for purely specular camera subpaths).
+inline std::vector<MisTechnique> validTechniques(const MisPath& p, const MisConfig& cfg) {
+    const int k = p.k();
+    std::vector<MisTechnique> out;
+    auto connectible = [&](int i) { return i >= 1 && i <= k - 1 && !p.v[i].specular; };
+    bool allSpecular = true;
+    for (int i = 1; i < k; ++i) allSpecular &= p.v[i].specular;
+    bool hitValid = !p.lightIsDelta() && (cfg.useVC || allSpecular);
+    if (hitValid) out.push_back({false, 0});
+    if (cfg.useVC) {
+        for (int s = 1; s <= k - 1; ++s)
+            if (connectible(s) && (s == 1 || connectible(s - 1))) out.push_back({false, s});
+        if (k >= 2 && connectible(k - 1)) out.push_back({false, k});
+    }
+    if (cfg.useVM)
+        for (int i = 1; i <= k - 1; ++i)
+            if (connectible(i)) out.push_back({true, i});
+    return out;
+}
+
+/// Explicit per-vertex area pdfs and the weights w_T = (n p_T)^beta / sum (n p_T')^beta.
+inline std::vector<MisTechnique> bruteForceWeights(const MisPath& p, const MisConfig& cfg) {
+    const int k = p.k();
+    // Forward (light-direction) pdfs a_0..a_{k-1} and a_0^NEE.
+    std::vector<double> a(k, 0), b(k, 0);
+    const bool finite = p.lightIsFinite();
+    double pick = p.lightPickProb;
+    // x_0: for finite lights the emitted position; for lights at infinity the direction
+    // (the planar position is then part of a_1, TR Sec. 5.1).
+    a[0] = pick * (finite ? p.emitPosPdf : p.emitDirPdfW);
+    double a0Nee = pick * p.directPdfA;
+    if (k >= 2) {
+        a[1] = finite ? double(p.emitDirPdfW) * p.v[1].cosIn / (double(p.dist[1]) * p.dist[1])
+                      : double(p.emitPosPdf) * p.v[1].cosIn;
+    }
+    for (int i = 2; i <= k - 1; ++i) {
+        const MisVertex& prev = p.v[i - 1];
+        a[i] = double(prev.pdfFwdW) * prev.cont * p.v[i].cosIn / (double(p.dist[i]) * p.dist[i]);
+    }
+    // Backward (camera-direction) pdfs b_0..b_{k-1}; b_k = 1 (pinhole).
+    for (int i = 0; i <= k - 1; ++i) {
+        double cosHere = i == 0 ? (finite ? p.cosLight : 1.0) : p.v[i].cosOut;
+        double d2 = double(p.dist[i + 1]) * p.dist[i + 1];
+        if (i == 0 && !finite) d2 = 1;  // solid-angle measure at infinity
+        double pw = i + 1 == k ? double(p.cameraPdfW) : double(p.v[i + 1].pdfRevW) * p.v[i + 1].cont;
+        b[i] = pw * cosHere / d2;
+    }
+    if (p.lightIsDelta()) b[0] = 0;
+
+    const double eta = M_PI * double(cfg.radius) * cfg.radius * cfg.lightSubPathCount;
+    std::vector<MisTechnique> techs = validTechniques(p, cfg);
+    double beta = cfg.heuristic == UB_MIS_POWER ? 2.0 : 1.0;
+    double sum = 0;
+    for (MisTechnique& t : techs) {
+        double pdf = 1;
+        if (!t.merge) {
+            int s = t.index;
+            for (int j = 0; j < s; ++j) pdf *= (j == 0 && s == 1) ? a0Nee : a[j];
+            for (int j = s; j <= k - 1; ++j) pdf *= b[j];
+            if (s == k) pdf *= cfg.lightSubPathCount;  // light tracing: N_L samples
+        } else {
+            int i = t.index;
+            for (int j = 0; j <= i; ++j) pdf *= a[j];
+            for (int j = i; j <= k - 1; ++j) pdf *= b[j];
+            pdf *= eta;
+        }
+        t.weight = std::pow(pdf, beta);
+        sum += t.weight;
+    }
+    for (MisTechnique& t : techs) t.weight /= sum;
+    return techs;
+}
+
+/// The recursive weights of ub_mis.h, evaluated with the quantities each subpath has
+/// at the vertex where the technique is applied (as the renderer does).
+inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisConfig& cfg) {
+    const int k = p.k();
+    ub_mis_constants c = ub_mis_make_constants(cfg.radius, cfg.lightSubPathCount, cfg.useVC,
+                                               cfg.useVM, cfg.heuristic);
+    const bool finite = p.lightIsFinite();
+    const float pick = p.lightPickProb;
+    const float emissionPdfW = p.emitPosPdf * p.emitDirPdfW;  // without pick probability
+    auto sq = [](float x) { return x * x; };
+
+    // Light subpath: partials stored at x_1..x_{k-1} (after the hit update).
+    std::vector<ub_mis_partials> L(k), E(k + 1);
+    ub_mis_partials lp = ub_mis_init_light(c, p.directPdfA * pick, emissionPdfW * pick,
+                                           p.cosLight, p.lightIsDelta(), finite);
+    for (int i = 1; i <= k - 1; ++i) {
+        const MisVertex& x = p.v[i];
+        lp = ub_mis_at_hit(c, lp, p.dist[i], x.cosIn, i > 1 || finite);
+        L[i] = lp;
+        lp = ub_mis_scatter(c, lp, x.cosOut, x.pdfFwdW * x.cont, x.pdfRevW * x.cont, x.specular);
+    }
+    // Camera subpath: partials at x_{k-1}..x_1, and at x_0 when it hits the light.
+    ub_mis_partials ep = ub_mis_init_camera(c, p.cameraPdfW);
+    for (int i = k - 1; i >= 1; --i) {
+        const MisVertex& x = p.v[i];
+        ep = ub_mis_at_hit(c, ep, p.dist[i + 1], x.cosOut, 1);
+        E[i] = ep;
+        ep = ub_mis_scatter(c, ep, x.cosIn, x.pdfRevW * x.cont, x.pdfFwdW * x.cont, x.specular);
+    }
+    // Lights at infinity are "hit" by escaping rays: no distance and no cosine.
+    E[0] = finite ? ub_mis_at_hit(c, ep, p.dist[1], p.cosLight, 1) : ep;
+
+    std::vector<MisTechnique> techs = validTechniques(p, cfg);
+    for (MisTechnique& t : techs) {
+        float w = 0;
+        if (t.merge) {
+            const MisVertex& x = p.v[t.index];
+            w = ub_mis_weight_merge(c, L[t.index], E[t.index], x.pdfRevW * x.cont,
+                                    x.pdfFwdW * x.cont);
+        } else if (t.index == 0) {
+            w = ub_mis_weight_hit_light(c, E[0], p.directPdfA * pick, emissionPdfW * pick);
+        } else if (t.index == 1 && k > 1) {
+            // NEE at x_1: illuminate()'s solid-angle pdf from the area pdf.
+            const MisVertex& x = p.v[1];
+            float cosAtLight = finite && !p.lightIsDelta() ? p.cosLight : 1.0f;
+            float directPdfW =
+                finite ? p.directPdfA * sq(p.dist[1]) / cosAtLight : p.directPdfA;
+            float bsdfDirPdfW = p.lightIsDelta() ? 0.0f : x.pdfRevW * x.cont;
+            w = ub_mis_weight_nee(c, E[1], bsdfDirPdfW, x.pdfFwdW * x.cont, pick, directPdfW,
+                                  emissionPdfW, x.cosIn, cosAtLight);
+        } else if (t.index == k) {
+            const MisVertex& y = p.v[k - 1];
+            float cameraPdfA = p.cameraPdfW * y.cosOut / sq(p.dist[k]);
+            w = ub_mis_weight_light_trace(c, L[k - 1], cameraPdfA, y.pdfRevW * y.cont);
+        } else {
+            int s = t.index;
+            const MisVertex& y = p.v[s - 1];  // light vertex
+            const MisVertex& z = p.v[s];      // camera vertex
+            float d2 = sq(p.dist[s]);
+            float cameraDirPdfA = z.pdfRevW * z.cont * y.cosOut / d2;
+            float lightDirPdfA = y.pdfFwdW * y.cont * z.cosIn / d2;
+            w = ub_mis_weight_connect(c, L[s - 1], E[s], cameraDirPdfA, y.pdfRevW * y.cont,
+                                      lightDirPdfA, z.pdfFwdW * z.cont);
+        }
+        t.weight = w;
+    }
+    return techs;
+}
+
+}  // namespace ub::test
