@@ -1,0 +1,510 @@
+// Scene geometry on Embree 3: triangle meshes (RTC_GEOMETRY_TYPE_TRIANGLE) and
+// analytic spheres (user geometry), one Embree geometry per shape, geomID = shapeId.
+//
+// ---- Self-intersection ---------------------------------------------------------
+// A hit point computed in floating point lies only near the surface, so a ray
+// leaving it can hit the same surface again at t ~ 0 ("surface acne"), or a ray
+// entering a closed object can start on the wrong side and escape. We avoid both
+// by moving ray origins off the surface along the geometric normal, to the side
+// of the outgoing direction (pbrt-v4 Sec. 6.8.6 does the same with a per-hit
+// error bound; Mitsuba 3 uses a relative epsilon as we do):
+//
+//     origin = p + sign(dot(n_g, dir)) * eps(p) * n_g,
+//     eps(p) = kRayEpsilon * (1 + max_i |p_i|).
+//
+// Why this bound suffices:
+//  * Triangle hits: p is interpolated from the vertices with the barycentrics
+//    Embree returns (not org + t*dir, whose error grows with t), so its distance
+//    to the triangle's plane is a few ulps of the coordinates, ~1e-7 * |p|.
+//    kRayEpsilon = 1e-5 leaves a margin of ~100 over that and over the error of
+//    Embree's own watertight (RTC_SCENE_FLAG_ROBUST) test on the plane side.
+//  * Sphere hits: solved in double with the cancellation-free quadratic of
+//    Haines et al., "Precision Improvements for Ray/Sphere Intersection" (Ray
+//    Tracing Gems, ch. 7, 2019), then re-projected onto the sphere, so p is within
+//    an ulp or two of the surface.
+//  * The "1 +" term is an absolute floor for points near the world origin on
+//    triangles whose vertices are far away (unit-scale scenes).
+// Because the offset is along the normal (not along dir), the origin is at
+// distance eps from the tangent plane for every direction: a ray leaving a plane
+// or the convex side of a sphere cannot re-hit it, and a ray entering a closed
+// surface starts strictly inside it. Offsets are applied in spawnRay(),
+// occluded() (both ends, each towards the other) and occludedToInfinity(); a zero
+// normal marks a point not on a surface (camera, point light) and is not moved.
+// Cost: contact shadows and inter-reflections closer than eps(p) are lost,
+// i.e. features below ~1e-5 of the coordinate magnitude.
+// ---------------------------------------------------------------------------------
+#include "scene/scene.h"
+
+#include <embree3/rtcore.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "core/error.h"
+
+namespace ub {
+
+namespace {
+
+constexpr float kRayEpsilon = 1e-5f;
+constexpr double kPiD = 3.14159265358979323846;
+
+float maxAbs(const Vec3& p) {
+    return std::max(std::abs(p.x), std::max(std::abs(p.y), std::abs(p.z)));
+}
+
+/// Origin offset of the comment block above; n is a unit normal or zero.
+Vec3 offsetOrigin(const Vec3& p, const Vec3& n, const Vec3& dir) {
+    float eps = kRayEpsilon * (1.0f + maxAbs(p));
+    return p + n * (dot(n, dir) >= 0.0f ? eps : -eps);
+}
+
+const char* embreeErrorName(RTCError e) {
+    switch (e) {
+        case RTC_ERROR_NONE:
+            return "no error";
+        case RTC_ERROR_UNKNOWN:
+            return "unknown error";
+        case RTC_ERROR_INVALID_ARGUMENT:
+            return "invalid argument";
+        case RTC_ERROR_INVALID_OPERATION:
+            return "invalid operation";
+        case RTC_ERROR_OUT_OF_MEMORY:
+            return "out of memory";
+        case RTC_ERROR_UNSUPPORTED_CPU:
+            return "unsupported CPU (Embree needs at least SSE2)";
+        case RTC_ERROR_CANCELLED:
+            return "cancelled";
+    }
+    return "unrecognised error code";
+}
+
+/// Last error message reported by Embree on this thread (Embree keeps error codes
+/// per thread too, so queries and builds on different threads do not mix).
+thread_local std::string tlsEmbreeMessage;
+
+void embreeErrorCallback(void*, RTCError code, const char* str) {
+    tlsEmbreeMessage = std::string(embreeErrorName(code)) + (str ? std::string(": ") + str : "");
+}
+
+struct SphereGeom {
+    Vec3 center;
+    float radius;
+};
+
+/// Both roots of |o + t d - c|^2 = r^2 in double, without catastrophic
+/// cancellation (Haines et al. 2019, Eqs. 7.5-7.8): the discriminant is formed from
+/// the squared distance of c to the ray line, and the smaller-magnitude root from
+/// Vieta's formula. Returns false if the line misses the sphere.
+bool solveSphere(const SphereGeom& s, double ox, double oy, double oz, double dx, double dy,
+                 double dz, double* t0, double* t1) {
+    double fx = ox - s.center.x, fy = oy - s.center.y, fz = oz - s.center.z;
+    double a = dx * dx + dy * dy + dz * dz;
+    double b = fx * dx + fy * dy + fz * dz;  // half the linear coefficient
+    double r2 = double(s.radius) * double(s.radius);
+    double lx = fx - (b / a) * dx, ly = fy - (b / a) * dy, lz = fz - (b / a) * dz;
+    double disc = a * (r2 - (lx * lx + ly * ly + lz * lz));  // = b^2 - a c
+    if (disc < 0.0) return false;
+    double c = fx * fx + fy * fy + fz * fz - r2;
+    double q = -(b + std::copysign(std::sqrt(disc), b));
+    double ta, tb;
+    if (q == 0.0) {
+        ta = tb = 0.0;  // tangent ray through the origin's closest point
+    } else {
+        ta = q / a;
+        tb = c / q;
+    }
+    *t0 = std::min(ta, tb);
+    *t1 = std::max(ta, tb);
+    return true;
+}
+
+void sphereBounds(const RTCBoundsFunctionArguments* args) {
+    const auto* s = static_cast<const SphereGeom*>(args->geometryUserPtr);
+    // Slightly enlarged so that float rounding of the box never clips the sphere.
+    float r = s->radius * (1.0f + 1e-6f) + 1e-7f * (1.0f + maxAbs(s->center));
+    RTCBounds* b = args->bounds_o;
+    b->lower_x = s->center.x - r;
+    b->lower_y = s->center.y - r;
+    b->lower_z = s->center.z - r;
+    b->upper_x = s->center.x + r;
+    b->upper_y = s->center.y + r;
+    b->upper_z = s->center.z + r;
+}
+
+void sphereIntersect(const RTCIntersectFunctionNArguments* args) {
+    const auto* s = static_cast<const SphereGeom*>(args->geometryUserPtr);
+    const unsigned N = args->N;
+    RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, N);
+    RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, N);
+    for (unsigned i = 0; i < N; ++i) {
+        if (!args->valid[i]) continue;
+        double ox = RTCRayN_org_x(ray, N, i), oy = RTCRayN_org_y(ray, N, i),
+               oz = RTCRayN_org_z(ray, N, i);
+        double dx = RTCRayN_dir_x(ray, N, i), dy = RTCRayN_dir_y(ray, N, i),
+               dz = RTCRayN_dir_z(ray, N, i);
+        double t0, t1;
+        if (!solveSphere(*s, ox, oy, oz, dx, dy, dz, &t0, &t1)) continue;
+        double tnear = RTCRayN_tnear(ray, N, i), tfar = RTCRayN_tfar(ray, N, i);
+        // Nearest root inside (tnear, tfar): the far root when the origin is inside.
+        double t = (t0 > tnear) ? t0 : t1;
+        if (!(t > tnear && t < tfar)) continue;
+        RTCRayN_tfar(ray, N, i) = float(t);
+        RTCHitN_Ng_x(hit, N, i) = float(ox + t * dx - s->center.x);
+        RTCHitN_Ng_y(hit, N, i) = float(oy + t * dy - s->center.y);
+        RTCHitN_Ng_z(hit, N, i) = float(oz + t * dz - s->center.z);
+        RTCHitN_u(hit, N, i) = 0.0f;
+        RTCHitN_v(hit, N, i) = 0.0f;
+        RTCHitN_primID(hit, N, i) = args->primID;
+        RTCHitN_geomID(hit, N, i) = args->geomID;
+        RTCHitN_instID(hit, N, i, 0) = args->context->instID[0];
+    }
+}
+
+void sphereOccluded(const RTCOccludedFunctionNArguments* args) {
+    const auto* s = static_cast<const SphereGeom*>(args->geometryUserPtr);
+    const unsigned N = args->N;
+    RTCRayN* ray = args->ray;
+    for (unsigned i = 0; i < N; ++i) {
+        if (!args->valid[i]) continue;
+        double t0, t1;
+        if (!solveSphere(*s, RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i),
+                         RTCRayN_org_z(ray, N, i), RTCRayN_dir_x(ray, N, i),
+                         RTCRayN_dir_y(ray, N, i), RTCRayN_dir_z(ray, N, i), &t0, &t1))
+            continue;
+        double tnear = RTCRayN_tnear(ray, N, i), tfar = RTCRayN_tfar(ray, N, i);
+        if ((t0 > tnear && t0 < tfar) || (t1 > tnear && t1 < tfar))
+            RTCRayN_tfar(ray, N, i) = -std::numeric_limits<float>::infinity();
+    }
+}
+
+/// Per-shape data needed to fill a Hit. Vertex and index arrays live in Embree's
+/// buffers (no second copy).
+struct ShapeGeom {
+    bool isSphere = false;
+    std::unique_ptr<SphereGeom> sphere;  // stable address: Embree's user data pointer
+    const float* vertices = nullptr;     // 3 floats per vertex (Embree buffer)
+    const uint32_t* indices = nullptr;   // 3 per triangle (Embree buffer)
+    std::vector<Vec3> normals;
+    std::vector<Vec2> uvs;
+};
+
+}  // namespace
+
+struct Scene::Impl {
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    std::vector<ShapeGeom> geoms;
+    bool committed = false;
+
+    ~Impl() {
+        if (scene) rtcReleaseScene(scene);
+        if (device) rtcReleaseDevice(device);
+    }
+
+    /// Throws std::runtime_error if Embree reported an error on this thread.
+    void check(const char* what) const {
+        RTCError e = rtcGetDeviceError(device);
+        if (e != RTC_ERROR_NONE)
+            throw std::runtime_error(
+                std::string("Embree error while ") + what + ": " +
+                (tlsEmbreeMessage.empty() ? embreeErrorName(e) : tlsEmbreeMessage));
+    }
+
+    Vec3 vertex(const ShapeGeom& g, uint32_t i) const {
+        const float* v = g.vertices + 3 * size_t(i);
+        return {v[0], v[1], v[2]};
+    }
+};
+
+Scene::Scene() : impl_(std::make_unique<Impl>()) {
+    tlsEmbreeMessage.clear();
+    impl_->device = rtcNewDevice(nullptr);
+    if (!impl_->device) {
+        RTCError e = rtcGetDeviceError(nullptr);
+        throw std::runtime_error(std::string("cannot create the Embree ray tracing device: ") +
+                                 embreeErrorName(e));
+    }
+    rtcSetDeviceErrorFunction(impl_->device, embreeErrorCallback, nullptr);
+    impl_->scene = rtcNewScene(impl_->device);
+    impl_->check("creating the scene");
+    rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
+}
+
+Scene::~Scene() = default;
+
+int Scene::addMaterial(const Material& m) {
+    materials.push_back(m);
+    return int(materials.size()) - 1;
+}
+
+uint32_t Scene::addMesh(TriangleMesh mesh, int materialId, int lightId, const std::string& name) {
+    if (impl_->committed) throw std::logic_error("Scene::addMesh called after commit()");
+    const std::string label = "mesh '" + name + "'";
+    const size_t nv = mesh.positions.size();
+    if (mesh.indices.size() % 3 != 0)
+        throw InputError(sourceFile, label + ": index count " +
+                                         std::to_string(mesh.indices.size()) +
+                                         " is not a multiple of 3");
+    if (mesh.triangleCount() == 0) throw InputError(sourceFile, label + " has no triangles");
+    if (nv > size_t(std::numeric_limits<uint32_t>::max()))
+        throw InputError(sourceFile, label + " has too many vertices");
+    if (!mesh.normals.empty() && mesh.normals.size() != nv)
+        throw InputError(sourceFile, label + ": " + std::to_string(mesh.normals.size()) +
+                                         " normals for " + std::to_string(nv) +
+                                         " vertices (expected none or one per vertex)");
+    if (!mesh.uvs.empty() && mesh.uvs.size() != nv)
+        throw InputError(sourceFile, label + ": " + std::to_string(mesh.uvs.size()) + " uvs for " +
+                                         std::to_string(nv) +
+                                         " vertices (expected none or one per vertex)");
+    Bounds3 box;
+    for (size_t i = 0; i < nv; ++i) {
+        if (!isFinite(mesh.positions[i]))
+            throw InputError(sourceFile,
+                             label + ": non-finite vertex position at vertex " + std::to_string(i));
+        box.extend(mesh.positions[i]);
+    }
+    for (size_t i = 0; i < mesh.indices.size(); ++i)
+        if (mesh.indices[i] >= nv)
+            throw InputError(sourceFile,
+                             label + ": vertex index " + std::to_string(mesh.indices[i]) +
+                                 " out of range (mesh has " + std::to_string(nv) + " vertices)");
+
+    RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    impl_->check("creating a triangle mesh");
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
+    auto* ib = static_cast<uint32_t*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(uint32_t), mesh.triangleCount()));
+    if (!vb || !ib) {
+        rtcReleaseGeometry(geom);
+        impl_->check("allocating mesh buffers");
+        throw std::runtime_error("Embree could not allocate the buffers of " + label);
+    }
+    for (size_t i = 0; i < nv; ++i) {
+        vb[3 * i + 0] = mesh.positions[i].x;
+        vb[3 * i + 1] = mesh.positions[i].y;
+        vb[3 * i + 2] = mesh.positions[i].z;
+    }
+    std::copy(mesh.indices.begin(), mesh.indices.end(), ib);
+    rtcCommitGeometry(geom);
+    uint32_t id = uint32_t(impl_->geoms.size());
+    rtcAttachGeometryByID(impl_->scene, geom, id);
+    rtcReleaseGeometry(geom);
+    impl_->check("adding a triangle mesh");
+
+    ShapeGeom g;
+    g.vertices = vb;
+    g.indices = ib;
+    g.normals = std::move(mesh.normals);
+    g.uvs = std::move(mesh.uvs);
+    impl_->geoms.push_back(std::move(g));
+
+    ShapeInfo info;
+    info.name = name;
+    info.isSphere = false;
+    info.materialId = materialId;
+    info.lightId = lightId;
+    info.triangleCount = mesh.triangleCount();
+    info.bounds = box;
+    shapes.push_back(info);
+    return id;
+}
+
+uint32_t Scene::addSphere(const Vec3& center, float radius, int materialId, int lightId,
+                          const std::string& name) {
+    if (impl_->committed) throw std::logic_error("Scene::addSphere called after commit()");
+    if (!isFinite(center) || !std::isfinite(radius) || !(radius > 0.0f))
+        throw InputError(sourceFile,
+                         "sphere '" + name + "': expected a finite center and a radius > 0");
+    ShapeGeom g;
+    g.isSphere = true;
+    g.sphere = std::make_unique<SphereGeom>(SphereGeom{center, radius});
+    uint32_t id = uint32_t(impl_->geoms.size());
+
+    RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_USER);
+    impl_->check("creating a sphere");
+    rtcSetGeometryUserPrimitiveCount(geom, 1);
+    rtcSetGeometryUserData(geom, g.sphere.get());
+    rtcSetGeometryBoundsFunction(geom, sphereBounds, nullptr);
+    rtcSetGeometryIntersectFunction(geom, sphereIntersect);
+    rtcSetGeometryOccludedFunction(geom, sphereOccluded);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(impl_->scene, geom, id);
+    rtcReleaseGeometry(geom);
+    impl_->check("adding a sphere");
+    impl_->geoms.push_back(std::move(g));
+
+    ShapeInfo info;
+    info.name = name;
+    info.isSphere = true;
+    info.materialId = materialId;
+    info.lightId = lightId;
+    info.triangleCount = 0;
+    info.bounds.extend(center - Vec3(radius));
+    info.bounds.extend(center + Vec3(radius));
+    shapes.push_back(info);
+    return id;
+}
+
+void Scene::commit() {
+    if (impl_->committed) throw std::logic_error("Scene::commit called twice");
+    rtcCommitScene(impl_->scene);
+    impl_->check("building the BVH");
+
+    bounds = Bounds3();
+    for (const ShapeInfo& s : shapes) bounds.extend(s.bounds);
+    // Bounding sphere of the box (as SmallVCM), slightly enlarged so that rounding
+    // never leaves geometry outside; never degenerate (radius > 0).
+    if (bounds.empty()) {
+        sceneSphere.center = Vec3(0.0f);
+        sceneSphere.radius = 1.0f;
+    } else {
+        sceneSphere.center = bounds.center();
+        float halfDiag = 0.5f * length(bounds.hi - bounds.lo);
+        float scale = 1.0f + std::max(maxAbs(bounds.lo), maxAbs(bounds.hi));
+        sceneSphere.radius = std::max(halfDiag * (1.0f + 1e-5f) + 1e-6f * scale, 1e-4f * scale);
+    }
+    sceneSphere.invRadiusSqr = 1.0f / (sceneSphere.radius * sceneSphere.radius);
+    impl_->committed = true;
+}
+
+bool Scene::intersect(const Ray& ray, Hit* hit) const {
+    if (!impl_->committed) throw std::logic_error("Scene::intersect called before commit()");
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    rh.ray.org_x = ray.org.x;
+    rh.ray.org_y = ray.org.y;
+    rh.ray.org_z = ray.org.z;
+    rh.ray.dir_x = ray.dir.x;
+    rh.ray.dir_y = ray.dir.y;
+    rh.ray.dir_z = ray.dir.z;
+    rh.ray.tnear = ray.tMin;
+    rh.ray.tfar = ray.tMax;
+    rh.ray.time = 0.0f;
+    rh.ray.mask = ~0u;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(impl_->scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+
+    const uint32_t id = rh.hit.geomID;
+    const ShapeGeom& g = impl_->geoms[id];
+    hit->dist = rh.ray.tfar;
+    hit->shapeId = id;
+    hit->primId = rh.hit.primID;
+    hit->materialId = shapes[id].materialId;
+    hit->lightId = shapes[id].lightId;
+
+    if (g.isSphere) {
+        // Re-project the hit onto the sphere (double precision) so that the point
+        // lies within an ulp or two of the surface.
+        const Vec3& c = g.sphere->center;
+        double t = rh.ray.tfar;
+        double px = double(ray.org.x) + t * ray.dir.x - c.x;
+        double py = double(ray.org.y) + t * ray.dir.y - c.y;
+        double pz = double(ray.org.z) + t * ray.dir.z - c.z;
+        double len = std::sqrt(px * px + py * py + pz * pz);
+        double nx = px / len, ny = py / len, nz = pz / len;
+        double r = g.sphere->radius;
+        hit->pos = Vec3(float(c.x + r * nx), float(c.y + r * ny), float(c.z + r * nz));
+        hit->geoNormal = normalize(Vec3(float(nx), float(ny), float(nz)));
+        hit->shadingNormal = hit->geoNormal;
+        // Spherical coordinates about +z: u = phi / 2pi in [0,1), v = theta / pi.
+        double phi = std::atan2(ny, nx);
+        if (phi < 0.0) phi += 2.0 * kPiD;
+        double theta = std::acos(std::max(-1.0, std::min(1.0, nz)));
+        hit->uv = Vec2(float(phi / (2.0 * kPiD)), float(theta / kPiD));
+        return true;
+    }
+
+    const uint32_t* tri = g.indices + 3 * size_t(rh.hit.primID);
+    const Vec3 p0 = impl_->vertex(g, tri[0]), p1 = impl_->vertex(g, tri[1]),
+               p2 = impl_->vertex(g, tri[2]);
+    // Embree's barycentrics: p = (1-u-v) p0 + u p1 + v p2.
+    const float b1 = rh.hit.u, b2 = rh.hit.v, b0 = 1.0f - b1 - b2;
+    hit->pos = b0 * p0 + b1 * p1 + b2 * p2;
+    Vec3 ng = cross(p1 - p0, p2 - p0);
+    float ngLen = length(ng);
+    // A zero-area triangle cannot be hit by Embree's test; guard anyway.
+    hit->geoNormal = ngLen > 0.0f ? ng / ngLen : -ray.dir;
+    hit->shadingNormal = hit->geoNormal;
+    if (!g.normals.empty()) {
+        Vec3 ns = b0 * g.normals[tri[0]] + b1 * g.normals[tri[1]] + b2 * g.normals[tri[2]];
+        float nsLen = length(ns);
+        if (nsLen > 0.0f && std::isfinite(nsLen)) {
+            ns = ns / nsLen;
+            hit->shadingNormal = dot(ns, hit->geoNormal) < 0.0f ? -ns : ns;
+        }
+    }
+    if (!g.uvs.empty()) {
+        const Vec2 &t0 = g.uvs[tri[0]], &t1 = g.uvs[tri[1]], &t2 = g.uvs[tri[2]];
+        hit->uv = Vec2(b0 * t0.x + b1 * t1.x + b2 * t2.x, b0 * t0.y + b1 * t1.y + b2 * t2.y);
+    } else {
+        hit->uv = Vec2(b1, b2);  // barycentrics when the mesh has no uvs
+    }
+    return true;
+}
+
+namespace {
+
+bool occludedRay(RTCScene scene, const Vec3& org, const Vec3& dir, float tMax) {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay r;
+    r.org_x = org.x;
+    r.org_y = org.y;
+    r.org_z = org.z;
+    r.dir_x = dir.x;
+    r.dir_y = dir.y;
+    r.dir_z = dir.z;
+    r.tnear = 0.0f;
+    r.tfar = tMax;
+    r.time = 0.0f;
+    r.mask = ~0u;
+    r.id = 0;
+    r.flags = 0;
+    rtcOccluded1(scene, &ctx, &r);
+    return r.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
+}
+
+}  // namespace
+
+bool Scene::occluded(const Vec3& a, const Vec3& geoNormalA, const Vec3& b,
+                     const Vec3& geoNormalB) const {
+    if (!impl_->committed) throw std::logic_error("Scene::occluded called before commit()");
+    Vec3 oa = offsetOrigin(a, geoNormalA, b - a);
+    Vec3 ob = offsetOrigin(b, geoNormalB, a - b);
+    Vec3 d = ob - oa;
+    float len = length(d);
+    if (!(len > 0.0f)) return false;
+    // Both ends are already off their surfaces, so the open segment is (0, len).
+    return occludedRay(impl_->scene, oa, d / len, len);
+}
+
+bool Scene::occludedToInfinity(const Vec3& from, const Vec3& geoNormal, const Vec3& dir) const {
+    if (!impl_->committed)
+        throw std::logic_error("Scene::occludedToInfinity called before commit()");
+    return occludedRay(impl_->scene, offsetOrigin(from, geoNormal, dir), dir,
+                       std::numeric_limits<float>::infinity());
+}
+
+Ray Scene::spawnRay(const Hit& hit, const Vec3& dir) const {
+    Ray r;
+    r.org = offsetOrigin(hit.pos, hit.geoNormal, dir);
+    r.dir = dir;
+    r.tMin = 0.0f;
+    r.tMax = kInf;
+    return r;
+}
+
+}  // namespace ub
