@@ -12,9 +12,31 @@
 // None of these includes the light selection probability (1/#lights), which
 // the integrators apply. Returned radiance / energy values are NOT divided by
 // any pdf: illuminate() returns Le(dir) and emit() returns Le (or intensity /
-// irradiance for delta lights), as in SmallVCM.
+// irradiance for delta lights). Unlike SmallVCM's Emit(), emit() does NOT multiply
+// by the emission cosine: a light subpath starts with throughput
+//   emit() * cosThetaLight / (emissionPdfW * lightPickProb)
+// (cosThetaLight = 1 for point, directional and environment lights).
 // Environment lights use the scene bounding sphere (SceneSphere) to place
-// emitted rays (Sec. 5.1 of "Implementing VCM").
+// emitted rays (Sec. 5.1 of "Implementing VCM"): emit() picks a direction
+// exactly as illuminate() does, then a point on the disk of radius R facing it,
+// centred at center + R * dirToLight (directional lights: center - R * direction).
+//
+// Area lights: every triangle emits on the side of normalize((p1-p0)x(p2-p0)) (both
+// sides if twoSided, where emit() picks each side with probability 1/2 and
+// emissionPdfW includes that 1/2); a sphere emits outward. A point is picked
+// uniformly by area over all triangles and the sphere (the sphere is the last bin
+// of triangleDistribution), so directPdfA = 1 / totalArea. radianceAlong() trusts
+// hitNormal as that front-side normal.
+//
+// Environment map orientation (same as Mitsuba 3's `envmap`): a direction
+// d = (dx, dy, dz) in the map's frame (d = worldToEnv(dirToLight)) looks up
+//   u = atan2(dx, -dz) / (2 pi)  (wrapped to [0,1)),   v = acos(dy) / pi,
+// pixel (floor(u * width), floor(v * height)), row 0 at the top (v = 0 is +y).
+// Inverse: d = (sin(phi) sin(theta), cos(theta), -cos(phi) sin(theta)) with
+// phi = 2 pi u, theta = pi v. Differences from Mitsuba: the map is piecewise
+// constant per pixel (no bilinear filtering), and envToWorld must be a rotation.
+// Sampling: Distribution2D over luminance(pixel * radiance) * sin(theta_row centre),
+// pdfW = pdfUv / (2 pi^2 sin theta) (0 at the poles).
 #pragma once
 
 #include <cstdint>
@@ -62,10 +84,15 @@ struct Light {
     std::shared_ptr<const Image> envMap;      ///< lat-long, u = phi / 2pi, v = theta / pi, +y up
     std::shared_ptr<const Distribution2D> envDistribution;
     Transform envToWorld;                     ///< rotation of the map (identity by default)
-    Transform worldToEnv;
+    Transform worldToEnv;                     ///< set by prepare()
 
-    /// Precomputes triangle distribution / area / env-map distribution. Must be called
-    /// once after filling the fields; throws InputError (file "") on a zero-area emitter.
+    bool prepared = false;                    ///< set by prepare()
+
+    /// Precomputes triangle distribution / area / env-map distribution and normalizes
+    /// `direction`. Must be called after filling the fields (calling it again is
+    /// harmless). Throws InputError (file "", where = "light '<name>'") on a zero-area
+    /// emitter, non-finite geometry, negative or non-finite radiance, a zero direction,
+    /// a missing or invalid env map, or a non-rotation envToWorld.
     void prepare();
 
     bool isDelta() const { return type == LightType::Point || type == LightType::Directional; }
