@@ -1,0 +1,257 @@
+// Regular tracking through homogeneous and NanoVDB grid media (see medium.h).
+#include "scene/medium.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace ub {
+
+namespace {
+
+bool isFiniteNonNegative(const Rgb& c) {
+    return isFinite(c) && c.x >= 0 && c.y >= 0 && c.z >= 0;
+}
+
+void checkG(float g) {
+    if (!(std::fabs(g) < 1.0f))
+        throw std::invalid_argument("medium: HG g must lie in (-1, 1), got " + std::to_string(g));
+}
+
+Rgb expNeg(const Rgb& tau) { return {std::exp(-tau.x), std::exp(-tau.y), std::exp(-tau.z)}; }
+
+/// Leaf nodes of the default NanoVDB float tree are 8^3 voxels; a voxel whose block has no
+/// leaf has the value of the enclosing tile (or the background) over the whole block.
+constexpr int kLeafDim = 8;
+
+/// Calls visit(ta, tb, sigmaT, sigmaS) for consecutive pieces [ta, tb) of constant
+/// coefficients covering [0, tMax] in order, until visit returns false. Zero-length pieces
+/// are skipped. Returns false if a visit stopped the walk.
+template <typename Visit>
+bool forEachPiece(const Medium& m, const Vec3& origin, const Vec3& dir, float tMax,
+                  Visit&& visit) {
+    if (!(tMax > 0.0f)) return true;
+    if (m.type == MediumType::kHomogeneous) return visit(0.0f, tMax, m.sigmaA + m.sigmaS, m.sigmaS);
+
+    const VdbGrid& vdb = *m.grid;
+    const float bgSigmaT = m.densityScale * vdb.background();
+    const Rgb bgT(bgSigmaT), bgS = m.albedo * bgSigmaT;
+
+    // Cell space: t is shared with world space because the direction is not renormalised.
+    const Vec3 P = m.worldToCell.point(origin);
+    const Vec3 D = m.worldToCell.vector(dir);
+    const nanovdb::CoordBBox& bb = vdb.indexBounds();
+    const int lo[3] = {bb.min()[0], bb.min()[1], bb.min()[2]};
+    const int hi[3] = {bb.max()[0] + 1, bb.max()[1] + 1, bb.max()[2] + 1};  // exclusive
+
+    // Slab test against the cell box [lo, hi).
+    float tEnter = 0.0f, tExit = tMax;
+    float invD[3];
+    int step[3];
+    for (int a = 0; a < 3; ++a) {
+        step[a] = D[a] > 0 ? 1 : (D[a] < 0 ? -1 : 0);
+        if (step[a] == 0) {
+            invD[a] = 0.0f;
+            if (P[a] < float(lo[a]) || P[a] >= float(hi[a])) tExit = -1.0f;  // misses the box
+            continue;
+        }
+        invD[a] = 1.0f / D[a];
+        float t0 = (float(lo[a]) - P[a]) * invD[a], t1 = (float(hi[a]) - P[a]) * invD[a];
+        if (t0 > t1) std::swap(t0, t1);
+        tEnter = std::max(tEnter, t0);
+        tExit = std::min(tExit, t1);
+    }
+    if (!(tEnter < tExit)) return visit(0.0f, tMax, bgT, bgS);
+    if (tEnter > 0.0f && !visit(0.0f, tEnter, bgT, bgS)) return false;
+
+    // 3D-DDA (Amanatides & Woo 1987) over voxels inside leaves and over whole 8^3 blocks
+    // elsewhere. v is the current voxel; the block containing it is [blockLo, blockLo + dim).
+    auto acc = vdb.grid().getAccessor();
+    int v[3];
+    const float tStart = tEnter;
+    for (int a = 0; a < 3; ++a)
+        v[a] = std::clamp(int(std::floor(P[a] + D[a] * tStart)), lo[a], hi[a] - 1);
+    float t = tEnter;
+    for (;;) {
+        const nanovdb::Coord ijk(v[0], v[1], v[2]);
+        const auto* leaf = acc.probeLeaf(ijk);
+        const int dim = leaf ? 1 : kLeafDim;
+        int blockLo[3];
+        for (int a = 0; a < 3; ++a) blockLo[a] = leaf ? v[a] : (v[a] & ~(kLeafDim - 1));
+        const float density = leaf ? leaf->getValue(ijk) : acc.getValue(ijk);
+
+        float tNext = tExit;
+        int axis = -1;
+        for (int a = 0; a < 3; ++a) {
+            if (step[a] == 0) continue;
+            const int boundary = step[a] > 0 ? blockLo[a] + dim : blockLo[a];
+            const float tb = (float(boundary) - P[a]) * invD[a];
+            if (tb < tNext) {
+                tNext = tb;
+                axis = a;
+            }
+        }
+        tNext = std::max(tNext, t);
+        if (tNext > t) {
+            const float sigmaT = m.densityScale * density;
+            if (!visit(t, tNext, Rgb(sigmaT), m.albedo * sigmaT)) return false;
+        }
+        if (axis < 0) break;  // reached tExit inside this block
+        t = tNext;
+        for (int b = 0; b < 3; ++b) {
+            if (b == axis) continue;
+            v[b] = std::clamp(int(std::floor(P[b] + D[b] * t)), blockLo[b], blockLo[b] + dim - 1);
+        }
+        v[axis] = step[axis] > 0 ? blockLo[axis] + dim : blockLo[axis] - 1;
+        if (v[axis] < lo[axis] || v[axis] >= hi[axis]) break;
+    }
+    if (tExit < tMax) return visit(tExit, tMax, bgT, bgS);
+    return true;
+}
+
+}  // namespace
+
+Medium Medium::homogeneous(const Rgb& sigmaA, const Rgb& sigmaS, float g, const Rgb& Le) {
+    if (!isFiniteNonNegative(sigmaA) || !isFiniteNonNegative(sigmaS) || !isFiniteNonNegative(Le))
+        throw std::invalid_argument("homogeneous medium: sigma_a, sigma_s and Le must be finite "
+                                    "and >= 0");
+    checkG(g);
+    Medium m;
+    m.type = MediumType::kHomogeneous;
+    m.sigmaA = sigmaA;
+    m.sigmaS = sigmaS;
+    m.Le = Le;
+    m.g = g;
+    return m;
+}
+
+Medium Medium::heterogeneous(std::shared_ptr<const VdbGrid> grid, float densityScale,
+                             const Rgb& albedo, float g, const Transform& localToWorld) {
+    if (!grid) throw std::invalid_argument("grid medium: no grid");
+    if (!(densityScale >= 0.0f) || !std::isfinite(densityScale))
+        throw std::invalid_argument("grid medium: density scale must be finite and >= 0");
+    if (!isFiniteNonNegative(albedo) || maxComponent(albedo) > 1.0f)
+        throw std::invalid_argument("grid medium: albedo must lie in [0, 1]");
+    checkG(g);
+    Transform cellToWorld =
+        localToWorld * grid->indexToLocal() * Transform::translate(Vec3(-0.5f));
+    if (!(std::fabs(cellToWorld.determinant3()) > 0.0f))
+        throw std::invalid_argument("grid medium: singular transform");
+    Medium m;
+    m.type = MediumType::kGrid;
+    m.grid = std::move(grid);
+    m.densityScale = densityScale;
+    m.albedo = albedo;
+    m.g = g;
+    m.localToWorld = localToWorld;
+    m.worldToCell = cellToWorld.inverse();
+    const nanovdb::CoordBBox& bb = m.grid->indexBounds();
+    for (int c = 0; c < 8; ++c) {
+        Vec3 corner(float(c & 1 ? bb.max()[0] + 1 : bb.min()[0]),
+                    float(c & 2 ? bb.max()[1] + 1 : bb.min()[1]),
+                    float(c & 4 ? bb.max()[2] + 1 : bb.min()[2]));
+        m.worldBounds.extend(cellToWorld.point(corner));
+    }
+    return m;
+}
+
+MediumCoefficients mediumCoefficientsAt(const Medium& m, const Vec3& p) {
+    MediumCoefficients c;
+    if (m.type == MediumType::kHomogeneous) {
+        c.sigmaA = m.sigmaA;
+        c.sigmaS = m.sigmaS;
+        c.sigmaT = m.sigmaA + m.sigmaS;
+        c.Le = m.Le;
+        return c;
+    }
+    const Vec3 q = m.worldToCell.point(p);
+    const nanovdb::CoordBBox& bb = m.grid->indexBounds();
+    const nanovdb::Coord ijk(int(std::floor(q.x)), int(std::floor(q.y)), int(std::floor(q.z)));
+    const float density =
+        bb.isInside(ijk) ? m.grid->grid().getAccessor().getValue(ijk) : m.grid->background();
+    const float sigmaT = m.densityScale * density;
+    c.sigmaT = Rgb(sigmaT);
+    c.sigmaS = m.albedo * sigmaT;
+    c.sigmaA = c.sigmaT - c.sigmaS;
+    c.Le = Rgb(0.0f);
+    return c;
+}
+
+Rgb transmittance(const Medium& m, const Vec3& origin, const Vec3& dir, float length) {
+    Rgb tau(0.0f);
+    forEachPiece(m, origin, dir, length, [&](float ta, float tb, const Rgb& sigmaT, const Rgb&) {
+        tau += sigmaT * (tb - ta);
+        return true;
+    });
+    return expNeg(tau);
+}
+
+MediumSegment evalMediumSegment(const Medium& m, const Vec3& origin, const Vec3& dir,
+                                float length) {
+    MediumSegment seg;
+    seg.length = length;
+    Rgb tau(0.0f);
+    bool first = true;
+    forEachPiece(m, origin, dir, length,
+                 [&](float ta, float tb, const Rgb& sigmaT, const Rgb& sigmaS) {
+                     if (first) seg.sigmaT0 = sigmaT;
+                     first = false;
+                     seg.sigmaT1 = sigmaT;
+                     seg.sigmaS1 = sigmaS;
+                     tau += sigmaT * (tb - ta);
+                     return true;
+                 });
+    if (first) {  // zero-length segment: both ends are the origin
+        MediumCoefficients c = mediumCoefficientsAt(m, origin);
+        seg.sigmaT0 = seg.sigmaT1 = c.sigmaT;
+        seg.sigmaS1 = c.sigmaS;
+    }
+    seg.transmittance = expNeg(tau);
+    return seg;
+}
+
+FreeFlightSample sampleFreeFlight(const Medium& m, const Vec3& origin, const Vec3& dir,
+                                  float tMax, float uChannel, float uDistance) {
+    const int c = std::min(2, int(uChannel * 3.0f));
+    // Target optical depth in channel c: tau ~ Exp(1) by inversion.
+    const float tauTarget = -std::log1p(-uDistance);
+    FreeFlightSample s;
+    MediumSegment& seg = s.segment;
+    Rgb tau(0.0f);
+    bool first = true;
+    forEachPiece(m, origin, dir, tMax,
+                 [&](float ta, float tb, const Rgb& sigmaT, const Rgb& sigmaS) {
+                     if (first) seg.sigmaT0 = sigmaT;
+                     first = false;
+                     seg.sigmaT1 = sigmaT;
+                     seg.sigmaS1 = sigmaS;
+                     const float len = tb - ta;
+                     if (sigmaT[c] > 0.0f && tau[c] + sigmaT[c] * len >= tauTarget) {
+                         // Invert the piecewise-linear optical depth inside this piece.
+                         float t = ta + (tauTarget - tau[c]) / sigmaT[c];
+                         t = std::clamp(t, ta, tb);
+                         tau += sigmaT * (t - ta);
+                         s.t = t;
+                         s.scattered = t < tMax;
+                         return false;
+                     }
+                     tau += sigmaT * len;
+                     return true;
+                 });
+    if (first) {
+        MediumCoefficients co = mediumCoefficientsAt(m, origin);
+        seg.sigmaT0 = seg.sigmaT1 = co.sigmaT;
+        seg.sigmaS1 = co.sigmaS;
+    }
+    seg.transmittance = expNeg(tau);
+    if (!s.scattered) s.t = tMax;
+    seg.length = s.t;
+    s.pdf = s.scattered ? seg.pdfScatterFwdL() : seg.probPass();
+    if (s.pdf > 0.0f)
+        s.weight = s.scattered ? seg.transmittance * seg.sigmaS1 / s.pdf
+                               : seg.transmittance / s.pdf;
+    return s;
+}
+
+}  // namespace ub

@@ -1,0 +1,122 @@
+// Participating media as flat data with a type tag (no virtual calls per
+// sample): homogeneous, or heterogeneous with density from a NanoVDB grid.
+//
+// Coefficients are per unit world length, RGB. sigma_t = sigma_a + sigma_s.
+//  * Homogeneous: sigma_a, sigma_s, optional emitted radiance Le (the source
+//    term of the RTE is sigma_a * Le, as in pbrt-v4), HG g.
+//  * Grid: sigma_t(x) = densityScale * density(x) (grey), sigma_s = albedo *
+//    sigma_t, HG g, no emission. density(x) is piecewise constant per voxel
+//    (see scene/vdb_grid.h for the cell convention); the grid's own transform
+//    maps index to grid-local space and `localToWorld` places it in the scene.
+//
+// Regular tracking (Novak et al. 2018, "Monte Carlo Methods for Volumetric
+// Light Transport Simulation", Sec. 4.1): a segment is cut into pieces of
+// constant sigma_t by a 3D-DDA through the voxels (Amanatides & Woo 1987,
+// "A Fast Voxel Traversal Algorithm for Ray Tracing"), skipping the 8^3
+// blocks that hold no leaf node in one step. The optical depth is then
+// piecewise linear in t, so transmittance T = exp(-sum_i sigma_t,i * len_i) is
+// exact and free-flight sampling inverts it exactly.
+//
+// Free-flight (distance) sampling with RGB coefficients (spectral MIS; Novak
+// et al. 2018, Sec. 5.1): pick channel c uniformly, sample t with density
+// sigma_t,c(t) T_c(t) on [0, tMax) or pass the segment with probability
+// T_c(tMax). The pdf of the combined technique is the average over channels:
+//   pdfScatterL(t) = (1/3) sum_c sigma_t,c(t) T_c(0, t)     (per unit length)
+//   probPass       = (1/3) sum_c T_c(0, tMax)               (a probability)
+// and the throughput weights are T sigma_s / pdfScatterL and T / probPass,
+// which makes every channel's estimate unbiased.
+//
+// Directions: `dir` is a unit world-space direction; t is distance along it.
+// For bidirectional MIS both directions of a segment x0 -> x1 are needed: the
+// reverse density (sampling from x1 towards x0 and stopping at x0) uses
+// sigma_t at x0; the pass probability is the same both ways (T is symmetric).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "core/vec.h"
+#include "scene/vdb_grid.h"
+
+namespace ub {
+
+enum class MediumType : uint32_t {
+    kHomogeneous = 0,
+    kGrid = 1,
+};
+
+struct Medium {
+    MediumType type = MediumType::kHomogeneous;
+    float g = 0.0f;  ///< Henyey-Greenstein mean cosine, |g| < 1 (kernels/shared/ub_phase.h)
+
+    // Homogeneous.
+    Rgb sigmaA{0.0f}, sigmaS{0.0f};
+    Rgb Le{0.0f};  ///< emitted radiance (source term sigma_a * Le)
+
+    // Grid.
+    std::shared_ptr<const VdbGrid> grid;
+    float densityScale = 1.0f;  ///< sigma_t = densityScale * density
+    Rgb albedo{1.0f};           ///< sigma_s / sigma_t, each channel in [0, 1]
+    Transform localToWorld;     ///< grid-local space -> world
+    // Derived by heterogeneous(); do not set by hand.
+    Transform worldToCell;  ///< world -> cell space (index space + 1/2: voxel v covers [v, v+1))
+    Bounds3 worldBounds;    ///< world bounds of the grid's active voxels (background outside)
+
+    /// Throws std::invalid_argument on negative or non-finite coefficients or |g| >= 1.
+    static Medium homogeneous(const Rgb& sigmaA, const Rgb& sigmaS, float g,
+                              const Rgb& Le = Rgb(0.0f));
+    /// Throws std::invalid_argument on a null grid, densityScale < 0, albedo outside [0, 1],
+    /// |g| >= 1 or a singular transform.
+    static Medium heterogeneous(std::shared_ptr<const VdbGrid> grid, float densityScale,
+                                const Rgb& albedo, float g,
+                                const Transform& localToWorld = Transform());
+
+    bool hasEmission() const { return !isBlack(Le) && !isBlack(sigmaA); }
+};
+
+/// Coefficients at one point (grid: the voxel containing it, background outside).
+struct MediumCoefficients {
+    Rgb sigmaT, sigmaS, sigmaA;
+    Rgb Le;  ///< emitted radiance (0 for grids)
+};
+MediumCoefficients mediumCoefficientsAt(const Medium& m, const Vec3& p);
+
+/// Transmittance and end-point extinction of the segment x0 = origin,
+/// x1 = origin + length * dir, with the pdfs of both sampling directions.
+struct MediumSegment {
+    float length = 0.0f;
+    Rgb transmittance{1.0f};  ///< T(x0, x1) = T(x1, x0)
+    Rgb sigmaT0{0.0f};        ///< extinction at x0 (of the first piece of the segment)
+    Rgb sigmaT1{0.0f};        ///< extinction at x1 (of the last piece)
+    Rgb sigmaS1{0.0f};        ///< scattering coefficient at x1
+
+    /// Density (per unit length) that free-flight sampling from x0 along dir stops at x1.
+    float pdfScatterFwdL() const { return average(sigmaT1 * transmittance); }
+    /// Density (per unit length) that free-flight sampling from x1 along -dir stops at x0.
+    float pdfScatterRevL() const { return average(sigmaT0 * transmittance); }
+    /// Probability that free-flight sampling passes the whole segment (either direction).
+    float probPass() const { return average(transmittance); }
+};
+
+/// Evaluates the segment by regular tracking (exact for the piecewise-constant grid).
+MediumSegment evalMediumSegment(const Medium& m, const Vec3& origin, const Vec3& dir,
+                                float length);
+/// Transmittance only (the cheaper query, for shadow rays and photon beams).
+Rgb transmittance(const Medium& m, const Vec3& origin, const Vec3& dir, float length);
+
+/// Result of free-flight sampling along [0, tMax).
+struct FreeFlightSample {
+    bool scattered = false;  ///< true: interaction at t < tMax; false: passed (t = tMax)
+    float t = 0.0f;
+    MediumSegment segment;  ///< from origin to origin + t * dir (pdfs of both directions)
+    float pdf = 0.0f;       ///< segment.pdfScatterFwdL() if scattered, else segment.probPass()
+    /// Throughput weight: T * sigma_s / pdf if scattered, T / pdf if passed; black if the
+    /// pdf underflowed to 0. (Emission at a sampled point: T * sigma_a * Le / pdf.)
+    Rgb weight{0.0f};
+};
+
+/// uChannel picks the colour channel, uDistance the distance; both uniform in [0, 1).
+FreeFlightSample sampleFreeFlight(const Medium& m, const Vec3& origin, const Vec3& dir,
+                                  float tMax, float uChannel, float uDistance);
+
+}  // namespace ub
