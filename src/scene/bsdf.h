@@ -18,6 +18,15 @@
 //  * Shading normals: the shading normal is flipped to the side of dirFix for
 //    two-sided opaque materials. For dielectrics the normal's side defines inside
 //    (the normal points outside).
+//  * Geometric normal guard (details in bsdf.cpp): a reflected dirGen must lie on the
+//    same side of the geometric surface as dirFix and a transmitted one on the other
+//    side; otherwise evaluate() and pdf() give 0 and sample() fails. With fromLight,
+//    the returned f_s includes Veach's shading-normal adjoint factor (1997, Sec. 5.3)
+//    |dirFix.Ns| |dirGen.Ng| / (|dirFix.Ng| |dirGen.Ns|), so callers always use
+//    f_s * cosThetaGen (shading cosine) and never apply the correction themselves.
+//  * sample() may fail (black, *pdfW = 0) for directions that the lobe proposes but the
+//    BSDF does not allow (below the surface, wrong side of the microfacet); pdf() is the
+//    density of the successful samples only, and is zero exactly where they cannot land.
 #pragma once
 
 #include <cstdint>
@@ -73,17 +82,37 @@ public:
     const Material* material() const { return mat_; }
 
 private:
+    /// f_s and both pdfs (lobe selection included) for dirGen given in frame_;
+    /// cosGeoGen = dot(dirGen, geoNormal_). Applies the geometric guard and the
+    /// fromLight shading-normal factor. Non-delta materials only.
+    Rgb evalLocal(const Vec3& localGen, float cosGeoGen, float* directPdfW,
+                  float* reversePdfW) const;
+    Rgb evalPhong(const Vec3& localGen, float* directPdfW, float* reversePdfW) const;
+    Rgb evalRoughConductor(const Vec3& localGen, float* directPdfW, float* reversePdfW) const;
+    Rgb evalRoughDielectric(const Vec3& localGen, float* directPdfW, float* reversePdfW) const;
+    /// Veach's adjoint factor for shading normals (1 for radiance transport).
+    float shadingFactor(float cosShadingGen, float cosGeoGen) const;
+    /// True if a dirGen with these cosines is on the allowed geometric side.
+    bool geometricSideOk(float localGenZ, float cosGeoGen) const;
+    Rgb sampleDelta(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
+                    uint32_t* sampledEvent) const;
+
     const Material* mat_ = nullptr;
     Frame frame_;        ///< shading frame (normal possibly flipped, see above)
     Vec3 localDirFix_;   ///< dirFix in frame_
     Vec3 geoNormal_;     ///< geometric normal, same side convention as frame_.n
+    float cosGeoFix_ = 0.0f;  ///< dot(dirFix, geoNormal_)
     bool fromLight_ = false;
     bool valid_ = false;
     bool isDelta_ = false;
+    bool black_ = false;  ///< back side of a one-sided material, or all-black lobes
     float contProb_ = 0.0f;
-    // Lobe selection probabilities (Phong: diffuse vs glossy; dielectrics: reflect vs refract).
+    // Lobe selection probabilities (Phong: diffuse vs glossy).
     float probDiffuse_ = 0.0f, probGlossy_ = 0.0f;
-    float etaRatio_ = 1.0f;   ///< for dielectrics: eta_outside_of_dirFix / eta_other_side
+    // Dielectrics: IOR on dirFix's side and on the other side of the interface, and the
+    // Fresnel reflectance of the smooth interface seen from dirFix.
+    float etaFix_ = 1.0f, etaOther_ = 1.0f;
+    float fresnelFix_ = 0.0f;
 };
 
 }  // namespace ub

@@ -1,0 +1,384 @@
+// BSDFs of unibeam's materials (conventions: top of bsdf.h).
+//
+// Lobes (formulas in kernels/shared/, shared with the OpenCL kernels):
+//  Diffuse          Lambert rho/pi, cosine-weighted sampling.
+//  Phong            SmallVCM's model: Lambert `diffuse` + modified Phong `glossy`
+//                   (n+2)/(2 pi) cos^n around the mirror direction of dirFix
+//                   (Lafortune & Willems 1994). One lobe is picked with probability
+//                   proportional to the luminance of its reflectance; the pdf is the
+//                   mixture of both lobe pdfs (one-sample MIS, as SmallVCM).
+//  Mirror           delta reflection, weight `specular`.
+//  Dielectric       smooth interface, exact unpolarised Fresnel F; reflection picked
+//                   with probability F, refraction with 1 - F; weights `specular`
+//                   times 1 (reflection) or (eta_fix/eta_gen)^2 for radiance and 1 for
+//                   importance (refraction; Veach 1997, Sec. 5.2). On a camera path
+//                   going from IOR n1 into n2, f cos / pdf = (n1/n2)^2 (pbrt-v4).
+//  RoughConductor   GGX, height-correlated Smith G2, conductor Fresnel per channel;
+//                   sampling of visible normals (Heitz 2018), exact pdf
+//                   G1(fix) D(h) / (4 cos_fix).
+//  RoughDielectric  Walter et al. 2007: GGX reflection (eq. 20, height-correlated G2)
+//                   and transmission (eq. 21, separable G2 = G1 G1), visible-normal
+//                   sampling on dirFix's side, Fresnel selection F(fix.h), Jacobians
+//                   eq. 14 / eq. 17. Radiance transport uses eq. 21 as written
+//                   (eta_o^2 with o = dirFix, the camera side); importance transport
+//                   uses its adjoint, eta_gen^2 in place of eta_fix^2, so
+//                   f_radiance(a, b) = f_importance(b, a).
+//
+// Sidedness: opaque two-sided materials flip both normals to dirFix's side of the
+// shading normal; one-sided ones are black from the back (valid, contProb 0).
+// Dielectrics never flip: dirFix on the back of the shading normal means inside
+// (IOR `ior`), the front is outside (IOR 1).
+//
+// Shading normals (Veach 1997, Sec. 5.3): f_s is defined with the shading normal.
+// Guard: a reflected dirGen must lie on dirFix's side of the geometric surface and a
+// transmitted one on the other side, otherwise f = 0, pdf = 0, and sampling fails
+// (this removes light leaks through the surface and black-side reflections; the
+// rule is symmetric in dirFix/dirGen, so reciprocity and reverse pdfs survive it).
+// For light subpaths f_s is multiplied by the adjoint factor
+//   |dirFix.Ns| |dirGen.Ng| / (|dirFix.Ng| |dirGen.Ns|)
+// so that f_s cos_s(dirGen) is the correct importance throughput; it is exactly 1
+// when Ns == Ng.
+//
+// Russian roulette (continuationProb): max over RGB of the albedo estimate,
+// clamped to [0,1] as SmallVCM: diffuse (+ glossy); mirror `specular`; dielectrics
+// `specular` (1 for clear glass; refraction weights may exceed 1 for radiance, RR
+// uses the tint only); rough conductor `specular` * F_conductor(cos_fix).
+#include "scene/bsdf.h"
+
+#include "core/sampling.h"
+#include "kernels/shared/ub_fresnel.h"
+#include "kernels/shared/ub_microfacet.h"
+#include "kernels/shared/ub_phong.h"
+
+namespace ub {
+
+namespace {
+
+constexpr float kEpsCosine = 1e-6f;
+/// Smallest GGX roughness used (alpha -> 0 is a delta lobe the float math cannot represent).
+constexpr float kMinAlpha = 1e-4f;
+
+float clamp01(float x) { return std::min(1.0f, std::max(0.0f, x)); }
+
+Rgb fresnelConductor(float cosThetaI, const Rgb& eta, const Rgb& k) {
+    return {ub_fresnel_conductor(cosThetaI, eta.x, k.x), ub_fresnel_conductor(cosThetaI, eta.y, k.y),
+            ub_fresnel_conductor(cosThetaI, eta.z, k.z)};
+}
+
+float ggxAlpha(const Material& m) { return std::max(m.alpha, kMinAlpha); }
+
+bool isDielectric(MaterialType t) {
+    return t == MaterialType::Dielectric || t == MaterialType::RoughDielectric;
+}
+
+}  // namespace
+
+bool Bsdf::setup(const Material& mat, const Vec3& dirFix, const Vec3& geoNormal,
+                 const Vec3& shadingNormal, bool fromLight) {
+    mat_ = &mat;
+    fromLight_ = fromLight;
+    valid_ = false;
+    black_ = false;
+    contProb_ = 0.0f;
+    probDiffuse_ = probGlossy_ = 0.0f;
+    etaFix_ = etaOther_ = 1.0f;
+    fresnelFix_ = 0.0f;
+    isDelta_ = mat.type == MaterialType::Mirror || mat.type == MaterialType::Dielectric;
+
+    Vec3 ns = shadingNormal, ng = geoNormal;
+    if (!isDielectric(mat.type) && dot(dirFix, ns) < 0.0f) {
+        if (mat.twoSided) {
+            ns = -ns;
+            ng = -ng;
+        } else {
+            black_ = true;
+        }
+    }
+    frame_ = Frame(ns);
+    geoNormal_ = ng;
+    localDirFix_ = frame_.toLocal(dirFix);
+    cosGeoFix_ = dot(dirFix, ng);
+    if (std::fabs(localDirFix_.z) < kEpsCosine || std::fabs(cosGeoFix_) < kEpsCosine) return false;
+
+    switch (mat.type) {
+    case MaterialType::Diffuse:
+        probDiffuse_ = 1.0f;
+        contProb_ = maxComponent(mat.diffuse);
+        break;
+    case MaterialType::Phong: {
+        // Lobe selection proportional to the albedo estimates (SmallVCM).
+        float albedoDiffuse = luminance(mat.diffuse), albedoGlossy = luminance(mat.glossy);
+        float total = albedoDiffuse + albedoGlossy;
+        if (total > 1e-9f) {
+            probDiffuse_ = albedoDiffuse / total;
+            probGlossy_ = albedoGlossy / total;
+        } else {
+            black_ = true;
+        }
+        contProb_ = maxComponent(mat.diffuse + mat.glossy);
+        break;
+    }
+    case MaterialType::Mirror:
+        contProb_ = maxComponent(mat.specular);
+        break;
+    case MaterialType::Dielectric:
+    case MaterialType::RoughDielectric:
+        if (localDirFix_.z > 0.0f) {
+            etaFix_ = 1.0f;
+            etaOther_ = mat.ior;
+        } else {
+            etaFix_ = mat.ior;
+            etaOther_ = 1.0f;
+        }
+        fresnelFix_ = ub_fresnel_dielectric(std::fabs(localDirFix_.z), etaOther_ / etaFix_);
+        contProb_ = maxComponent(mat.specular);
+        break;
+    case MaterialType::RoughConductor:
+        contProb_ = maxComponent(mat.specular * fresnelConductor(localDirFix_.z, mat.eta, mat.k));
+        break;
+    }
+    if (black_) contProb_ = 0.0f;
+    contProb_ = clamp01(contProb_);
+    valid_ = true;
+    return true;
+}
+
+float Bsdf::shadingFactor(float cosShadingGen, float cosGeoGen) const {
+    if (!fromLight_) return 1.0f;
+    return std::fabs(localDirFix_.z) * std::fabs(cosGeoGen) /
+           (std::fabs(cosGeoFix_) * cosShadingGen);
+}
+
+bool Bsdf::geometricSideOk(float localGenZ, float cosGeoGen) const {
+    if (cosGeoGen == 0.0f) return false;
+    bool shadingReflect = localGenZ * localDirFix_.z > 0.0f;
+    bool geometricReflect = cosGeoGen * cosGeoFix_ > 0.0f;
+    return shadingReflect == geometricReflect;
+}
+
+Rgb Bsdf::evaluate(const Vec3& dirGen, float* cosThetaGen, float* directPdfW,
+                   float* reversePdfW) const {
+    Vec3 localGen = frame_.toLocal(dirGen);
+    if (cosThetaGen) *cosThetaGen = std::fabs(localGen.z);
+    float pd = 0.0f, pr = 0.0f;
+    Rgb f(0.0f);
+    if (valid_ && !isDelta_ && !black_) f = evalLocal(localGen, dot(dirGen, geoNormal_), &pd, &pr);
+    if (directPdfW) *directPdfW = pd;
+    if (reversePdfW) *reversePdfW = pr;
+    return f;
+}
+
+float Bsdf::pdf(const Vec3& dirGen, bool reverse) const {
+    float pd = 0.0f, pr = 0.0f;
+    evaluate(dirGen, nullptr, &pd, &pr);
+    return reverse ? pr : pd;
+}
+
+Rgb Bsdf::evalLocal(const Vec3& localGen, float cosGeoGen, float* directPdfW,
+                    float* reversePdfW) const {
+    *directPdfW = *reversePdfW = 0.0f;
+    if (std::fabs(localGen.z) < kEpsCosine || !geometricSideOk(localGen.z, cosGeoGen))
+        return Rgb(0.0f);
+    Rgb f(0.0f);
+    switch (mat_->type) {
+    case MaterialType::Diffuse:
+    case MaterialType::Phong: f = evalPhong(localGen, directPdfW, reversePdfW); break;
+    case MaterialType::RoughConductor:
+        f = evalRoughConductor(localGen, directPdfW, reversePdfW);
+        break;
+    case MaterialType::RoughDielectric:
+        f = evalRoughDielectric(localGen, directPdfW, reversePdfW);
+        break;
+    default: break;
+    }
+    return f * shadingFactor(std::fabs(localGen.z), cosGeoGen);
+}
+
+Rgb Bsdf::evalPhong(const Vec3& gen, float* directPdfW, float* reversePdfW) const {
+    const Vec3& fix = localDirFix_;
+    if (fix.z <= 0.0f || gen.z <= 0.0f) return Rgb(0.0f);  // reflection above the surface only
+    Rgb f(0.0f);
+    if (probDiffuse_ > 0.0f) {
+        f += mat_->diffuse * kInvPi;
+        *directPdfW += probDiffuse_ * ub_lambert_pdf(gen.z);
+        *reversePdfW += probDiffuse_ * ub_lambert_pdf(fix.z);
+    }
+    if (probGlossy_ > 0.0f) {
+        // cos(alpha) between dirGen and the mirror direction of dirFix; symmetric in
+        // the two directions, so the reverse pdf is the same value.
+        const Vec3 mirrorFix(-fix.x, -fix.y, fix.z);
+        float cosAlpha = dot(mirrorFix, gen);
+        float lobePdf = probGlossy_ * ub_power_cos_pdf(cosAlpha, mat_->exponent);
+        f += mat_->glossy * ub_phong_lobe(cosAlpha, mat_->exponent);
+        *directPdfW += lobePdf;
+        *reversePdfW += lobePdf;
+    }
+    return f;
+}
+
+Rgb Bsdf::evalRoughConductor(const Vec3& gen, float* directPdfW, float* reversePdfW) const {
+    const Vec3& fix = localDirFix_;
+    if (fix.z <= 0.0f || gen.z <= 0.0f) return Rgb(0.0f);
+    const float alpha = ggxAlpha(*mat_);
+    const Vec3 h = normalize(fix + gen);  // h.z > 0 and fix.h = gen.h > 0 here
+    const float cosFixH = dot(fix, h), cosGenH = dot(gen, h);
+    const float d = ub_ggx_d(h.z, alpha);
+    const float g2 = ub_ggx_g2_correlated(fix.z, gen.z, alpha);
+    // Visible-normal density times the reflection Jacobian (Walter eq. 14).
+    *directPdfW = ub_ggx_visible_pdf(fix.z, cosFixH, h.z, alpha) * ub_jacobian_reflect(cosGenH);
+    *reversePdfW = ub_ggx_visible_pdf(gen.z, cosGenH, h.z, alpha) * ub_jacobian_reflect(cosFixH);
+    // Walter eq. 20: F D G / (4 |i.n| |o.n|).
+    return mat_->specular * fresnelConductor(cosFixH, mat_->eta, mat_->k) *
+           (d * g2 / (4.0f * fix.z * gen.z));
+}
+
+Rgb Bsdf::evalRoughDielectric(const Vec3& gen, float* directPdfW, float* reversePdfW) const {
+    const Vec3& fix = localDirFix_;
+    const float alpha = ggxAlpha(*mat_);
+    const bool reflect = fix.z * gen.z > 0.0f;
+    const float etaGen = reflect ? etaFix_ : etaOther_;
+    // Half vector: Walter eq. 13 (reflection), eq. 16 (refraction), oriented to +z.
+    Vec3 h = reflect ? fix + gen : etaFix_ * fix + etaGen * gen;
+    float len2 = lengthSqr(h);
+    if (!(len2 > 1e-12f)) return Rgb(0.0f);
+    h = h / std::sqrt(len2);
+    if (h.z < 0.0f) h = -h;
+    const float cosFixH = dot(fix, h), cosGenH = dot(gen, h);
+    // Both directions must see the microfacet from their side of the macro-surface
+    // (the chi+ factors of Walter eq. 20/21).
+    if (cosFixH * fix.z <= 0.0f || cosGenH * gen.z <= 0.0f) return Rgb(0.0f);
+    const float cFix = std::fabs(fix.z), cGen = std::fabs(gen.z);
+    const float aFix = std::fabs(cosFixH), aGen = std::fabs(cosGenH);
+    const float d = ub_ggx_d(h.z, alpha);
+    const float visFix = ub_ggx_visible_pdf(cFix, aFix, h.z, alpha);
+    const float visGen = ub_ggx_visible_pdf(cGen, aGen, h.z, alpha);
+    if (reflect) {
+        const float fresnelFix = ub_fresnel_dielectric(aFix, etaOther_ / etaFix_);
+        const float fresnelGen = ub_fresnel_dielectric(aGen, etaOther_ / etaFix_);
+        *directPdfW = fresnelFix * visFix * ub_jacobian_reflect(aGen);
+        *reversePdfW = fresnelGen * visGen * ub_jacobian_reflect(aFix);
+        const float g2 = ub_ggx_g2_correlated(cFix, cGen, alpha);
+        return mat_->specular * (fresnelFix * d * g2 / (4.0f * cFix * cGen));
+    }
+    // Refraction: gen is on the side of IOR etaGen = etaOther_. F(cos_i, eta) equals
+    // F(cos_t, 1/eta); it is computed from the outside direction whichever of the two is
+    // dirFix, so f and the pdfs are bitwise symmetric under swapping dirFix and dirGen.
+    const float transmit = 1.0f - (fix.z > 0.0f ? ub_fresnel_dielectric(aFix, etaGen / etaFix_)
+                                                : ub_fresnel_dielectric(aGen, etaFix_ / etaGen));
+    *directPdfW = transmit * visFix * ub_jacobian_refract(etaFix_, cosFixH, etaGen, cosGenH);
+    *reversePdfW = transmit * visGen * ub_jacobian_refract(etaGen, cosGenH, etaFix_, cosFixH);
+    const float denom = ub_sqr(etaFix_ * cosFixH + etaGen * cosGenH);
+    // Walter eq. 21 with o = the camera-side direction: eta_o^2 is etaFix for radiance
+    // (dirFix towards the camera) and etaGen for importance (the adjoint BTDF).
+    const float etaO = fromLight_ ? etaGen : etaFix_;
+    const float g2 = ub_ggx_g2_separable(cFix, cGen, alpha);
+    return mat_->specular *
+           (transmit * d * g2 * aFix * aGen * etaO * etaO / (cFix * cGen * denom));
+}
+
+Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
+                 uint32_t* sampledEvent) const {
+    *pdfW = 0.0f;
+    if (cosThetaGen) *cosThetaGen = 0.0f;
+    if (sampledEvent) *sampledEvent = kEventNone;
+    if (!valid_ || black_) return Rgb(0.0f);
+    if (isDelta_) return sampleDelta(rnd, dirGen, pdfW, cosThetaGen, sampledEvent);
+
+    const Vec3& fix = localDirFix_;
+    Vec3 gen;
+    uint32_t event = kEventGlossy;
+    switch (mat_->type) {
+    case MaterialType::Diffuse:
+    case MaterialType::Phong:
+        if (rnd.z < probDiffuse_) {
+            gen = sampleCosineHemisphere(Vec2(rnd.x, rnd.y));
+            event = kEventDiffuse;
+        } else {
+            Vec3 lobe;
+            ub_power_cos_sample(rnd.x, rnd.y, mat_->exponent, &lobe.x, &lobe.y, &lobe.z);
+            gen = Frame(Vec3(-fix.x, -fix.y, fix.z)).toWorld(lobe);
+        }
+        break;
+    case MaterialType::RoughConductor: {
+        Vec3 m;
+        ub_ggx_sample_visible(fix.x, fix.y, fix.z, ggxAlpha(*mat_), rnd.x, rnd.y, &m.x, &m.y,
+                              &m.z);
+        gen = 2.0f * dot(fix, m) * m - fix;
+        break;
+    }
+    case MaterialType::RoughDielectric: {
+        // Work mirrored to dirFix's side (GGX is symmetric under z -> -z).
+        const float side = fix.z < 0.0f ? -1.0f : 1.0f;
+        const Vec3 fixUp(fix.x, fix.y, side * fix.z);
+        Vec3 m;
+        ub_ggx_sample_visible(fixUp.x, fixUp.y, fixUp.z, ggxAlpha(*mat_), rnd.x, rnd.y, &m.x,
+                              &m.y, &m.z);
+        const float cosI = dot(fixUp, m);
+        float cosT;
+        const float fresnel = ub_fresnel_dielectric_ct(cosI, etaOther_ / etaFix_, &cosT);
+        const bool reflect = rnd.z < fresnel;
+        if (reflect) {
+            gen = 2.0f * cosI * m - fixUp;
+        } else {
+            const float eta = etaFix_ / etaOther_;  // Snell: t = -eta i + (eta cos_i - cos_t) m
+            gen = -eta * fixUp + (eta * cosI - cosT) * m;
+        }
+        // A microfacet reflection that leaves below the macro-surface, or a refraction
+        // that leaves above it, fails: evaluate() would read it as the other lobe, whose
+        // pdf this sample does not follow.
+        if ((gen.z > 0.0f) != reflect) return Rgb(0.0f);
+        gen.z *= side;
+        break;
+    }
+    default: return Rgb(0.0f);
+    }
+    if (!(lengthSqr(gen) > 0.0f)) return Rgb(0.0f);
+    const Vec3 world = frame_.toWorld(normalize(gen));
+    // Evaluate exactly as evaluate() does, so sample() and evaluate()/pdf() agree.
+    float pd, pr, cosGen;
+    Rgb f = evaluate(world, &cosGen, &pd, &pr);
+    if (!(pd > 0.0f)) return Rgb(0.0f);
+    *dirGen = world;
+    *pdfW = pd;
+    if (cosThetaGen) *cosThetaGen = cosGen;
+    if (sampledEvent) *sampledEvent = event;
+    return f;
+}
+
+Rgb Bsdf::sampleDelta(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
+                      uint32_t* sampledEvent) const {
+    const Vec3& fix = localDirFix_;
+    Vec3 gen(-fix.x, -fix.y, fix.z);  // mirror direction
+    float prob = 1.0f;
+    Rgb weight = mat_->specular;
+    uint32_t event = kEventReflect;
+    if (mat_->type == MaterialType::Dielectric) {
+        const float fresnel = fresnelFix_;
+        if (rnd.z < fresnel) {
+            prob = fresnel;
+            weight = mat_->specular * fresnel;
+        } else {
+            const float eta = etaFix_ / etaOther_;  // n_fix / n_gen
+            float cosT;
+            ub_fresnel_dielectric_ct(std::fabs(fix.z), etaOther_ / etaFix_, &cosT);
+            gen = Vec3(-eta * fix.x, -eta * fix.y, fix.z > 0.0f ? -cosT : cosT);
+            prob = 1.0f - fresnel;
+            // Radiance is scaled by (n_fix/n_gen)^2 across the interface; importance is not.
+            weight = mat_->specular * ((1.0f - fresnel) * (fromLight_ ? 1.0f : eta * eta));
+            event = kEventRefract;
+        }
+    }
+    const Vec3 world = frame_.toWorld(gen);
+    const float cosGen = std::fabs(gen.z);
+    const float cosGeoGen = dot(world, geoNormal_);
+    if (!(prob > 0.0f) || cosGen < kEpsCosine || !geometricSideOk(gen.z, cosGeoGen))
+        return Rgb(0.0f);
+    *dirGen = world;
+    *pdfW = prob;
+    if (cosThetaGen) *cosThetaGen = cosGen;
+    if (sampledEvent) *sampledEvent = event;
+    // Pre-divided by the cosine the caller multiplies with (SmallVCM convention).
+    return weight * (shadingFactor(cosGen, cosGeoGen) / cosGen);
+}
+
+}  // namespace ub
