@@ -4,6 +4,8 @@
 // 0.05, 0.3, 0.8; rough dielectric IOR 1.5 and 1/1.5; incidence 5, 45 and 80 degrees
 // from the normal; dirFix on the front and on the back side; fromLight false and true.
 // The normal is tilted (not +z) so the frame code is exercised too.
+#include "scene/bsdf.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,7 +17,6 @@
 #include "core/sampling.h"
 #include "kernels/shared/ub_fresnel.h"
 #include "kernels/shared/ub_microfacet.h"
-#include "scene/bsdf.h"
 #include "tests/support/chi2.h"
 
 using namespace ub;
@@ -67,11 +68,12 @@ std::vector<NamedMaterial> diffuseMaterials() {
     return {{"Diffuse", m, false}};
 }
 std::vector<NamedMaterial> phongMaterials() {
-    return {{"Phong1", phong(1), false}, {"Phong20", phong(20), false},
-            {"Phong500", phong(500), true}};
+    return {
+        {"Phong1", phong(1), false}, {"Phong20", phong(20), false}, {"Phong500", phong(500), true}};
 }
 std::vector<NamedMaterial> conductorMaterials() {
-    return {{"Conductor0.05", conductor(0.05f), true}, {"Conductor0.3", conductor(0.3f), false},
+    return {{"Conductor0.05", conductor(0.05f), true},
+            {"Conductor0.3", conductor(0.3f), false},
             {"Conductor0.8", conductor(0.8f), false}};
 }
 std::vector<NamedMaterial> roughGlassMaterials() {
@@ -132,7 +134,8 @@ bool nearRel(const Rgb& a, const Rgb& b, float rel = 1e-4f) {
     return nearRel(a.x, b.x, rel) && nearRel(a.y, b.y, rel) && nearRel(a.z, b.z, rel);
 }
 std::string str(const Rgb& c) {
-    return "(" + std::to_string(c.x) + ", " + std::to_string(c.y) + ", " + std::to_string(c.z) + ")";
+    return "(" + std::to_string(c.x) + ", " + std::to_string(c.y) + ", " + std::to_string(c.z) +
+           ")";
 }
 
 // ---------------------------------------------------------------------------------------
@@ -194,10 +197,18 @@ void runChi2(const std::vector<NamedMaterial>& mats, uint64_t seed) {
 
 }  // namespace
 
-TEST(Bsdf, DiffuseChiSquare) { runChi2(diffuseMaterials(), 100); }
-TEST(Bsdf, PhongChiSquare) { runChi2(phongMaterials(), 200); }
-TEST(Bsdf, RoughConductorChiSquare) { runChi2(conductorMaterials(), 300); }
-TEST(Bsdf, RoughDielectricChiSquare) { runChi2(roughGlassMaterials(), 400); }
+TEST(Bsdf, DiffuseChiSquare) {
+    runChi2(diffuseMaterials(), 100);
+}
+TEST(Bsdf, PhongChiSquare) {
+    runChi2(phongMaterials(), 200);
+}
+TEST(Bsdf, RoughConductorChiSquare) {
+    runChi2(conductorMaterials(), 300);
+}
+TEST(Bsdf, RoughDielectricChiSquare) {
+    runChi2(roughGlassMaterials(), 400);
+}
 
 // ---------------------------------------------------------------------------------------
 // Consistency of sample(), evaluate() and pdf() (relative 1e-4: the same float code path).
@@ -286,7 +297,8 @@ TEST(Bsdf, ReversePdfAndReciprocity) {
             const bool reflect = dot(a, kNormal) * dot(b, kNormal) > 0;
             if (reflect) {
                 ++reflections;
-                ASSERT_TRUE(nearRel(fAB, fBA)) << c.label() << " " << str(fAB) << " vs " << str(fBA);
+                ASSERT_TRUE(nearRel(fAB, fBA))
+                    << c.label() << " " << str(fAB) << " vs " << str(fBA);
             } else {
                 ++refractions;
                 const float ior = c.m->mat.ior;
@@ -297,7 +309,8 @@ TEST(Bsdf, ReversePdfAndReciprocity) {
                 Rgb radAB = radA.evaluate(b, nullptr, nullptr, nullptr);
                 Rgb radBA = radB.evaluate(a, nullptr, nullptr, nullptr);
                 Rgb impBA = impB.evaluate(a, nullptr, nullptr, nullptr);
-                ASSERT_TRUE(nearRel(radAB, impBA)) << c.label() << str(radAB) << str(impBA) << str(radBA);
+                ASSERT_TRUE(nearRel(radAB, impBA))
+                    << c.label() << str(radAB) << str(impBA) << str(radBA);
                 ASSERT_TRUE(nearRel(radAB / (etaA * etaA), radBA / (etaB * etaB))) << c.label();
             }
         }
@@ -394,7 +407,8 @@ TEST(Bsdf, RoughDielectricApproachesSmooth) {
         Vec3 fix = directionAt(kNormal, 5.0f, side);
         const float etaFix = side > 0 ? 1.0f : 1.5f, etaGen = side > 0 ? 1.5f : 1.0f;
         float cosT;
-        const float fres = ub_fresnel_dielectric_ct(std::cos(5.0f * kPi / 180), etaGen / etaFix, &cosT);
+        const float fres =
+            ub_fresnel_dielectric_ct(std::cos(5.0f * kPi / 180), etaGen / etaFix, &cosT);
         Albedo imp = albedo(makeBsdf(m, fix, true), 100000, 8);
         Albedo rad = albedo(makeBsdf(m, fix, false), 100000, 9);
         const float expectedRad = fres + (1 - fres) * (etaFix / etaGen) * (etaFix / etaGen);
@@ -416,8 +430,8 @@ TEST(Bsdf, MirrorReflectsExactlyWithSpecularWeight) {
             Vec3 fix = directionAt(kNormal, theta, side);
             Bsdf b = makeBsdf(m, fix, false);
             ASSERT_TRUE(b.isValid() && b.isDelta());
-            EXPECT_TRUE(isBlack(b.evaluate(directionAt(kNormal, 30, side), nullptr, nullptr,
-                                           nullptr)));
+            EXPECT_TRUE(
+                isBlack(b.evaluate(directionAt(kNormal, 30, side), nullptr, nullptr, nullptr)));
             EXPECT_EQ(b.pdf(reflect(fix, kNormal)), 0.0f);
             Vec3 dir;
             float pdfW, cosGen;
@@ -469,7 +483,8 @@ TEST(Bsdf, DielectricFresnelSelectionSnellAndRadianceScaling) {
                             ASSERT_NEAR(w, expected, 1e-5f * expected);
                             // Snell: eta_fix sin_fix = eta_gen sin_gen, opposite sides.
                             float sinGen = length(cross(dir, kNormal));
-                            ASSERT_NEAR(etaGen * sinGen, etaFix * std::sin(theta * kPi / 180), 1e-5f);
+                            ASSERT_NEAR(etaGen * sinGen, etaFix * std::sin(theta * kPi / 180),
+                                        1e-5f);
                             ASSERT_LT(dot(dir, kNormal) * dot(fix, kNormal), 0.0f);
                         }
                     }
@@ -506,7 +521,8 @@ TEST(Bsdf, OneSidedBackIsBlackTwoSidedBackMatchesFront) {
         one.twoSided = false;
         two.twoSided = true;
         const Vec3 front = directionAt(kNormal, 30, 1), back = directionAt(kNormal, 30, -1);
-        const Vec3 genFront = directionAt(kNormal, 40, 1, 200), genBack = directionAt(kNormal, 40, -1, 200);
+        const Vec3 genFront = directionAt(kNormal, 40, 1, 200),
+                   genBack = directionAt(kNormal, 40, -1, 200);
         Bsdf oneBack = makeBsdf(one, back, false);
         EXPECT_TRUE(oneBack.isValid());
         EXPECT_EQ(oneBack.continuationProb(), 0.0f) << nm.name;
@@ -528,7 +544,8 @@ TEST(Bsdf, OneSidedBackIsBlackTwoSidedBackMatchesFront) {
         EXPECT_TRUE(nearRel(f0, f1)) << nm.name;
         EXPECT_TRUE(nearRel(p0, p1)) << nm.name;
         EXPECT_TRUE(isBlack(twoBack.evaluate(genFront, nullptr, nullptr, nullptr))) << nm.name;
-        EXPECT_TRUE(nearRel(twoBack.continuationProb(), makeBsdf(two, front, false).continuationProb()));
+        EXPECT_TRUE(
+            nearRel(twoBack.continuationProb(), makeBsdf(two, front, false).continuationProb()));
         (void)front;
     }
 }
@@ -568,13 +585,15 @@ TEST(Bsdf, ShadingNormalGuardAndAdjointFactor) {
         for (int i = 0; i < 200; ++i) {
             Vec3 a = fg.toWorld(sampleCosineHemisphere(rng.uniform2()));
             Vec3 c = fg.toWorld(sampleCosineHemisphere(rng.uniform2()));
-            if (dot(a, ns) < 0.05f || dot(c, ns) < 0.05f || dot(a, ng) < 0.05f || dot(c, ng) < 0.05f)
+            if (dot(a, ns) < 0.05f || dot(c, ns) < 0.05f || dot(a, ng) < 0.05f ||
+                dot(c, ng) < 0.05f)
                 continue;
             Rgb fLight = makeBsdf(m, a, true, ng, ns).evaluate(c, nullptr, nullptr, nullptr);
             Rgb fCam = makeBsdf(m, c, false, ng, ns).evaluate(a, nullptr, nullptr, nullptr);
             float factor = std::fabs(dot(a, ns)) * std::fabs(dot(c, ng)) /
                            (std::fabs(dot(a, ng)) * std::fabs(dot(c, ns)));
-            ASSERT_TRUE(nearRel(fLight, fCam * factor, 1e-3f)) << nm.name << str(fLight) << str(fCam * factor);
+            ASSERT_TRUE(nearRel(fLight, fCam * factor, 1e-3f))
+                << nm.name << str(fLight) << str(fCam * factor);
         }
     }
 }
@@ -594,7 +613,8 @@ TEST(Bsdf, ContinuationProbabilityIsMaxAlbedoEstimate) {
     Material c = conductor(0.3f);
     float expected = 0;
     for (int k = 0; k < 3; ++k)
-        expected = std::max(expected, ub_fresnel_conductor(std::cos(30 * kPi / 180), c.eta[k], c.k[k]));
+        expected =
+            std::max(expected, ub_fresnel_conductor(std::cos(30 * kPi / 180), c.eta[k], c.k[k]));
     EXPECT_NEAR(makeBsdf(c, fix, false).continuationProb(), expected, 1e-5f);
 }
 

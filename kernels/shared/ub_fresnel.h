@@ -17,8 +17,7 @@
 /* Dielectric interface. cosThetaI: |cos| of the incident direction with the normal;
  * eta = eta_t / eta_i (IOR of the transmitted side over the incident side).
  * Writes |cos(theta_t)| into *cosThetaT (0 on total internal reflection, where F = 1). */
-UB_INLINE float ub_fresnel_dielectric_ct(float cosThetaI, float eta,
-                                         UB_PRIVATE float* cosThetaT) {
+UB_INLINE float ub_fresnel_dielectric_ct(float cosThetaI, float eta, UB_PRIVATE float* cosThetaT) {
     float c = ub_clampf(cosThetaI, 0.0f, 1.0f);
     float sin2T = (1.0f - c * c) / (eta * eta); /* Snell: sin_t = sin_i / eta */
     if (sin2T >= 1.0f) {

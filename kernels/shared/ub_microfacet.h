@@ -63,8 +63,8 @@ UB_INLINE float ub_ggx_visible_pdf(float cosThetaV, float vDotM, float cosThetaM
 /* Samples a microfacet normal m visible from v (v.z > 0, unit) from (u1, u2) in [0,1)^2
  * (Heitz 2018, Sec. 3-4): stretch v to the alpha = 1 configuration, sample the
  * projected half disk, lift it onto the hemisphere, unstretch. */
-UB_INLINE void ub_ggx_sample_visible(float vx, float vy, float vz, float alpha, float u1,
-                                     float u2, UB_PRIVATE float* mx, UB_PRIVATE float* my,
+UB_INLINE void ub_ggx_sample_visible(float vx, float vy, float vz, float alpha, float u1, float u2,
+                                     UB_PRIVATE float* mx, UB_PRIVATE float* my,
                                      UB_PRIVATE float* mz) {
     /* Stretched view direction. */
     float hx = alpha * vx, hy = alpha * vy, hz = vz;
@@ -105,7 +105,9 @@ UB_INLINE void ub_ggx_sample_visible(float vx, float vy, float vz, float alpha, 
 }
 
 /* |d omega_o / d omega_m| for reflection (Walter et al. 2007, eq. 14). */
-UB_INLINE float ub_jacobian_reflect(float oDotM) { return 1.0f / (4.0f * ub_fabs(oDotM)); }
+UB_INLINE float ub_jacobian_reflect(float oDotM) {
+    return 1.0f / (4.0f * ub_fabs(oDotM));
+}
 
 /* |d omega_o / d omega_m| for refraction from the side of i (IOR etaI) to the side of o
  * (IOR etaO) (Walter et al. 2007, eq. 17). */

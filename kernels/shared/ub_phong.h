@@ -18,7 +18,9 @@
 #include "ub_defs.h"
 
 /* Lambert: f = rho / pi; cosine-weighted density cos(theta) / pi. */
-UB_INLINE float ub_lambert_pdf(float cosTheta) { return ub_fmax(0.0f, cosTheta) * UB_INV_PI; }
+UB_INLINE float ub_lambert_pdf(float cosTheta) {
+    return ub_fmax(0.0f, cosTheta) * UB_INV_PI;
+}
 
 /* Energy-normalised modified Phong lobe without rho: (n + 2)/(2 pi) cos^n. */
 UB_INLINE float ub_phong_lobe(float cosAlpha, float exponent) {

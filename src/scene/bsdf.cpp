@@ -58,14 +58,19 @@ constexpr float kEpsCosine = 1e-6f;
 /// Smallest GGX roughness used (alpha -> 0 is a delta lobe the float math cannot represent).
 constexpr float kMinAlpha = 1e-4f;
 
-float clamp01(float x) { return std::min(1.0f, std::max(0.0f, x)); }
+float clamp01(float x) {
+    return std::min(1.0f, std::max(0.0f, x));
+}
 
 Rgb fresnelConductor(float cosThetaI, const Rgb& eta, const Rgb& k) {
-    return {ub_fresnel_conductor(cosThetaI, eta.x, k.x), ub_fresnel_conductor(cosThetaI, eta.y, k.y),
+    return {ub_fresnel_conductor(cosThetaI, eta.x, k.x),
+            ub_fresnel_conductor(cosThetaI, eta.y, k.y),
             ub_fresnel_conductor(cosThetaI, eta.z, k.z)};
 }
 
-float ggxAlpha(const Material& m) { return std::max(m.alpha, kMinAlpha); }
+float ggxAlpha(const Material& m) {
+    return std::max(m.alpha, kMinAlpha);
+}
 
 bool isDielectric(MaterialType t) {
     return t == MaterialType::Dielectric || t == MaterialType::RoughDielectric;
@@ -101,41 +106,42 @@ bool Bsdf::setup(const Material& mat, const Vec3& dirFix, const Vec3& geoNormal,
     if (std::fabs(localDirFix_.z) < kEpsCosine || std::fabs(cosGeoFix_) < kEpsCosine) return false;
 
     switch (mat.type) {
-    case MaterialType::Diffuse:
-        probDiffuse_ = 1.0f;
-        contProb_ = maxComponent(mat.diffuse);
-        break;
-    case MaterialType::Phong: {
-        // Lobe selection proportional to the albedo estimates (SmallVCM).
-        float albedoDiffuse = luminance(mat.diffuse), albedoGlossy = luminance(mat.glossy);
-        float total = albedoDiffuse + albedoGlossy;
-        if (total > 1e-9f) {
-            probDiffuse_ = albedoDiffuse / total;
-            probGlossy_ = albedoGlossy / total;
-        } else {
-            black_ = true;
+        case MaterialType::Diffuse:
+            probDiffuse_ = 1.0f;
+            contProb_ = maxComponent(mat.diffuse);
+            break;
+        case MaterialType::Phong: {
+            // Lobe selection proportional to the albedo estimates (SmallVCM).
+            float albedoDiffuse = luminance(mat.diffuse), albedoGlossy = luminance(mat.glossy);
+            float total = albedoDiffuse + albedoGlossy;
+            if (total > 1e-9f) {
+                probDiffuse_ = albedoDiffuse / total;
+                probGlossy_ = albedoGlossy / total;
+            } else {
+                black_ = true;
+            }
+            contProb_ = maxComponent(mat.diffuse + mat.glossy);
+            break;
         }
-        contProb_ = maxComponent(mat.diffuse + mat.glossy);
-        break;
-    }
-    case MaterialType::Mirror:
-        contProb_ = maxComponent(mat.specular);
-        break;
-    case MaterialType::Dielectric:
-    case MaterialType::RoughDielectric:
-        if (localDirFix_.z > 0.0f) {
-            etaFix_ = 1.0f;
-            etaOther_ = mat.ior;
-        } else {
-            etaFix_ = mat.ior;
-            etaOther_ = 1.0f;
-        }
-        fresnelFix_ = ub_fresnel_dielectric(std::fabs(localDirFix_.z), etaOther_ / etaFix_);
-        contProb_ = maxComponent(mat.specular);
-        break;
-    case MaterialType::RoughConductor:
-        contProb_ = maxComponent(mat.specular * fresnelConductor(localDirFix_.z, mat.eta, mat.k));
-        break;
+        case MaterialType::Mirror:
+            contProb_ = maxComponent(mat.specular);
+            break;
+        case MaterialType::Dielectric:
+        case MaterialType::RoughDielectric:
+            if (localDirFix_.z > 0.0f) {
+                etaFix_ = 1.0f;
+                etaOther_ = mat.ior;
+            } else {
+                etaFix_ = mat.ior;
+                etaOther_ = 1.0f;
+            }
+            fresnelFix_ = ub_fresnel_dielectric(std::fabs(localDirFix_.z), etaOther_ / etaFix_);
+            contProb_ = maxComponent(mat.specular);
+            break;
+        case MaterialType::RoughConductor:
+            contProb_ =
+                maxComponent(mat.specular * fresnelConductor(localDirFix_.z, mat.eta, mat.k));
+            break;
     }
     if (black_) contProb_ = 0.0f;
     contProb_ = clamp01(contProb_);
@@ -181,15 +187,18 @@ Rgb Bsdf::evalLocal(const Vec3& localGen, float cosGeoGen, float* directPdfW,
         return Rgb(0.0f);
     Rgb f(0.0f);
     switch (mat_->type) {
-    case MaterialType::Diffuse:
-    case MaterialType::Phong: f = evalPhong(localGen, directPdfW, reversePdfW); break;
-    case MaterialType::RoughConductor:
-        f = evalRoughConductor(localGen, directPdfW, reversePdfW);
-        break;
-    case MaterialType::RoughDielectric:
-        f = evalRoughDielectric(localGen, directPdfW, reversePdfW);
-        break;
-    default: break;
+        case MaterialType::Diffuse:
+        case MaterialType::Phong:
+            f = evalPhong(localGen, directPdfW, reversePdfW);
+            break;
+        case MaterialType::RoughConductor:
+            f = evalRoughConductor(localGen, directPdfW, reversePdfW);
+            break;
+        case MaterialType::RoughDielectric:
+            f = evalRoughDielectric(localGen, directPdfW, reversePdfW);
+            break;
+        default:
+            break;
     }
     return f * shadingFactor(std::fabs(localGen.z), cosGeoGen);
 }
@@ -272,8 +281,7 @@ Rgb Bsdf::evalRoughDielectric(const Vec3& gen, float* directPdfW, float* reverse
     // (dirFix towards the camera) and etaGen for importance (the adjoint BTDF).
     const float etaO = fromLight_ ? etaGen : etaFix_;
     const float g2 = ub_ggx_g2_separable(cFix, cGen, alpha);
-    return mat_->specular *
-           (transmit * d * g2 * aFix * aGen * etaO * etaO / (cFix * cGen * denom));
+    return mat_->specular * (transmit * d * g2 * aFix * aGen * etaO * etaO / (cFix * cGen * denom));
 }
 
 Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
@@ -288,49 +296,50 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
     Vec3 gen;
     uint32_t event = kEventGlossy;
     switch (mat_->type) {
-    case MaterialType::Diffuse:
-    case MaterialType::Phong:
-        if (rnd.z < probDiffuse_) {
-            gen = sampleCosineHemisphere(Vec2(rnd.x, rnd.y));
-            event = kEventDiffuse;
-        } else {
-            Vec3 lobe;
-            ub_power_cos_sample(rnd.x, rnd.y, mat_->exponent, &lobe.x, &lobe.y, &lobe.z);
-            gen = Frame(Vec3(-fix.x, -fix.y, fix.z)).toWorld(lobe);
+        case MaterialType::Diffuse:
+        case MaterialType::Phong:
+            if (rnd.z < probDiffuse_) {
+                gen = sampleCosineHemisphere(Vec2(rnd.x, rnd.y));
+                event = kEventDiffuse;
+            } else {
+                Vec3 lobe;
+                ub_power_cos_sample(rnd.x, rnd.y, mat_->exponent, &lobe.x, &lobe.y, &lobe.z);
+                gen = Frame(Vec3(-fix.x, -fix.y, fix.z)).toWorld(lobe);
+            }
+            break;
+        case MaterialType::RoughConductor: {
+            Vec3 m;
+            ub_ggx_sample_visible(fix.x, fix.y, fix.z, ggxAlpha(*mat_), rnd.x, rnd.y, &m.x, &m.y,
+                                  &m.z);
+            gen = 2.0f * dot(fix, m) * m - fix;
+            break;
         }
-        break;
-    case MaterialType::RoughConductor: {
-        Vec3 m;
-        ub_ggx_sample_visible(fix.x, fix.y, fix.z, ggxAlpha(*mat_), rnd.x, rnd.y, &m.x, &m.y,
-                              &m.z);
-        gen = 2.0f * dot(fix, m) * m - fix;
-        break;
-    }
-    case MaterialType::RoughDielectric: {
-        // Work mirrored to dirFix's side (GGX is symmetric under z -> -z).
-        const float side = fix.z < 0.0f ? -1.0f : 1.0f;
-        const Vec3 fixUp(fix.x, fix.y, side * fix.z);
-        Vec3 m;
-        ub_ggx_sample_visible(fixUp.x, fixUp.y, fixUp.z, ggxAlpha(*mat_), rnd.x, rnd.y, &m.x,
-                              &m.y, &m.z);
-        const float cosI = dot(fixUp, m);
-        float cosT;
-        const float fresnel = ub_fresnel_dielectric_ct(cosI, etaOther_ / etaFix_, &cosT);
-        const bool reflect = rnd.z < fresnel;
-        if (reflect) {
-            gen = 2.0f * cosI * m - fixUp;
-        } else {
-            const float eta = etaFix_ / etaOther_;  // Snell: t = -eta i + (eta cos_i - cos_t) m
-            gen = -eta * fixUp + (eta * cosI - cosT) * m;
+        case MaterialType::RoughDielectric: {
+            // Work mirrored to dirFix's side (GGX is symmetric under z -> -z).
+            const float side = fix.z < 0.0f ? -1.0f : 1.0f;
+            const Vec3 fixUp(fix.x, fix.y, side * fix.z);
+            Vec3 m;
+            ub_ggx_sample_visible(fixUp.x, fixUp.y, fixUp.z, ggxAlpha(*mat_), rnd.x, rnd.y, &m.x,
+                                  &m.y, &m.z);
+            const float cosI = dot(fixUp, m);
+            float cosT;
+            const float fresnel = ub_fresnel_dielectric_ct(cosI, etaOther_ / etaFix_, &cosT);
+            const bool reflect = rnd.z < fresnel;
+            if (reflect) {
+                gen = 2.0f * cosI * m - fixUp;
+            } else {
+                const float eta = etaFix_ / etaOther_;  // Snell: t = -eta i + (eta cos_i - cos_t) m
+                gen = -eta * fixUp + (eta * cosI - cosT) * m;
+            }
+            // A microfacet reflection that leaves below the macro-surface, or a refraction
+            // that leaves above it, fails: evaluate() would read it as the other lobe, whose
+            // pdf this sample does not follow.
+            if ((gen.z > 0.0f) != reflect) return Rgb(0.0f);
+            gen.z *= side;
+            break;
         }
-        // A microfacet reflection that leaves below the macro-surface, or a refraction
-        // that leaves above it, fails: evaluate() would read it as the other lobe, whose
-        // pdf this sample does not follow.
-        if ((gen.z > 0.0f) != reflect) return Rgb(0.0f);
-        gen.z *= side;
-        break;
-    }
-    default: return Rgb(0.0f);
+        default:
+            return Rgb(0.0f);
     }
     if (!(lengthSqr(gen) > 0.0f)) return Rgb(0.0f);
     const Vec3 world = frame_.toWorld(normalize(gen));

@@ -40,7 +40,8 @@ namespace ub {
 enum BsdfEvent : uint32_t {
     kEventNone = 0,
     kEventDiffuse = 1,
-    kEventGlossy = 2,
+    kEventGlossy = 2,    ///< Phong lobe, GGX reflection or GGX transmission (rough dielectric:
+                         ///< the side of dirGen w.r.t. the geometric normal tells which)
     kEventReflect = 4,   ///< specular (delta) reflection
     kEventRefract = 8,   ///< specular (delta) refraction
     kEventSpecular = kEventReflect | kEventRefract,
