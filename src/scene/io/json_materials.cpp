@@ -1,0 +1,157 @@
+// "materials" of the native JSON scene format (docs/scene-format.md):
+// an object mapping names to materials with a "type" tag.
+#include <algorithm>
+
+#include "scene/io/json_scene_parts.h"
+
+namespace ub {
+
+namespace {
+
+/// Named metals for rough_conductor "metal": complex IOR n + ik sampled at
+/// 650 nm (R), 550 nm (G) and 450 nm (B) from measured tables (refractiveindex.info).
+/// The same numbers are listed in docs/scene-format.md.
+struct MetalPreset {
+    const char* name;
+    Rgb eta, k;
+};
+const MetalPreset kMetals[] = {
+    {"gold", {0.1830f, 0.4211f, 1.3734f}, {3.4242f, 2.3459f, 1.7704f}},
+    {"copper", {0.2711f, 0.6769f, 1.3164f}, {3.6092f, 2.6248f, 2.2921f}},
+    {"silver", {0.1626f, 0.1451f, 0.1355f}, {4.0728f, 3.1900f, 2.1997f}},
+    {"aluminium", {1.5196f, 0.9657f, 0.5312f}, {7.6635f, 6.4581f, 5.0699f}},
+};
+
+const std::vector<std::string> kMaterialTypes = {"diffuse",    "phong",           "mirror",
+                                                 "dielectric", "rough_conductor", "rough_dielectric"};
+
+std::vector<std::string> metalNames() {
+    std::vector<std::string> names;
+    for (const auto& m : kMetals) names.push_back(m.name);
+    return names;
+}
+
+/// Reflectances are albedos: a component above 1 would create energy.
+const NumberRange kReflectance = NumberRange::closed(0.0, 1.0);
+
+const char* kChannel[3] = {"red", "green", "blue"};
+
+void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material& mat) {
+    if (!r.isObject(m, ptr, "a material object with a \"type\" key")) return;
+    const Json* typeJson = r.member(m, ptr, "type", Presence::Required,
+                                    "a material type: one of " + joinNames(kMaterialTypes));
+    if (!typeJson) return;
+    std::string typePtr = jsonPointerChild(ptr, "type");
+    std::string type = r.string(*typeJson, typePtr);
+    if (type.empty()) return;
+
+    std::vector<std::string> keys = {"type"};
+    if (type == "diffuse") {
+        mat.type = MaterialType::Diffuse;
+        keys.insert(keys.end(), {"reflectance", "two_sided"});
+        r.checkKeys(m, ptr, keys, "diffuse material");
+        mat.diffuse = r.getRgb(m, ptr, "reflectance", Presence::Optional, kReflectance, Rgb(0.5f));
+    } else if (type == "phong") {
+        mat.type = MaterialType::Phong;
+        keys.insert(keys.end(),
+                    {"diffuse_reflectance", "glossy_reflectance", "exponent", "two_sided"});
+        r.checkKeys(m, ptr, keys, "phong material");
+        mat.diffuse = r.getRgb(m, ptr, "diffuse_reflectance", Presence::Optional, kReflectance,
+                               Rgb(0.0f));
+        mat.glossy = r.getRgb(m, ptr, "glossy_reflectance", Presence::Optional, kReflectance,
+                              Rgb(0.0f));
+        mat.exponent = r.getNumber(m, ptr, "exponent", Presence::Required, NumberRange::positive(),
+                                   1.0f);
+        // The modified Phong lobe is normalized ((n+2)/(2 pi) cos^n, Lafortune & Willems
+        // 1994), so its albedo is at most glossy_reflectance; the sum with the Lambertian
+        // part must stay <= 1 per channel to conserve energy.
+        for (int c = 0; c < 3; ++c) {
+            float sum = mat.diffuse[c] + mat.glossy[c];
+            if (sum > 1.0f) {
+                r.error(ptr, "diffuse_reflectance + glossy_reflectance = " +
+                                 formatNumber(sum) + " > 1 in the " + kChannel[c] +
+                                 " channel: the material would create energy (expected a sum "
+                                 "<= 1)");
+                break;
+            }
+        }
+    } else if (type == "mirror") {
+        mat.type = MaterialType::Mirror;
+        keys.insert(keys.end(), {"reflectance", "two_sided"});
+        r.checkKeys(m, ptr, keys, "mirror material");
+        mat.specular = r.getRgb(m, ptr, "reflectance", Presence::Optional, kReflectance, Rgb(1.0f));
+    } else if (type == "dielectric" || type == "rough_dielectric") {
+        bool rough = type == "rough_dielectric";
+        mat.type = rough ? MaterialType::RoughDielectric : MaterialType::Dielectric;
+        keys.insert(keys.end(), {"ior", "tint"});
+        if (rough) keys.push_back("alpha");
+        r.checkKeys(m, ptr, keys, type + " material");
+        mat.ior = r.getNumber(m, ptr, "ior", Presence::Required, NumberRange::positive(), 1.5f);
+        mat.specular = r.getRgb(m, ptr, "tint", Presence::Optional, kReflectance, Rgb(1.0f));
+        if (rough)
+            mat.alpha = r.getNumber(m, ptr, "alpha", Presence::Required,
+                                    NumberRange::leftOpen(0.0, 1.0), 0.1f);
+        mat.twoSided = false;  // the inside of a dielectric is defined by its normal
+    } else if (type == "rough_conductor") {
+        mat.type = MaterialType::RoughConductor;
+        keys.insert(keys.end(), {"metal", "eta", "k", "alpha", "tint", "two_sided"});
+        r.checkKeys(m, ptr, keys, "rough_conductor material");
+        const Json* metal = r.member(m, ptr, "metal", Presence::Optional, "");
+        bool hasEta = m.contains("eta"), hasK = m.contains("k");
+        if (metal) {
+            std::string metalPtr = jsonPointerChild(ptr, "metal");
+            if (hasEta || hasK) {
+                r.error(metalPtr, "give either \"metal\" or both \"eta\" and \"k\", not both");
+            }
+            std::string name = r.string(*metal, metalPtr);
+            if (name == "aluminum") name = "aluminium";
+            auto it = std::find_if(std::begin(kMetals), std::end(kMetals),
+                                   [&](const MetalPreset& p) { return name == p.name; });
+            if (it != std::end(kMetals)) {
+                mat.eta = it->eta;
+                mat.k = it->k;
+            } else if (!name.empty()) {
+                r.error(metalPtr, "unknown metal '" + name + "'" + didYouMean(name, metalNames()) +
+                                      "; valid metals: " + joinNames(metalNames()));
+            }
+        } else if (hasEta || hasK) {
+            mat.eta = r.getRgb(m, ptr, "eta", Presence::Required, NumberRange::positive(), mat.eta);
+            mat.k = r.getRgb(m, ptr, "k", Presence::Required, NumberRange::nonNegative(), mat.k);
+        } else {
+            r.error(ptr, "a rough_conductor needs \"metal\" (one of " + joinNames(metalNames()) +
+                             ") or both \"eta\" and \"k\" (RGB)");
+        }
+        mat.alpha = r.getNumber(m, ptr, "alpha", Presence::Required,
+                                NumberRange::leftOpen(0.0, 1.0), 0.1f);
+        mat.specular = r.getRgb(m, ptr, "tint", Presence::Optional, kReflectance, Rgb(1.0f));
+    } else {
+        r.error(typePtr, "unknown material type '" + type + "'" +
+                             didYouMean(type, kMaterialTypes) +
+                             "; valid types: " + joinNames(kMaterialTypes));
+        return;
+    }
+    if (mat.type != MaterialType::Dielectric && mat.type != MaterialType::RoughDielectric)
+        mat.twoSided = r.getBool(m, ptr, "two_sided", true);
+}
+
+}  // namespace
+
+void readJsonMaterials(JsonReader& r, const Json& materials, JsonSceneParts& parts) {
+    const std::string ptr = "/materials";
+    if (!r.isObject(materials, ptr, "an object mapping material names to materials")) return;
+    for (const auto& item : materials.items()) {
+        std::string itemPtr = jsonPointerChild(ptr, item.key());
+        if (item.key().empty()) {
+            r.errorAtKey(itemPtr, "a material name must not be empty");
+            continue;
+        }
+        Material mat;
+        mat.name = item.key();
+        readMaterial(r, item.value(), itemPtr, mat);
+        parts.materialIds[mat.name] = int(parts.materials.size());
+        parts.materialNames.push_back(mat.name);
+        parts.materials.push_back(mat);
+    }
+}
+
+}  // namespace ub

@@ -1,0 +1,62 @@
+// Internal to the JSON loader: what is read from a scene file before a Scene
+// is built. Reading fills this and the diagnostics; only a file without
+// errors is turned into a Scene (json_loader.cpp), so a Scene never sees a
+// fallback value.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/vec.h"
+#include "scene/io/json_reader.h"
+#include "scene/light.h"
+#include "scene/material.h"
+#include "scene/scene.h"
+
+namespace ub {
+
+struct JsonCameraDesc {
+    Vec3 position{0, 0, 0}, target{0, 0, 1}, up{0, 1, 0};
+    float fovYDeg = 45.0f;
+    int width = 256, height = 256;
+    float lensRadius = 0.0f, focusDistance = 1.0f;
+};
+
+struct JsonShapeDesc {
+    std::string name;
+    bool isSphere = false;
+    TriangleMesh mesh;        ///< world space (not spheres)
+    Vec3 center;              ///< spheres, world space
+    float radius = 0.0f;      ///< spheres, world space
+    int materialId = -1;      ///< index into JsonSceneParts::materials
+    int lightIndex = -1;      ///< index into JsonSceneParts::lights, or -1
+};
+
+struct JsonSceneParts {
+    std::string baseDir;      ///< folder of the scene file; relative paths start here
+    bool hasCamera = false;
+    JsonCameraDesc camera;
+    RenderSettings settings;
+    std::vector<Material> materials;
+    std::map<std::string, int> materialIds;  ///< by name
+    std::vector<std::string> materialNames;  ///< in file order, for messages
+    std::vector<JsonShapeDesc> shapes;
+    std::vector<Light> lights;
+    int backgroundLight = -1;  ///< index into lights
+    std::string environmentPtr; ///< JSON pointer of the environment light, for messages
+};
+
+/// Resolves a path from the scene file: absolute paths stay, others start at baseDir.
+std::string resolveScenePath(const std::string& baseDir, const std::string& path);
+
+/// Reads "/materials" (an object: name -> material).
+void readJsonMaterials(JsonReader& r, const Json& materials, JsonSceneParts& parts);
+/// Reads "/shapes" (an array), creating area lights for emissive shapes.
+void readJsonShapes(JsonReader& r, const Json& shapes, JsonSceneParts& parts);
+/// Reads a "transform" value: {"scale", "rotate", "translate"} or {"matrix"}.
+Transform readJsonTransform(JsonReader& r, const Json& v, const std::string& ptr);
+/// Reads a "rotate" value: {"axis", "angle"} or an array of them (applied in order).
+Transform readJsonRotation(JsonReader& r, const Json& v, const std::string& ptr);
+
+}  // namespace ub
