@@ -248,17 +248,18 @@ void readRoot(JsonReader& r, const Json& root, JsonSceneParts& parts) {
         readSettings(r, *s, parts);
     if (const Json* m = r.member(root, "", "materials", Presence::Optional, ""))
         readJsonMaterials(r, *m, parts);
-    // Lights before shapes, so that explicit lights come first in Scene::lights.
+    // Shapes before lights: area lights of emissive shapes come first in Scene::lights
+    // (in shape order), then the entries of "lights".
     size_t lightEntries = 0;
-    if (const Json* l = r.member(root, "", "lights", Presence::Optional, "")) {
-        readJsonLights(r, *l, parts);
-        lightEntries += l->is_array() ? l->size() : 1;
-    }
     if (const Json* s = r.member(root, "", "shapes", Presence::Optional, "")) {
         readJsonShapes(r, *s, parts);
         if (s->is_array())
             for (const auto& shape : *s)
                 if (shape.is_object() && shape.contains("emission")) ++lightEntries;
+    }
+    if (const Json* l = r.member(root, "", "lights", Presence::Optional, "")) {
+        readJsonLights(r, *l, parts);
+        lightEntries += l->is_array() ? l->size() : 1;
     }
     // Only when nothing was even attempted: a light with an error was reported already.
     if (lightEntries == 0)
