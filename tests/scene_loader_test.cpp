@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "core/image.h"
 #include "scene/io/json_loader.h"
@@ -304,6 +305,22 @@ TEST(BundledScenes, SkyMapIsTheGeneratedOne) {
     EXPECT_GT(maxLum, 100.0f);  // the sun
 }
 
+TEST(SceneFormatDoc, OpeningExampleLoads) {
+    // The complete scene at the top of docs/scene-format.md must stay valid.
+    std::ifstream in(std::string(UNIBEAM_SOURCE_DIR) + "/docs/scene-format.md");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    std::string doc = ss.str();
+    size_t begin = doc.find("```json\n");
+    ASSERT_NE(begin, std::string::npos);
+    begin += 8;
+    size_t end = doc.find("```", begin);
+    ASSERT_NE(end, std::string::npos);
+    auto scene = loadJsonSceneFromString(doc.substr(begin, end - begin), "doc.json", kDataDir);
+    EXPECT_EQ(scene->shapes.size(), 2u);
+    EXPECT_EQ(scene->lights.size(), 1u);
+}
+
 TEST(SceneSummary, DescribesCountsBoundsCameraAndSettings) {
     auto scene = loadScene(kScenesDir + "/cornell-point-light.json");
     std::string s = describeScene(*scene);
@@ -321,8 +338,15 @@ TEST(SceneSummary, DescribesCountsBoundsCameraAndSettings) {
 
 TEST(JsonLoaderErrors, SyntaxErrorNamesLineAndColumn) {
     std::string e = onlyError("{\n  \"camera\": {\"fov\": 45,, \"x\": 1}\n}");
-    EXPECT_TRUE(contains(e, "scene.json:2:23: error: invalid JSON: syntax error while parsing "
+    EXPECT_TRUE(contains(e, "scene.json:2:24: error: invalid JSON: syntax error while parsing "
                             "object key - unexpected ','; expected string literal"))
+        << e;
+}
+
+TEST(JsonLoaderErrors, UnexpectedEndOfInputPointsAtTheLastToken) {
+    std::string e = onlyError("{\n  \"camera\": {\"fov\": 45}\n");
+    EXPECT_TRUE(contains(e, "scene.json:2:23: error: invalid JSON: syntax error while parsing "
+                            "object - unexpected end of input; expected '}'"))
         << e;
 }
 
@@ -376,7 +400,8 @@ TEST(JsonLoaderErrors, UnknownTypesListValidTypes) {
     EXPECT_EQ(d[0].message, "unknown material type 'difuse' (did you mean 'diffuse'?); valid types: "
                             "diffuse, phong, mirror, dielectric, rough_conductor, rough_dielectric");
     EXPECT_EQ(d[1].message,
-              "unknown shape type 'cone'; valid types: obj, ply, rectangle, cube, sphere");
+              "unknown shape type 'cone' (did you mean 'cube'?); valid types: obj, ply, "
+              "rectangle, cube, sphere");
     EXPECT_EQ(d[2].message, "unknown light type 'spot'; valid types: point, directional, "
                             "constant, envmap (area lights are shapes with an \"emission\")");
 }

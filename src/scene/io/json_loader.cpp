@@ -4,6 +4,8 @@
 // from a file without errors.
 #include "scene/io/json_loader.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -46,8 +48,11 @@ bool parseText(const std::string& text, const std::string& file, Diagnostics& di
         *out = Json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
         return true;
     } catch (const Json::parse_error& e) {
-        // e.byte is the 1-based index of the character where parsing failed.
-        size_t offset = e.byte > 0 ? size_t(e.byte - 1) : 0;
+        // e.byte is the 1-based index of the last character nlohmann read, which can be
+        // the whitespace after the offending token: step back to the token.
+        size_t offset = std::min(e.byte > 0 ? size_t(e.byte - 1) : 0, text.size());
+        while (offset > 0 && (offset >= text.size() || std::isspace(uint8_t(text[offset]))))
+            --offset;
         add(sourcePosOfOffset(text, offset),
             "invalid JSON: " + stripNlohmannPrefix(e.what()));
     } catch (const Json::exception& e) {
