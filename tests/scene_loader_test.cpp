@@ -415,6 +415,13 @@ TEST(JsonLoaderErrors, UnknownMaterialReferenceListsDefinedOnes) {
                  "mean 'glass'?) (defined: white, red, glass)");
 }
 
+TEST(JsonLoaderErrors, UnknownMaterialWhenNoneAreDefined) {
+    std::string e = onlyError(sceneWith("", kRect, kPoint));
+    EXPECT_TRUE(contains(e, "at /shapes/0/material: unknown material 'white' (no materials are "
+                            "defined in \"materials\")"))
+        << e;
+}
+
 TEST(JsonLoaderErrors, NegativeAndOutOfRangeValues) {
     struct Case {
         std::string from, to, expected;

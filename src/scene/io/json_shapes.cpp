@@ -206,7 +206,9 @@ void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
         } else if (!name.empty()) {
             r.error(mPtr, "unknown material '" + name + "'" +
                               didYouMean(name, parts.materialNames) +
-                              " (defined: " + joinNames(parts.materialNames) + ")");
+                              (parts.materialNames.empty()
+                                   ? std::string(" (no materials are defined in \"materials\")")
+                                   : " (defined: " + joinNames(parts.materialNames) + ")"));
         }
     } else if (v.contains("emission")) {
         shape.materialId = blackEmitterMaterial(parts);
