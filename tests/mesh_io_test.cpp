@@ -232,3 +232,14 @@ TEST(MeshIo, ErrorPlyGarbageAndTruncated) {
     d = loadError(meshPath("truncated_binary.ply"));
     EXPECT_TRUE(contains(d.message, "out of range (mesh has 4 vertices)")) << d.message;
 }
+
+// CRLF line endings, groups, smoothing groups and material statements: materials
+// come from the scene file, so a missing .mtl is neither an error nor a warning.
+TEST(MeshIo, ObjWithCrlfAndMaterialStatements) {
+    Diagnostics diags;
+    TriangleMesh m = loadOk("crlf_with_mtllib.obj", &diags);
+    EXPECT_EQ(m.triangleCount(), 1u);
+    ASSERT_EQ(m.uvs.size(), 3u);
+    EXPECT_TRUE(m.normals.empty());
+    EXPECT_TRUE(diags.all().empty()) << diags.all()[0].format();
+}
