@@ -2,6 +2,8 @@
 // valid scenes load with the expected contents, and every kind of bad input
 // gives the documented message at the right file:line:column and JSON pointer.
 // Positions in the expected messages were counted by hand in the test texts.
+#include "scene/io/scene_loader.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,7 +14,6 @@
 #include "core/image.h"
 #include "scene/io/json_loader.h"
 #include "scene/io/json_positions.h"
-#include "scene/io/scene_loader.h"
 #include "scene/scene_summary.h"
 
 using namespace ub;
@@ -67,8 +68,9 @@ struct TempDir {
     fs::path path;
     TempDir() {
         path = fs::temp_directory_path() /
-               ("unibeam_loader_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-                "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+               ("unibeam_loader_test_" +
+                std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
         fs::create_directories(path);
     }
     ~TempDir() {
@@ -133,8 +135,7 @@ TEST(JsonLoader, TransformsApplyScaleThenRotateThenTranslate) {
         R"json({"type": "rectangle", "material": "white", "transform": {"scale": [2, 3, 1], "rotate": {"axis": [0, 0, 1], "angle": 90}, "translate": [10, 0, 0]}},
         {"type": "rectangle", "material": "white", "transform": {"matrix": [[0, -3, 0, 10], [2, 0, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]}},
         {"type": "sphere", "material": "white", "center": [1, 0, 0], "radius": 0.5, "transform": {"scale": 2, "translate": [0, 5, 0]}})json";
-    auto scene =
-        loadJsonSceneFromString(sceneWith(kWhite, shapes, kPoint), "scene.json", kDataDir);
+    auto scene = loadJsonSceneFromString(sceneWith(kWhite, shapes, kPoint), "scene.json", kDataDir);
     ASSERT_EQ(scene->shapes.size(), 3u);
     // [-1,1]^2 scaled to [-2,2]x[-3,3], rotated 90 deg about z to [-3,3]x[-2,2], moved by +10 in x.
     for (int s = 0; s < 2; ++s) {
@@ -161,7 +162,8 @@ TEST(JsonLoader, MaterialsOfEveryTypeKeepTheirParameters) {
         "gold": {"type": "rough_conductor", "metal": "gold", "alpha": 0.2},
         "custom": {"type": "rough_conductor", "eta": [1, 2, 3], "k": 4, "alpha": 0.5, "tint": 0.5},
         "frosted": {"type": "rough_dielectric", "ior": 1.5, "alpha": 0.3})json";
-    auto scene = loadJsonSceneFromString(sceneWith(materials, kRect, kPoint), "scene.json", kDataDir);
+    auto scene =
+        loadJsonSceneFromString(sceneWith(materials, kRect, kPoint), "scene.json", kDataDir);
     const auto& m = scene->materials;
     ASSERT_EQ(m.size(), 7u);
     EXPECT_EQ(m[0].type, MaterialType::Diffuse);
@@ -197,8 +199,8 @@ TEST(JsonLoader, LightsOfEveryType) {
         {"type": "envmap", "file": "sky.exr", "scale": 2, "rotate": {"axis": [0, 1, 0], "angle": 90}})json";
     const std::string shapes =
         R"json({"type": "sphere", "radius": 0.25, "emission": 4, "emission_two_sided": true})json";
-    auto scene = loadJsonSceneFromString(sceneWith(kWhite, shapes, lights), "scene.json",
-                                         tmp.path.string());
+    auto scene =
+        loadJsonSceneFromString(sceneWith(kWhite, shapes, lights), "scene.json", tmp.path.string());
     ASSERT_EQ(scene->lights.size(), 3u);
     const Light& area = scene->lights[0];  // emissive shapes first
     EXPECT_EQ(area.type, LightType::Area);
@@ -237,7 +239,8 @@ TEST(JsonLoader, ObjMeshPathIsRelativeToTheSceneFile) {
 }
 
 TEST(JsonLoader, CommentsAreAllowed) {
-    std::string text = "// a comment\n" + sceneWith(kWhite, kRect, "/* here */" + std::string(kPoint));
+    std::string text =
+        "// a comment\n" + sceneWith(kWhite, kRect, "/* here */" + std::string(kPoint));
     EXPECT_TRUE(errorsOf(text).empty());
 }
 
@@ -327,7 +330,8 @@ TEST(SceneSummary, DescribesCountsBoundsCameraAndSettings) {
     EXPECT_TRUE(contains(s, "shapes: 7 (5 meshes with 10 triangles, 2 spheres)")) << s;
     EXPECT_TRUE(contains(s, "materials: 7 (diffuse 4, phong 1, mirror 1, dielectric 1)")) << s;
     EXPECT_TRUE(contains(s, "lights: 1 (point 1)")) << s;
-    EXPECT_TRUE(contains(s, "bounds: (-1.27029, -1.25549, -1.28002) to (1.28975, 1.30455, 1.28002)"))
+    EXPECT_TRUE(
+        contains(s, "bounds: (-1.27029, -1.25549, -1.28002) to (1.28975, 1.30455, 1.28002)"))
         << s;
     EXPECT_TRUE(contains(s, "camera: 256x256")) << s;
     EXPECT_TRUE(contains(s, "fov 45 deg (vertical), pinhole")) << s;
@@ -338,22 +342,25 @@ TEST(SceneSummary, DescribesCountsBoundsCameraAndSettings) {
 
 TEST(JsonLoaderErrors, SyntaxErrorNamesLineAndColumn) {
     std::string e = onlyError("{\n  \"camera\": {\"fov\": 45,, \"x\": 1}\n}");
-    EXPECT_TRUE(contains(e, "scene.json:2:24: error: invalid JSON: syntax error while parsing "
-                            "object key - unexpected ','; expected string literal"))
+    EXPECT_TRUE(contains(e,
+                         "scene.json:2:24: error: invalid JSON: syntax error while parsing "
+                         "object key - unexpected ','; expected string literal"))
         << e;
 }
 
 TEST(JsonLoaderErrors, UnexpectedEndOfInputPointsAtTheLastToken) {
     std::string e = onlyError("{\n  \"camera\": {\"fov\": 45}\n");
-    EXPECT_TRUE(contains(e, "scene.json:2:23: error: invalid JSON: syntax error while parsing "
-                            "object - unexpected end of input; expected '}'"))
+    EXPECT_TRUE(contains(e,
+                         "scene.json:2:23: error: invalid JSON: syntax error while parsing "
+                         "object - unexpected end of input; expected '}'"))
         << e;
 }
 
 TEST(JsonLoaderErrors, NumberOverflowIsFound) {
     std::string e = onlyError("{\n  \"camera\": {\"fov\": 1e999}\n}");
-    EXPECT_TRUE(contains(e, "scene.json:2:21: error: invalid number: number overflow parsing "
-                            "'1e999' (expected a finite number)"))
+    EXPECT_TRUE(contains(e,
+                         "scene.json:2:21: error: invalid number: number overflow parsing "
+                         "'1e999' (expected a finite number)"))
         << e;
 }
 
@@ -361,33 +368,35 @@ TEST(JsonLoaderErrors, FloatOverflowIsNotFinite) {
     std::string text = sceneWith(kWhite, kRect, kPoint);
     text.replace(text.find("\"intensity\": 10"), 15, "\"intensity\": 1e39");
     std::string e = onlyError(text);
-    EXPECT_TRUE(contains(e, "at /lights/0/intensity: expected a finite number, got 1e+39"))
-        << e;
+    EXPECT_TRUE(contains(e, "at /lights/0/intensity: expected a finite number, got 1e+39")) << e;
 }
 
 TEST(JsonLoaderErrors, UnknownKeyListsValidKeys) {
     std::string text = sceneWith(kWhite, kRect, kPoint);
     text.replace(text.find("\"fov\""), 5, "\"fvo\"");
     std::string e = onlyError(text);
-    EXPECT_EQ(e, "scene.json:2:73: error: at /camera/fvo: unknown key 'fvo' in camera (did you "
-                 "mean 'fov'?); valid keys: position, target, up, fov, resolution, lens_radius, "
-                 "focus_distance");
+    EXPECT_EQ(e,
+              "scene.json:2:73: error: at /camera/fvo: unknown key 'fvo' in camera (did you "
+              "mean 'fov'?); valid keys: position, target, up, fov, resolution, lens_radius, "
+              "focus_distance");
 }
 
 TEST(JsonLoaderErrors, WrongTypeSaysWhatWasExpected) {
     std::string text = sceneWith(kWhite, kRect, kPoint);
     text.replace(text.find("\"fov\": 40"), 9, "\"fov\": \"40\"");
     std::string e = onlyError(text);
-    EXPECT_EQ(e, "scene.json:2:80: error: at /camera/fov: expected a number in (0, 180), got a "
-                 "string (\"40\")");
+    EXPECT_EQ(e,
+              "scene.json:2:80: error: at /camera/fov: expected a number in (0, 180), got a "
+              "string (\"40\")");
 }
 
 TEST(JsonLoaderErrors, MissingRequiredKey) {
-    std::string e = onlyError(
-        sceneWith(kWhite, kRect, R"json({"type": "point", "position": [0, 0, 3]})json"));
-    EXPECT_TRUE(contains(e, "scene.json:5:12: error: at /lights/0/intensity: missing required key "
-                            "'intensity' (expected an RGB colour: one number or [r, g, b], each "
-                            "a number >= 0)"))
+    std::string e =
+        onlyError(sceneWith(kWhite, kRect, R"json({"type": "point", "position": [0, 0, 3]})json"));
+    EXPECT_TRUE(contains(e,
+                         "scene.json:5:12: error: at /lights/0/intensity: missing required key "
+                         "'intensity' (expected an RGB colour: one number or [r, g, b], each "
+                         "a number >= 0)"))
         << e;
 }
 
@@ -397,28 +406,32 @@ TEST(JsonLoaderErrors, UnknownTypesListValidTypes) {
                                 R"json({"type": "spot"})json"));
     ASSERT_EQ(d.size(), 3u);
     EXPECT_EQ(d[0].where, "/materials/white/type");
-    EXPECT_EQ(d[0].message, "unknown material type 'difuse' (did you mean 'diffuse'?); valid types: "
-                            "diffuse, phong, mirror, dielectric, rough_conductor, rough_dielectric");
+    EXPECT_EQ(d[0].message,
+              "unknown material type 'difuse' (did you mean 'diffuse'?); valid types: "
+              "diffuse, phong, mirror, dielectric, rough_conductor, rough_dielectric");
     EXPECT_EQ(d[1].message,
               "unknown shape type 'cone' (did you mean 'cube'?); valid types: obj, ply, "
               "rectangle, cube, sphere");
-    EXPECT_EQ(d[2].message, "unknown light type 'spot'; valid types: point, directional, "
-                            "constant, envmap (area lights are shapes with an \"emission\")");
+    EXPECT_EQ(d[2].message,
+              "unknown light type 'spot'; valid types: point, directional, "
+              "constant, envmap (area lights are shapes with an \"emission\")");
 }
 
 TEST(JsonLoaderErrors, UnknownMaterialReferenceListsDefinedOnes) {
     const std::string materials =
         R"json("white": {"type": "diffuse"}, "red": {"type": "diffuse"}, "glass": {"type": "dielectric", "ior": 1.5})json";
-    std::string e = onlyError(
-        sceneWith(materials, R"json({"type": "cube", "material": "glas"})json", kPoint));
-    EXPECT_EQ(e, "scene.json:4:41: error: at /shapes/0/material: unknown material 'glas' (did you "
-                 "mean 'glass'?) (defined: white, red, glass)");
+    std::string e =
+        onlyError(sceneWith(materials, R"json({"type": "cube", "material": "glas"})json", kPoint));
+    EXPECT_EQ(e,
+              "scene.json:4:41: error: at /shapes/0/material: unknown material 'glas' (did you "
+              "mean 'glass'?) (defined: white, red, glass)");
 }
 
 TEST(JsonLoaderErrors, UnknownMaterialWhenNoneAreDefined) {
     std::string e = onlyError(sceneWith("", kRect, kPoint));
-    EXPECT_TRUE(contains(e, "at /shapes/0/material: unknown material 'white' (no materials are "
-                            "defined in \"materials\")"))
+    EXPECT_TRUE(contains(e,
+                         "at /shapes/0/material: unknown material 'white' (no materials are "
+                         "defined in \"materials\")"))
         << e;
 }
 
@@ -461,16 +474,19 @@ TEST(JsonLoaderErrors, MaterialParametersOutOfRange) {
         "f": {"type": "rough_conductor", "alpha": 0.1})json",
         kRect, kPoint));
     ASSERT_EQ(d.size(), 7u);
-    EXPECT_EQ(d[0].format(), "scene.json:4:44: error: at /materials/a/ior: expected a number > 0, got 0");
+    EXPECT_EQ(d[0].format(),
+              "scene.json:4:44: error: at /materials/a/ior: expected a number > 0, got 0");
     EXPECT_EQ(d[1].message, "expected a number in (0, 1], got 0");
     EXPECT_EQ(d[2].where, "/materials/c/alpha");
     EXPECT_EQ(d[3].where, "/materials/d/exponent");
-    EXPECT_EQ(d[4].format(), "scene.json:7:14: error: at /materials/d: diffuse_reflectance + "
-                             "glossy_reflectance = 1.1 > 1 in the green channel: the material "
-                             "would create energy (expected a sum <= 1)");
+    EXPECT_EQ(d[4].format(),
+              "scene.json:7:14: error: at /materials/d: diffuse_reflectance + "
+              "glossy_reflectance = 1.1 > 1 in the green channel: the material "
+              "would create energy (expected a sum <= 1)");
     EXPECT_EQ(d[5].message, "unknown metal 'tin'; valid metals: gold, copper, silver, aluminium");
-    EXPECT_EQ(d[6].message, "a rough_conductor needs \"metal\" (one of gold, copper, silver, "
-                            "aluminium) or both \"eta\" and \"k\" (RGB)");
+    EXPECT_EQ(d[6].message,
+              "a rough_conductor needs \"metal\" (one of gold, copper, silver, "
+              "aluminium) or both \"eta\" and \"k\" (RGB)");
 }
 
 TEST(JsonLoaderErrors, SphereRadiusAndNonUniformScale) {
@@ -482,16 +498,18 @@ TEST(JsonLoaderErrors, SphereRadiusAndNonUniformScale) {
     EXPECT_EQ(d[0].format(),
               "scene.json:4:62: error: at /shapes/0/radius: expected a number > 0, got -1");
     EXPECT_EQ(d[1].where, "/shapes/1/transform");
-    EXPECT_EQ(d[1].message, "a sphere's transform must keep it a sphere: rotations, translations "
-                            "and uniform scales only (this one scales non-uniformly or shears)");
+    EXPECT_EQ(d[1].message,
+              "a sphere's transform must keep it a sphere: rotations, translations "
+              "and uniform scales only (this one scales non-uniformly or shears)");
 }
 
 TEST(JsonLoaderErrors, MaxPathLengthBelowOne) {
     std::string text = sceneWith(kWhite, kRect, kPoint);
     text.insert(2, "\"settings\": {\"max_path_length\": 0},\n");
     std::string e = onlyError(text);
-    EXPECT_EQ(e, "scene.json:2:33: error: at /settings/max_path_length: expected an integer in "
-                 "[1, 1000], got 0");
+    EXPECT_EQ(e,
+              "scene.json:2:33: error: at /settings/max_path_length: expected an integer in "
+              "[1, 1000], got 0");
 }
 
 TEST(JsonLoaderErrors, ZeroAreaEmitter) {
@@ -501,8 +519,9 @@ TEST(JsonLoaderErrors, ZeroAreaEmitter) {
         kWhite,
         R"json({"type": "rectangle", "emission": 1, "transform": {"scale": [1e-20, 1e-20, 1]}})json",
         kPoint));
-    EXPECT_EQ(e, "scene.json:4:12: error: at /shapes/0: zero-area emitter: the surface area of this "
-                 "rectangle after its transform is 0 (expected > 0)");
+    EXPECT_EQ(e,
+              "scene.json:4:12: error: at /shapes/0: zero-area emitter: the surface area of this "
+              "rectangle after its transform is 0 (expected > 0)");
 }
 
 TEST(JsonLoaderErrors, DegenerateMeshFile) {
@@ -514,9 +533,10 @@ TEST(JsonLoaderErrors, DegenerateMeshFile) {
     bool meshError = false;
     for (const auto& x : d) meshError = meshError || contains(x.file, "degenerate.obj");
     EXPECT_TRUE(meshError);
-    EXPECT_EQ(d.back().format(), "scene.json:4:36: error: at /shapes/0/file: mesh file "
-                                 "'meshes/degenerate.obj' could not be loaded (see the errors "
-                                 "reported for it)");
+    EXPECT_EQ(d.back().format(),
+              "scene.json:4:36: error: at /shapes/0/file: mesh file "
+              "'meshes/degenerate.obj' could not be loaded (see the errors "
+              "reported for it)");
 }
 
 TEST(JsonLoaderErrors, MissingMeshAndEnvMapFiles) {
@@ -524,22 +544,25 @@ TEST(JsonLoaderErrors, MissingMeshAndEnvMapFiles) {
         kWhite, R"json({"type": "ply", "file": "nowhere/bunny.ply", "material": "white"})json",
         R"json({"type": "envmap", "file": "nowhere/sky.exr"})json"));
     ASSERT_EQ(d.size(), 2u);
-    EXPECT_TRUE(contains(d[0].format(), "scene.json:4:36: error: at /shapes/0/file: mesh file "
-                                        "'nowhere/bunny.ply' not found (looked for '"))
+    EXPECT_TRUE(contains(d[0].format(),
+                         "scene.json:4:36: error: at /shapes/0/file: mesh file "
+                         "'nowhere/bunny.ply' not found (looked for '"))
         << d[0].format();
-    EXPECT_TRUE(contains(d[1].format(), "scene.json:5:39: error: at /lights/0/file: environment "
-                                        "map 'nowhere/sky.exr' not found"))
+    EXPECT_TRUE(contains(d[1].format(),
+                         "scene.json:5:39: error: at /lights/0/file: environment "
+                         "map 'nowhere/sky.exr' not found"))
         << d[1].format();
 }
 
 TEST(JsonLoaderErrors, UnreadableEnvMapMergesTheImageError) {
     TempDir tmp;
     std::ofstream((tmp.path / "fake.exr").string()) << "this is not an OpenEXR file\n";
-    std::string e = onlyError(
-        sceneWith(kWhite, kRect, R"json({"type": "envmap", "file": "fake.exr"})json"),
-        tmp.path.string());
-    EXPECT_TRUE(contains(e, "scene.json:5:39: error: at /lights/0/file: cannot read environment "
-                            "map 'fake.exr': "))
+    std::string e =
+        onlyError(sceneWith(kWhite, kRect, R"json({"type": "envmap", "file": "fake.exr"})json"),
+                  tmp.path.string());
+    EXPECT_TRUE(contains(e,
+                         "scene.json:5:39: error: at /lights/0/file: cannot read environment "
+                         "map 'fake.exr': "))
         << e;
 }
 
@@ -547,8 +570,9 @@ TEST(JsonLoaderErrors, MeshTypeMustMatchExtension) {
     std::string e = onlyError(sceneWith(
         kWhite, R"json({"type": "ply", "file": "meshes/triangle.obj", "material": "white"})json",
         kPoint));
-    EXPECT_TRUE(contains(e, "at /shapes/0/file: a shape of type 'ply' needs a .ply file, got "
-                            "'meshes/triangle.obj'"))
+    EXPECT_TRUE(contains(e,
+                         "at /shapes/0/file: a shape of type 'ply' needs a .ply file, got "
+                         "'meshes/triangle.obj'"))
         << e;
 }
 
@@ -556,20 +580,24 @@ TEST(JsonLoaderErrors, AtMostOneEnvironmentLight) {
     std::string e = onlyError(sceneWith(kWhite, kRect,
                                         R"json({"type": "constant", "radiance": 1},
         {"type": "constant", "radiance": 2})json"));
-    EXPECT_EQ(e, "scene.json:6:18: error: at /lights/1/type: more than one environment light: "
-                 "/lights/0 is one already (a scene has at most one)");
+    EXPECT_EQ(e,
+              "scene.json:6:18: error: at /lights/1/type: more than one environment light: "
+              "/lights/0 is one already (a scene has at most one)");
 }
 
 TEST(JsonLoaderErrors, SceneWithoutLight) {
     std::string e = onlyError(sceneWith(kWhite, kRect, ""));
-    EXPECT_EQ(e, "scene.json:1:1: error: at /: the scene has no light (expected an entry in "
-                 "\"lights\" or a shape with an \"emission\")");
+    EXPECT_EQ(e,
+              "scene.json:1:1: error: at /: the scene has no light (expected an entry in "
+              "\"lights\" or a shape with an \"emission\")");
 }
 
 TEST(JsonLoaderErrors, SceneWithoutCamera) {
-    std::string e = onlyError(R"json({"materials": {}, "lights": [{"type": "constant", "radiance": 1}]})json");
-    EXPECT_EQ(e, "scene.json:1:1: error: at /camera: missing required key 'camera' (expected a "
-                 "camera object with \"position\" and \"target\")");
+    std::string e =
+        onlyError(R"json({"materials": {}, "lights": [{"type": "constant", "radiance": 1}]})json");
+    EXPECT_EQ(e,
+              "scene.json:1:1: error: at /camera: missing required key 'camera' (expected a "
+              "camera object with \"position\" and \"target\")");
 }
 
 TEST(JsonLoaderErrors, CameraLooksNowhere) {
@@ -584,8 +612,9 @@ TEST(JsonLoaderErrors, DuplicateKey) {
     std::string text = sceneWith(kWhite, kRect, kPoint);
     text.replace(text.find("\"fov\": 40"), 9, "\"fov\": 40, \"fov\": 50");
     std::string e = onlyError(text);
-    EXPECT_EQ(e, "scene.json:2:84: error: at /camera/fov: duplicate key (first given at line 2, "
-                 "column 73; keys must be unique)");
+    EXPECT_EQ(e,
+              "scene.json:2:84: error: at /camera/fov: duplicate key (first given at line 2, "
+              "column 73; keys must be unique)");
 }
 
 TEST(JsonLoaderErrors, ReportsEveryErrorOfAFileWithPositions) {
@@ -599,12 +628,15 @@ TEST(JsonLoaderErrors, ReportsEveryErrorOfAFileWithPositions) {
             got.push_back(std::to_string(d.line) + ":" + std::to_string(d.column) + " " + d.where);
         }
         // Positions found with a text search in the file (see the comment in the data).
-        const std::vector<std::string> expected = {
-            "2:65 /camera/fov",           "3:33 /camera/resolution/1",
-            "4:35 /settings/max_path_length", "6:49 /materials/white/reflectance",
-            "7:44 /materials/glass/ior",  "10:36 /shapes/0/material",
-            "10:54 /shapes/0/radius",     "11:14 /shapes/1/type",
-            "13:72 /lights/0/colour"};
+        const std::vector<std::string> expected = {"2:65 /camera/fov",
+                                                   "3:33 /camera/resolution/1",
+                                                   "4:35 /settings/max_path_length",
+                                                   "6:49 /materials/white/reflectance",
+                                                   "7:44 /materials/glass/ior",
+                                                   "10:36 /shapes/0/material",
+                                                   "10:54 /shapes/0/radius",
+                                                   "11:14 /shapes/1/type",
+                                                   "13:72 /lights/0/colour"};
         EXPECT_EQ(got, expected);
     }
 }
@@ -627,4 +659,70 @@ TEST(SceneLoader, MissingSceneFile) {
     } catch (const InputError& e) {
         EXPECT_TRUE(contains(e.what(), "cannot open the scene file")) << e.what();
     }
+}
+
+TEST(JsonLoader, ThinLensFocusesOnTheTargetByDefault) {
+    std::string text = sceneWith(kWhite, kRect, kPoint);
+    text.replace(text.find("\"fov\": 40"), 9, "\"fov\": 40, \"lens_radius\": 0.1");
+    text.insert(2,
+                "\"settings\": {\"max_path_length\": 3, \"min_path_length\": 2, \"seed\": 99},\n");
+    auto scene = loadJsonSceneFromString(text, "scene.json", kDataDir);
+    EXPECT_FALSE(scene->camera.isPinhole());
+    EXPECT_FLOAT_EQ(scene->camera.lensRadius(), 0.1f);
+    EXPECT_FLOAT_EQ(scene->camera.focusDistance(), 5.0f);  // |target - position|
+    EXPECT_EQ(scene->settings.maxPathLength, 3);
+    EXPECT_EQ(scene->settings.minPathLength, 2);
+    EXPECT_EQ(scene->settings.seed, 99u);
+}
+
+TEST(JsonLoader, RotationListAppliesInOrder) {
+    // x by 90 first turns the normal +z into -y, then z by 90 turns -y into +x: the
+    // rectangle ends up in the plane x = 0 (the other order would give y = 0).
+    const std::string shapes =
+        R"json({"type": "rectangle", "material": "white", "transform": {"rotate": [{"axis": [1, 0, 0], "angle": 90}, {"axis": [0, 0, 1], "angle": 90}]}},
+        {"type": "rectangle", "material": "white", "transform": {"matrix": [1, 0, 0, 5, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]}})json";
+    auto scene = loadJsonSceneFromString(sceneWith(kWhite, shapes, kPoint), "scene.json", kDataDir);
+    const Bounds3& b = scene->shapes[0].bounds;
+    EXPECT_NEAR(b.hi.x - b.lo.x, 0.0f, 1e-5f);
+    EXPECT_NEAR(b.hi.y - b.lo.y, 2.0f, 1e-5f);
+    EXPECT_NEAR(b.hi.z - b.lo.z, 2.0f, 1e-5f);
+    EXPECT_NEAR(scene->shapes[1].bounds.center().x, 5.0f, 1e-5f);  // flat 16-number matrix
+}
+
+TEST(JsonLoader, BlackEmissionIsAWarningAndNoLight) {
+    std::vector<Diagnostic> warnings;
+    auto scene = loadJsonSceneFromString(
+        sceneWith(kWhite, R"json({"type": "cube", "material": "white", "emission": 0})json",
+                  kPoint),
+        "scene.json", kDataDir, &warnings);
+    EXPECT_EQ(scene->lights.size(), 1u);
+    EXPECT_EQ(scene->shapes[0].lightId, -1);
+    ASSERT_EQ(warnings.size(), 1u);
+    EXPECT_EQ(warnings[0].format(),
+              "scene.json:4:62: warning: at /shapes/0/emission: emission is "
+              "black: the shape does not emit light");
+}
+
+TEST(JsonLoaderErrors, TransformMistakes) {
+    auto d = errorsOf(sceneWith(
+        kWhite,
+        R"json({"type": "cube", "material": "white", "transform": {"matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1], "scale": 2}},
+        {"type": "cube", "material": "white", "transform": {"matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 1, 1]}},
+        {"type": "cube", "material": "white", "transform": {"scale": [1, 0, 1]}},
+        {"type": "cube", "material": "white", "transform": {"rotate": {"axis": [0, 0, 0], "angle": 10}}},
+        {"type": "cube", "material": "white", "emission_two_sided": true})json",
+        kPoint));
+    ASSERT_EQ(d.size(), 5u);
+    EXPECT_EQ(d[0].message,
+              "\"matrix\" cannot be combined with \"scale\", \"rotate\" or "
+              "\"translate\"; use one form");
+    EXPECT_EQ(d[1].message,
+              "the last row of the matrix must be [0, 0, 0, 1] (only affine "
+              "transforms are supported)");
+    EXPECT_EQ(d[2].message,
+              "a scale factor is zero: the shape would be flattened (expected "
+              "non-zero factors)");
+    EXPECT_EQ(d[3].where, "/shapes/3/transform/rotate/axis");
+    EXPECT_EQ(d[3].message, "expected a non-zero direction [x, y, z], got [0,0,0]");
+    EXPECT_EQ(d[4].message, "\"emission_two_sided\" needs an \"emission\" on the same shape");
 }

@@ -44,7 +44,8 @@ Rgb skyRadiance(const Vec3& d, const Vec3& sunDir) {
 
     float angle = std::acos(std::min(1.0f, std::max(-1.0f, dot(d, sunDir))));
     const float glowSigma = 6.0f * kDeg;
-    c += Rgb(1.0f, 0.85f, 0.6f) * (2.0f * std::exp(-0.5f * angle * angle / (glowSigma * glowSigma)));
+    c +=
+        Rgb(1.0f, 0.85f, 0.6f) * (2.0f * std::exp(-0.5f * angle * angle / (glowSigma * glowSigma)));
     if (angle < 2.5f * kDeg) c += Rgb(1000.0f, 950.0f, 850.0f);
     return c;
 }

@@ -8,23 +8,34 @@ namespace ub {
 
 const char* materialTypeName(MaterialType t) {
     switch (t) {
-        case MaterialType::Diffuse: return "diffuse";
-        case MaterialType::Phong: return "phong";
-        case MaterialType::Mirror: return "mirror";
-        case MaterialType::Dielectric: return "dielectric";
-        case MaterialType::RoughConductor: return "rough_conductor";
-        case MaterialType::RoughDielectric: return "rough_dielectric";
+        case MaterialType::Diffuse:
+            return "diffuse";
+        case MaterialType::Phong:
+            return "phong";
+        case MaterialType::Mirror:
+            return "mirror";
+        case MaterialType::Dielectric:
+            return "dielectric";
+        case MaterialType::RoughConductor:
+            return "rough_conductor";
+        case MaterialType::RoughDielectric:
+            return "rough_dielectric";
     }
     return "unknown";
 }
 
 const char* lightTypeName(LightType t) {
     switch (t) {
-        case LightType::Area: return "area";
-        case LightType::Point: return "point";
-        case LightType::Directional: return "directional";
-        case LightType::ConstantEnv: return "constant";
-        case LightType::EnvMap: return "envmap";
+        case LightType::Area:
+            return "area";
+        case LightType::Point:
+            return "point";
+        case LightType::Directional:
+            return "directional";
+        case LightType::ConstantEnv:
+            return "constant";
+        case LightType::EnvMap:
+            return "envmap";
     }
     return "unknown";
 }
@@ -37,7 +48,9 @@ std::string num(float v) {
     return buf;
 }
 
-std::string vec(const Vec3& v) { return "(" + num(v.x) + ", " + num(v.y) + ", " + num(v.z) + ")"; }
+std::string vec(const Vec3& v) {
+    return "(" + num(v.x) + ", " + num(v.y) + ", " + num(v.z) + ")";
+}
 
 /// "3 (diffuse 2, mirror 1)"; types in first-seen order.
 template <class T, class NameFn>
@@ -66,15 +79,17 @@ std::string describeScene(const Scene& scene) {
 
     size_t spheres = 0, meshes = 0, triangles = 0;
     for (const ShapeInfo& s : scene.shapes) {
-        if (s.isSphere) ++spheres;
-        else ++meshes, triangles += s.triangleCount;
+        if (s.isSphere)
+            ++spheres;
+        else
+            ++meshes, triangles += s.triangleCount;
     }
     os << "shapes: " << scene.shapes.size() << " (" << meshes << " meshes with " << triangles
        << " triangles, " << spheres << " spheres)\n";
 
-    os << "materials: "
-       << countByType(scene.materials, [](const Material& m) { return materialTypeName(m.type); })
-       << "\n";
+    os << "materials: " << countByType(scene.materials, [](const Material& m) {
+        return materialTypeName(m.type);
+    }) << "\n";
     for (size_t i = 0; i < scene.materials.size(); ++i)
         os << "  material " << i << ": " << scene.materials[i].name << " ("
            << materialTypeName(scene.materials[i].type) << ")\n";
@@ -88,8 +103,8 @@ std::string describeScene(const Scene& scene) {
         switch (l.type) {
             case LightType::Area:
                 os << ", radiance " << vec(l.radiance) << ", "
-                   << (l.isSphere ? "sphere" : std::to_string(l.triangles.size() / 3) +
-                                                   " triangles")
+                   << (l.isSphere ? "sphere"
+                                  : std::to_string(l.triangles.size() / 3) + " triangles")
                    << ", area " << num(l.totalArea) << (l.twoSided ? ", two-sided" : "");
                 break;
             case LightType::Point:
@@ -98,7 +113,9 @@ std::string describeScene(const Scene& scene) {
             case LightType::Directional:
                 os << ", irradiance " << vec(l.radiance) << " towards " << vec(l.direction);
                 break;
-            case LightType::ConstantEnv: os << ", radiance " << vec(l.radiance); break;
+            case LightType::ConstantEnv:
+                os << ", radiance " << vec(l.radiance);
+                break;
             case LightType::EnvMap:
                 os << ", scale " << vec(l.radiance);
                 if (l.envMap) os << ", " << l.envMap->width << "x" << l.envMap->height;
@@ -114,8 +131,8 @@ std::string describeScene(const Scene& scene) {
 
     const Camera& c = scene.camera;
     os << "camera: " << c.width() << "x" << c.height() << ", position " << vec(c.position())
-       << ", forward " << vec(c.forward()) << ", up " << vec(c.up()) << ", fov "
-       << num(c.fovYDeg()) << " deg (vertical)";
+       << ", forward " << vec(c.forward()) << ", up " << vec(c.up()) << ", fov " << num(c.fovYDeg())
+       << " deg (vertical)";
     if (c.isPinhole())
         os << ", pinhole\n";
     else

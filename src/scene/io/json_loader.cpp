@@ -53,8 +53,7 @@ bool parseText(const std::string& text, const std::string& file, Diagnostics& di
         size_t offset = std::min(e.byte > 0 ? size_t(e.byte - 1) : 0, text.size());
         while (offset > 0 && (offset >= text.size() || std::isspace(uint8_t(text[offset]))))
             --offset;
-        add(sourcePosOfOffset(text, offset),
-            "invalid JSON: " + stripNlohmannPrefix(e.what()));
+        add(sourcePosOfOffset(text, offset), "invalid JSON: " + stripNlohmannPrefix(e.what()));
     } catch (const Json::exception& e) {
         // Number overflow (e.g. 1e999) carries no position: find the literal in the text.
         std::string msg = stripNlohmannPrefix(e.what());
@@ -80,8 +79,8 @@ void readCamera(JsonReader& r, const Json& c, JsonSceneParts& parts) {
     cam.position = r.getVec3(c, ptr, "position", Presence::Required, cam.position);
     cam.target = r.getVec3(c, ptr, "target", Presence::Required, cam.target);
     cam.up = r.getDirection(c, ptr, "up", Presence::Optional, Vec3(0, 1, 0));
-    cam.fovYDeg = r.getNumber(c, ptr, "fov", Presence::Optional, NumberRange::open(0.0, 180.0),
-                              45.0f);
+    cam.fovYDeg =
+        r.getNumber(c, ptr, "fov", Presence::Optional, NumberRange::open(0.0, 180.0), 45.0f);
     if (const Json* res = r.member(c, ptr, "resolution", Presence::Optional, "")) {
         std::string resPtr = jsonPointerChild(ptr, "resolution");
         // 16384 per side: larger images are almost surely a typo (and 4 GiB of film).
@@ -120,10 +119,10 @@ void readSettings(JsonReader& r, const Json& s, JsonSceneParts& parts) {
     RenderSettings& st = parts.settings;
     st.maxPathLength =
         int(r.getInteger(s, ptr, "max_path_length", Presence::Optional, 1, 1000, 10));
-    st.minPathLength = int(r.getInteger(s, ptr, "min_path_length", Presence::Optional, 0,
-                                        st.maxPathLength, 0));
-    st.seed = uint64_t(
-        r.getInteger(s, ptr, "seed", Presence::Optional, 0, std::numeric_limits<int64_t>::max(), 1));
+    st.minPathLength =
+        int(r.getInteger(s, ptr, "min_path_length", Presence::Optional, 0, st.maxPathLength, 0));
+    st.seed = uint64_t(r.getInteger(s, ptr, "seed", Presence::Optional, 0,
+                                    std::numeric_limits<int64_t>::max(), 1));
 }
 
 /// Checks an environment map's pixels: finite, non-negative, not all black.
@@ -204,8 +203,8 @@ void readLight(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
                     light.envMap = std::move(img);
                 } catch (const InputError& e) {
                     for (const Diagnostic& d : e.diagnostics())
-                        r.error(filePtr, "cannot read environment map '" + file + "': " +
-                                             d.message);
+                        r.error(filePtr,
+                                "cannot read environment map '" + file + "': " + d.message);
                 }
             }
         }
@@ -218,8 +217,8 @@ void readLight(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
     if (v.contains("name")) light.name = r.getString(v, ptr, "name", Presence::Optional);
     if (r.errorCount() != before) return;
 
-    bool black = light.type == LightType::Point ? isBlack(light.intensity)
-                                                : isBlack(light.radiance);
+    bool black =
+        light.type == LightType::Point ? isBlack(light.intensity) : isBlack(light.radiance);
     if (black) r.warning(ptr, "this light is black: it emits nothing");
     if (light.isEnvironment()) {
         if (parts.backgroundLight >= 0) {
@@ -241,7 +240,8 @@ void readJsonLights(JsonReader& r, const Json& lights, JsonSceneParts& parts) {
 }
 
 void readRoot(JsonReader& r, const Json& root, JsonSceneParts& parts) {
-    if (!r.isObject(root, "", "a scene object with \"camera\", \"materials\", \"shapes\" ...")) return;
+    if (!r.isObject(root, "", "a scene object with \"camera\", \"materials\", \"shapes\" ..."))
+        return;
     r.checkKeys(root, "", {"description", "camera", "settings", "materials", "shapes", "lights"},
                 "the scene");
     if (const Json* d = r.member(root, "", "description", Presence::Optional, ""))
@@ -268,8 +268,9 @@ void readRoot(JsonReader& r, const Json& root, JsonSceneParts& parts) {
     }
     // Only when nothing was even attempted: a light with an error was reported already.
     if (lightEntries == 0)
-        r.error("", "the scene has no light (expected an entry in \"lights\" or a shape with "
-                    "an \"emission\")");
+        r.error("",
+                "the scene has no light (expected an entry in \"lights\" or a shape with "
+                "an \"emission\")");
 }
 
 std::unique_ptr<Scene> buildScene(JsonSceneParts& parts, const std::string& fileName) {
@@ -307,8 +308,7 @@ std::unique_ptr<Scene> buildScene(JsonSceneParts& parts, const std::string& file
 
 }  // namespace
 
-std::unique_ptr<Scene> loadJsonSceneFromString(const std::string& text,
-                                               const std::string& fileName,
+std::unique_ptr<Scene> loadJsonSceneFromString(const std::string& text, const std::string& fileName,
                                                const std::string& baseDir,
                                                std::vector<Diagnostic>* warnings) {
     Diagnostics diags;

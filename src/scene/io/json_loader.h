@@ -23,8 +23,7 @@ std::unique_ptr<Scene> loadJsonScene(const std::string& path,
 
 /// Same, from text in memory: `fileName` is used in messages and as Scene::sourceFile,
 /// relative file paths start at `baseDir`.
-std::unique_ptr<Scene> loadJsonSceneFromString(const std::string& text,
-                                               const std::string& fileName,
+std::unique_ptr<Scene> loadJsonSceneFromString(const std::string& text, const std::string& fileName,
                                                const std::string& baseDir,
                                                std::vector<Diagnostic>* warnings = nullptr);
 

@@ -22,8 +22,8 @@ const MetalPreset kMetals[] = {
     {"aluminium", {1.5196f, 0.9657f, 0.5312f}, {7.6635f, 6.4581f, 5.0699f}},
 };
 
-const std::vector<std::string> kMaterialTypes = {"diffuse",    "phong",           "mirror",
-                                                 "dielectric", "rough_conductor", "rough_dielectric"};
+const std::vector<std::string> kMaterialTypes = {
+    "diffuse", "phong", "mirror", "dielectric", "rough_conductor", "rough_dielectric"};
 
 std::vector<std::string> metalNames() {
     std::vector<std::string> names;
@@ -56,20 +56,20 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         keys.insert(keys.end(),
                     {"diffuse_reflectance", "glossy_reflectance", "exponent", "two_sided"});
         r.checkKeys(m, ptr, keys, "phong material");
-        mat.diffuse = r.getRgb(m, ptr, "diffuse_reflectance", Presence::Optional, kReflectance,
-                               Rgb(0.0f));
-        mat.glossy = r.getRgb(m, ptr, "glossy_reflectance", Presence::Optional, kReflectance,
-                              Rgb(0.0f));
-        mat.exponent = r.getNumber(m, ptr, "exponent", Presence::Required, NumberRange::positive(),
-                                   1.0f);
+        mat.diffuse =
+            r.getRgb(m, ptr, "diffuse_reflectance", Presence::Optional, kReflectance, Rgb(0.0f));
+        mat.glossy =
+            r.getRgb(m, ptr, "glossy_reflectance", Presence::Optional, kReflectance, Rgb(0.0f));
+        mat.exponent =
+            r.getNumber(m, ptr, "exponent", Presence::Required, NumberRange::positive(), 1.0f);
         // The modified Phong lobe is normalized ((n+2)/(2 pi) cos^n, Lafortune & Willems
         // 1994), so its albedo is at most glossy_reflectance; the sum with the Lambertian
         // part must stay <= 1 per channel to conserve energy.
         for (int c = 0; c < 3; ++c) {
             float sum = mat.diffuse[c] + mat.glossy[c];
             if (sum > 1.0f) {
-                r.error(ptr, "diffuse_reflectance + glossy_reflectance = " +
-                                 formatNumber(sum) + " > 1 in the " + kChannel[c] +
+                r.error(ptr, "diffuse_reflectance + glossy_reflectance = " + formatNumber(sum) +
+                                 " > 1 in the " + kChannel[c] +
                                  " channel: the material would create energy (expected a sum "
                                  "<= 1)");
                 break;
@@ -121,12 +121,11 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
             r.error(ptr, "a rough_conductor needs \"metal\" (one of " + joinNames(metalNames()) +
                              ") or both \"eta\" and \"k\" (RGB)");
         }
-        mat.alpha = r.getNumber(m, ptr, "alpha", Presence::Required,
-                                NumberRange::leftOpen(0.0, 1.0), 0.1f);
+        mat.alpha =
+            r.getNumber(m, ptr, "alpha", Presence::Required, NumberRange::leftOpen(0.0, 1.0), 0.1f);
         mat.specular = r.getRgb(m, ptr, "tint", Presence::Optional, kReflectance, Rgb(1.0f));
     } else {
-        r.error(typePtr, "unknown material type '" + type + "'" +
-                             didYouMean(type, kMaterialTypes) +
+        r.error(typePtr, "unknown material type '" + type + "'" + didYouMean(type, kMaterialTypes) +
                              "; valid types: " + joinNames(kMaterialTypes));
         return;
     }

@@ -23,9 +23,12 @@ SourcePos sourcePosOfOffset(const std::string& text, size_t offset) {
 std::string jsonPointerChild(const std::string& pointer, const std::string& key) {
     std::string r = pointer + '/';
     for (char c : key) {
-        if (c == '~') r += "~0";
-        else if (c == '/') r += "~1";
-        else r += c;
+        if (c == '~')
+            r += "~0";
+        else if (c == '/')
+            r += "~1";
+        else
+            r += c;
     }
     return r;
 }
@@ -36,7 +39,7 @@ std::string jsonPointerChild(const std::string& pointer, size_t index) {
 
 // Recursive-descent walk over a JSON text that nlohmann already accepted.
 class JsonScanner {
-public:
+  public:
     JsonScanner(const std::string& text, JsonPositionIndex& index) : s_(text), idx_(index) {
         // Line starts, so that offset -> line:column is a binary search plus a short count.
         lineStarts_.push_back(0);
@@ -49,7 +52,7 @@ public:
         if (i_ < s_.size()) value("");
     }
 
-private:
+  private:
     const std::string& s_;
     JsonPositionIndex& idx_;
     std::vector<size_t> lineStarts_;
@@ -104,9 +107,12 @@ private:
         for (int k = 0; k < 4 && i_ < s_.size(); ++k, ++i_) {
             char c = s_[i_];
             v <<= 4;
-            if (c >= '0' && c <= '9') v |= uint32_t(c - '0');
-            else if (c >= 'a' && c <= 'f') v |= uint32_t(c - 'a' + 10);
-            else if (c >= 'A' && c <= 'F') v |= uint32_t(c - 'A' + 10);
+            if (c >= '0' && c <= '9')
+                v |= uint32_t(c - '0');
+            else if (c >= 'a' && c <= 'f')
+                v |= uint32_t(c - 'a' + 10);
+            else if (c >= 'A' && c <= 'F')
+                v |= uint32_t(c - 'A' + 10);
         }
         return v;
     }
@@ -125,11 +131,21 @@ private:
             if (i_ >= s_.size()) break;
             char e = s_[i_++];
             switch (e) {
-                case 'b': out += '\b'; break;
-                case 'f': out += '\f'; break;
-                case 'n': out += '\n'; break;
-                case 'r': out += '\r'; break;
-                case 't': out += '\t'; break;
+                case 'b':
+                    out += '\b';
+                    break;
+                case 'f':
+                    out += '\f';
+                    break;
+                case 'n':
+                    out += '\n';
+                    break;
+                case 'r':
+                    out += '\r';
+                    break;
+                case 't':
+                    out += '\t';
+                    break;
                 case 'u': {
                     uint32_t cp = hex4();
                     if (cp >= 0xD800 && cp < 0xDC00 && i_ + 1 < s_.size() && s_[i_] == '\\' &&
@@ -141,7 +157,9 @@ private:
                     appendUtf8(out, cp);
                     break;
                 }
-                default: out += e; break;  // \" \\ \/
+                default:
+                    out += e;
+                    break;  // \" \\ \/
             }
         }
         ++i_;  // closing quote

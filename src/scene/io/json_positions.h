@@ -33,7 +33,7 @@ std::string jsonPointerChild(const std::string& pointer, const std::string& key)
 std::string jsonPointerChild(const std::string& pointer, size_t index);
 
 class JsonPositionIndex {
-public:
+  public:
     JsonPositionIndex() = default;
     explicit JsonPositionIndex(const std::string& text);
 
@@ -50,7 +50,7 @@ public:
     };
     const std::vector<Duplicate>& duplicates() const { return duplicates_; }
 
-private:
+  private:
     std::unordered_map<std::string, SourcePos> values_, keys_;
     std::vector<Duplicate> duplicates_;
     friend class JsonScanner;

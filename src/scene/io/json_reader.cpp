@@ -14,9 +14,13 @@ std::string formatNumber(double v) {
 
 namespace {
 
-std::string fmt(double v) { return formatNumber(v); }
+std::string fmt(double v) {
+    return formatNumber(v);
+}
 
-bool isFiniteFloat(double d) { return std::isfinite(d) && std::isfinite(float(d)); }
+bool isFiniteFloat(double d) {
+    return std::isfinite(d) && std::isfinite(float(d));
+}
 
 }  // namespace
 
@@ -72,12 +76,18 @@ std::string JsonReader::describeValue(const Json& v) {
     std::string text = v.dump();
     if (text.size() > 40) text = text.substr(0, 37) + "...";
     switch (v.type()) {
-        case Json::value_t::null: return "null";
-        case Json::value_t::boolean: return "a boolean (" + text + ")";
-        case Json::value_t::string: return "a string (" + text + ")";
-        case Json::value_t::array: return v.empty() ? "an empty array" : "an array (" + text + ")";
-        case Json::value_t::object: return "an object";
-        default: return v.is_number() ? "the number " + text : "a " + std::string(v.type_name());
+        case Json::value_t::null:
+            return "null";
+        case Json::value_t::boolean:
+            return "a boolean (" + text + ")";
+        case Json::value_t::string:
+            return "a string (" + text + ")";
+        case Json::value_t::array:
+            return v.empty() ? "an empty array" : "an array (" + text + ")";
+        case Json::value_t::object:
+            return "an object";
+        default:
+            return v.is_number() ? "the number " + text : "a " + std::string(v.type_name());
     }
 }
 
@@ -115,9 +125,9 @@ void JsonReader::checkKeys(const Json& obj, const std::string& ptr,
     if (!obj.is_object()) return;
     for (const auto& item : obj.items()) {
         if (std::find(allowed.begin(), allowed.end(), item.key()) != allowed.end()) continue;
-        errorAtKey(jsonPointerChild(ptr, item.key()),
-                   "unknown key '" + item.key() + "' in " + what +
-                       didYouMean(item.key(), allowed) + "; valid keys: " + joinNames(allowed));
+        errorAtKey(jsonPointerChild(ptr, item.key()), "unknown key '" + item.key() + "' in " +
+                                                          what + didYouMean(item.key(), allowed) +
+                                                          "; valid keys: " + joinNames(allowed));
     }
 }
 
@@ -166,8 +176,7 @@ float JsonReader::number(const Json& v, const std::string& ptr, const NumberRang
 
 int64_t JsonReader::integer(const Json& v, const std::string& ptr, int64_t lo, int64_t hi,
                             int64_t fallback) {
-    std::string expected =
-        "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    std::string expected = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
     if (!v.is_number()) {
         error(ptr, "expected " + expected + ", got " + describeValue(v));
         return fallback;
@@ -270,9 +279,9 @@ float JsonReader::getNumber(const Json& obj, const std::string& objPtr, const st
 
 int64_t JsonReader::getInteger(const Json& obj, const std::string& objPtr, const std::string& key,
                                Presence presence, int64_t lo, int64_t hi, int64_t fallback) {
-    const Json* v = member(obj, objPtr, key, presence,
-                           "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                               "]");
+    const Json* v =
+        member(obj, objPtr, key, presence,
+               "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return v ? integer(*v, jsonPointerChild(objPtr, key), lo, hi, fallback) : fallback;
 }
 

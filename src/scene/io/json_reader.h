@@ -8,10 +8,9 @@
 #pragma once
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "core/error.h"
 #include "core/vec.h"
@@ -50,7 +49,7 @@ std::string formatNumber(double v);
 std::string joinNames(const std::vector<std::string>& names);
 
 class JsonReader {
-public:
+  public:
     JsonReader(std::string file, const JsonPositionIndex& index, Diagnostics& diags)
         : file_(std::move(file)), index_(index), diags_(diags) {}
 
@@ -110,7 +109,7 @@ public:
     /// "a number (3.5)", "a string (\"abc\")", "an array", ... for "got ..." in messages.
     static std::string describeValue(const Json& v);
 
-private:
+  private:
     Diagnostic make(const std::string& ptr, SourcePos pos, const std::string& message) const;
 
     std::string file_;

@@ -26,15 +26,15 @@ struct JsonCameraDesc {
 struct JsonShapeDesc {
     std::string name;
     bool isSphere = false;
-    TriangleMesh mesh;        ///< world space (not spheres)
-    Vec3 center;              ///< spheres, world space
-    float radius = 0.0f;      ///< spheres, world space
-    int materialId = -1;      ///< index into JsonSceneParts::materials
-    int lightIndex = -1;      ///< index into JsonSceneParts::lights, or -1
+    TriangleMesh mesh;    ///< world space (not spheres)
+    Vec3 center;          ///< spheres, world space
+    float radius = 0.0f;  ///< spheres, world space
+    int materialId = -1;  ///< index into JsonSceneParts::materials
+    int lightIndex = -1;  ///< index into JsonSceneParts::lights, or -1
 };
 
 struct JsonSceneParts {
-    std::string baseDir;      ///< folder of the scene file; relative paths start here
+    std::string baseDir;  ///< folder of the scene file; relative paths start here
     bool hasCamera = false;
     JsonCameraDesc camera;
     RenderSettings settings;
@@ -43,8 +43,8 @@ struct JsonSceneParts {
     std::vector<std::string> materialNames;  ///< in file order, for messages
     std::vector<JsonShapeDesc> shapes;
     std::vector<Light> lights;
-    int backgroundLight = -1;  ///< index into lights
-    std::string environmentPtr; ///< JSON pointer of the environment light, for messages
+    int backgroundLight = -1;    ///< index into lights
+    std::string environmentPtr;  ///< JSON pointer of the environment light, for messages
 };
 
 /// Resolves a path from the scene file: absolute paths stay, others start at baseDir.

@@ -33,8 +33,7 @@ bool isAffine(const Transform& t) {
 }
 
 Transform readMatrix(JsonReader& r, const Json& v, const std::string& ptr) {
-    const std::string expected =
-        "a 4x4 row-major matrix: 16 numbers, or 4 rows of 4 numbers";
+    const std::string expected = "a 4x4 row-major matrix: 16 numbers, or 4 rows of 4 numbers";
     Transform t;
     std::vector<std::pair<const Json*, std::string>> entries;
     if (v.is_array() && v.size() == 16) {
@@ -43,8 +42,8 @@ Transform readMatrix(JsonReader& r, const Json& v, const std::string& ptr) {
         for (size_t row = 0; row < 4; ++row) {
             std::string rowPtr = jsonPointerChild(ptr, row);
             if (!v[row].is_array() || v[row].size() != 4) {
-                r.error(rowPtr, "expected a row of 4 numbers, got " +
-                                    JsonReader::describeValue(v[row]));
+                r.error(rowPtr,
+                        "expected a row of 4 numbers, got " + JsonReader::describeValue(v[row]));
                 return {};
             }
             for (size_t c = 0; c < 4; ++c)
@@ -60,8 +59,9 @@ Transform readMatrix(JsonReader& r, const Json& v, const std::string& ptr) {
                                      i / 4 == i % 4 ? 1.0f : 0.0f);
     if (r.errorCount() != before) return {};
     if (!isAffine(t)) {
-        r.error(ptr, "the last row of the matrix must be [0, 0, 0, 1] (only affine transforms "
-                     "are supported)");
+        r.error(ptr,
+                "the last row of the matrix must be [0, 0, 0, 1] (only affine transforms "
+                "are supported)");
         return {};
     }
     return t;
@@ -87,8 +87,9 @@ Transform readJsonTransform(JsonReader& r, const Json& v, const std::string& ptr
     if (const Json* m = r.member(v, ptr, "matrix", Presence::Optional, "")) {
         std::string mPtr = jsonPointerChild(ptr, "matrix");
         if (v.size() > 1) {
-            r.error(mPtr, "\"matrix\" cannot be combined with \"scale\", \"rotate\" or "
-                          "\"translate\"; use one form");
+            r.error(mPtr,
+                    "\"matrix\" cannot be combined with \"scale\", \"rotate\" or "
+                    "\"translate\"; use one form");
             return {};
         }
         result = readMatrix(r, *m, mPtr);
@@ -97,12 +98,12 @@ Transform readJsonTransform(JsonReader& r, const Json& v, const std::string& ptr
         Transform s, rot, t;
         if (const Json* sv = r.member(v, ptr, "scale", Presence::Optional, "")) {
             std::string sPtr = jsonPointerChild(ptr, "scale");
-            Vec3 scale = sv->is_number()
-                             ? Vec3(r.number(*sv, sPtr, NumberRange::any(), 1.0f))
-                             : r.vec3(*sv, sPtr, Vec3(1.0f));
+            Vec3 scale = sv->is_number() ? Vec3(r.number(*sv, sPtr, NumberRange::any(), 1.0f))
+                                         : r.vec3(*sv, sPtr, Vec3(1.0f));
             if (scale.x == 0 || scale.y == 0 || scale.z == 0)
-                r.error(sPtr, "a scale factor is zero: the shape would be flattened (expected "
-                              "non-zero factors)");
+                r.error(sPtr,
+                        "a scale factor is zero: the shape would be flattened (expected "
+                        "non-zero factors)");
             else
                 s = Transform::scale(scale);
         }
@@ -154,14 +155,14 @@ int blackEmitterMaterial(JsonSceneParts& parts) {
 void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t index,
                JsonSceneParts& parts) {
     if (!r.isObject(v, ptr, "a shape object with a \"type\" key")) return;
-    const Json* typeJson =
-        r.member(v, ptr, "type", Presence::Required, "a shape type: one of " + joinNames(kShapeTypes));
+    const Json* typeJson = r.member(v, ptr, "type", Presence::Required,
+                                    "a shape type: one of " + joinNames(kShapeTypes));
     if (!typeJson) return;
     std::string typePtr = jsonPointerChild(ptr, "type");
     std::string type = r.string(*typeJson, typePtr);
     if (type.empty()) return;
-    std::vector<std::string> keys = {"type", "name", "material", "transform", "emission",
-                                     "emission_two_sided"};
+    std::vector<std::string> keys = {"type",      "name",     "material",
+                                     "transform", "emission", "emission_two_sided"};
     if (type == "obj" || type == "ply") {
         keys.push_back("file");
     } else if (type == "sphere") {
@@ -182,8 +183,8 @@ void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
     Rgb emission(0.0f);
     bool emissive = false;
     if (v.contains("emission")) {
-        emission = r.getRgb(v, ptr, "emission", Presence::Required, NumberRange::nonNegative(),
-                            Rgb(0.0f));
+        emission =
+            r.getRgb(v, ptr, "emission", Presence::Required, NumberRange::nonNegative(), Rgb(0.0f));
         emissive = !isBlack(emission);
         if (!emissive && r.errorCount() == errorsBefore)
             r.warning(jsonPointerChild(ptr, "emission"),
@@ -195,8 +196,8 @@ void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
                 "\"emission_two_sided\" needs an \"emission\" on the same shape");
 
     // Material: required, except on emitters (which are then black).
-    if (const Json* mj = r.member(v, ptr, "material", v.contains("emission") ? Presence::Optional
-                                                                             : Presence::Required,
+    if (const Json* mj = r.member(v, ptr, "material",
+                                  v.contains("emission") ? Presence::Optional : Presence::Required,
                                   "the name of a material defined in \"materials\"")) {
         std::string mPtr = jsonPointerChild(ptr, "material");
         std::string name = r.string(*mj, mPtr);
@@ -253,8 +254,9 @@ void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
                     size_t before = r.errorCount();
                     shape.mesh = loadMeshFile(path, r.diagnostics(), ptr);
                     if (r.errorCount() != before)
-                        r.error(filePtr, "mesh file '" + file + "' could not be loaded (see the "
-                                         "errors reported for it)");
+                        r.error(filePtr, "mesh file '" + file +
+                                             "' could not be loaded (see the "
+                                             "errors reported for it)");
                 }
             }
         }
@@ -263,9 +265,8 @@ void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
             float area = meshArea(shape.mesh);
             if (!(area > 0.0f) || !std::isfinite(area))
                 r.error(ptr, std::string(emissive ? "zero-area emitter: " : "degenerate shape: ") +
-                                 "the surface area of this " + type +
-                                 " after its transform is " + formatNumber(area) +
-                                 " (expected > 0)");
+                                 "the surface area of this " + type + " after its transform is " +
+                                 formatNumber(area) + " (expected > 0)");
         }
     }
     if (r.errorCount() != errorsBefore) return;

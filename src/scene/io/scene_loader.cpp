@@ -7,7 +7,9 @@
 
 namespace ub {
 
-std::vector<std::string> supportedSceneExtensions() { return {".json"}; }
+std::vector<std::string> supportedSceneExtensions() {
+    return {".json"};
+}
 
 std::unique_ptr<Scene> loadScene(const std::string& path, std::vector<Diagnostic>* warnings) {
     std::string ext = std::filesystem::path(path).extension().string();
