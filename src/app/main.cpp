@@ -1,2 +1,151 @@
-// placeholder replaced by the CLI implementation
-int main() { return 0; }
+// `unibeam`: the command-line program (CLI11). Commands:
+//   unibeam render SCENE [options]   render a scene progressively, write EXR / PNG
+//   unibeam info SCENE               print what a scene contains
+//   unibeam --version | --help, and --help on every command.
+// Exit status: 0 success, 1 unexpected failure, 2 bad input (flags, scene, paths).
+// docs/cli.md documents every option.
+#include <CLI/CLI.hpp>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <iostream>
+#include <string>
+
+#include "app/commands.h"
+#include "core/error.h"
+#include "render/integrator.h"
+
+namespace {
+
+constexpr int kExitFailure = 1;
+constexpr int kExitBadInput = 2;
+
+/// Parses a non-negative decimal 64-bit integer, or throws UsageError.
+uint64_t parseSeed(const std::string& s) {
+    bool digits = !s.empty() && s.size() <= 20;
+    for (char c : s) digits = digits && c >= '0' && c <= '9';
+    if (digits) {
+        errno = 0;
+        char* end = nullptr;
+        unsigned long long v = std::strtoull(s.c_str(), &end, 10);
+        if (errno == 0 && *end == '\0') return uint64_t(v);
+    }
+    throw ub::app::UsageError("--seed: expected a non-negative integer below 2^64, got '" + s +
+                              "'");
+}
+
+std::string algorithmList() {
+    std::string s;
+    for (const auto& n : ub::integratorNames()) s += (s.empty() ? "" : ", ") + n;
+    return s;
+}
+
+int run(int argc, char** argv) {
+    CLI::App app{"unibeam: a physically based renderer (path tracing, VCM, UPBP)", "unibeam"};
+    app.set_version_flag("--version", std::string("unibeam ") + UNIBEAM_VERSION);
+    app.require_subcommand(1);
+    app.fallthrough(false);
+
+    // ---- render ----
+    ub::app::RenderArgs ra;
+    std::string seedText, maxLengthText;
+    float radius = 0, alpha = 0;
+    CLI::App* render = app.add_subcommand("render", "Render a scene progressively");
+    render->add_option("scene", ra.scene, "Scene file (native .json)")->required();
+    render->add_option("-a,--algorithm", ra.algorithm,
+                       "Rendering algorithm: one of " + algorithmList() + " (default pt)");
+    CLI::Option* timeOpt =
+        render->add_option("-t,--time", ra.timeLimit,
+                           "Time limit in seconds (> 0); the iteration running at the limit "
+                           "is finished")
+            ->check(CLI::PositiveNumber);
+    CLI::Option* iterOpt =
+        render->add_option("-i,--iterations", ra.iterations,
+                           "Number of iterations, one sample per pixel each (> 0; default " +
+                               std::to_string(ub::app::kDefaultIterations) +
+                               " when neither -t nor -i is given)")
+            ->check(CLI::PositiveNumber);
+    timeOpt->excludes(iterOpt);
+    render->add_option("-o,--output", ra.exrPath,
+                       "OpenEXR output (32-bit float RGB); default SCENE_STEM.exr in the "
+                       "current directory unless only --png is given");
+    render->add_option("--png", ra.pngPath, "Also write an 8-bit sRGB PNG");
+    render->add_option("--exposure", ra.exposure, "PNG exposure in stops (PNG = 2^EV x image)");
+    render->add_option("--threads", ra.threads, "Number of threads (> 0; default: all cores)")
+        ->check(CLI::PositiveNumber);
+    render->add_option("--seed", seedText, "Random seed (non-negative integer; default: scene)");
+    render->add_option("--max-length", maxLengthText,
+                       "Maximum path length in segments (>= 1; a directly visible light is "
+                       "length 1; default: scene)");
+    render->add_option("--resolution", ra.resolution, "Image size WIDTHxHEIGHT (default: scene)");
+    render->add_option("--mis", ra.mis, "MIS heuristic: power or balance (default power)")
+        ->check(CLI::IsMember({"power", "balance"}));
+    CLI::Option* radiusOpt = render->add_option("--radius", radius,
+                       "Merging radius (ppm/bpm/vcm) as a fraction of the scene bounding "
+                       "sphere radius (> 0)")
+        ->check(CLI::PositiveNumber);
+    CLI::Option* alphaOpt = render->add_option("--alpha", alpha,
+                       "Radius reduction exponent of progressive merging, in (0, 1]")
+        ->check(CLI::Range(0.0, 1.0))
+        ->check(CLI::PositiveNumber);
+
+    // ---- info ----
+    std::string infoScene;
+    CLI::App* info = app.add_subcommand("info", "Print what a scene file contains");
+    info->add_option("scene", infoScene, "Scene file")->required();
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::Success& e) {
+        return app.exit(e);  // --help / --version
+    } catch (const CLI::ParseError& e) {
+        std::fprintf(stderr, "unibeam: error: %s\nRun 'unibeam --help' or 'unibeam COMMAND --help' "
+                             "for usage.\n", e.what());
+        return kExitBadInput;
+    }
+
+    try {
+        if (*render) {
+            if (!seedText.empty()) ra.seed = parseSeed(seedText);
+            if (!maxLengthText.empty()) {
+                bool ok = maxLengthText.size() <= 6 &&
+                          maxLengthText.find_first_not_of("0123456789") == std::string::npos;
+                int v = ok ? std::stoi(maxLengthText) : 0;
+                if (!ok || v < 1)
+                    throw ub::app::UsageError("--max-length: expected an integer >= 1, got '" +
+                                              maxLengthText + "'");
+                ra.maxLength = v;
+            }
+            if (radiusOpt->count() > 0) ra.radius = radius;
+            if (alphaOpt->count() > 0) ra.alpha = alpha;
+            return ub::app::runRender(ra);
+        }
+        if (*info) return ub::app::runInfo(infoScene);
+    } catch (const ub::app::UsageError& e) {
+        std::fprintf(stderr, "unibeam: error: %s\n", e.what());
+        return kExitBadInput;
+    } catch (const ub::InputError& e) {
+        for (const auto& d : e.diagnostics()) std::fprintf(stderr, "%s\n", d.format().c_str());
+        return kExitBadInput;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "unibeam: error: %s\n", e.what());
+        return kExitFailure;
+    }
+    return kExitBadInput;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    try {
+        return run(argc, argv);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "unibeam: error: %s\n", e.what());
+        return kExitFailure;
+    } catch (...) {
+        std::fprintf(stderr, "unibeam: error: unknown exception\n");
+        return kExitFailure;
+    }
+}

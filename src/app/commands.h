@@ -1,0 +1,43 @@
+// The `unibeam` subcommands. Each returns the process exit status:
+//   0  success (also a render stopped by SIGINT/SIGTERM whose image was written)
+//   1  unexpected failure (I/O error while writing an image, out of memory, ...)
+//   2  bad input: command-line flags, scene file, or a missing/unwritable path
+// Usage errors are reported by throwing UsageError (message printed, exit 2);
+// ub::InputError is printed one diagnostic per line (exit 2).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+namespace ub::app {
+
+struct UsageError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+struct RenderArgs {
+    std::string scene;
+    std::string algorithm = "pt";
+    double timeLimit = 0;       ///< -t, 0 if not given
+    int iterations = 0;         ///< -i, 0 if not given
+    std::string exrPath;        ///< -o
+    std::string pngPath;        ///< --png
+    float exposure = 0;
+    int threads = 0;            ///< 0: all cores
+    std::optional<uint64_t> seed;
+    std::optional<int> maxLength;
+    std::string resolution;     ///< "WxH" or empty
+    std::string mis = "power";
+    std::optional<float> radius;
+    std::optional<float> alpha;
+};
+
+/// Default number of iterations when neither -t nor -i is given.
+constexpr int kDefaultIterations = 16;
+
+int runRender(const RenderArgs& args);
+int runInfo(const std::string& scenePath);
+
+}  // namespace ub::app

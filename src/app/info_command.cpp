@@ -1,0 +1,20 @@
+// `unibeam info`: load a scene and print its summary.
+#include <cstdio>
+#include <filesystem>
+
+#include "app/commands.h"
+#include "app/scene_access.h"
+
+namespace ub::app {
+
+int runInfo(const std::string& scenePath) {
+    if (!std::filesystem::exists(scenePath))
+        throw UsageError("scene file '" + scenePath + "' does not exist");
+    std::unique_ptr<Scene> scene = loadSceneFile(scenePath);
+    std::string text = sceneDescription(*scene);
+    std::fputs(text.c_str(), stdout);
+    if (!text.empty() && text.back() != '\n') std::fputc('\n', stdout);
+    return 0;
+}
+
+}  // namespace ub::app

@@ -1,0 +1,164 @@
+// `unibeam render`: load a scene, run the progressive loop, write EXR/PNG.
+#include <tbb/global_control.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+
+#include "app/commands.h"
+#include "app/progress_bar.h"
+#include "app/scene_access.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "render/integrator.h"
+#include "render/progressive.h"
+
+namespace ub::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string lower(std::string s) {
+    for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+/// Throws UsageError unless `path` has extension `ext` and can be created or overwritten.
+void checkOutputPath(const std::string& path, const std::string& ext, const std::string& flag) {
+    fs::path p(path);
+    if (lower(p.extension().string()) != ext)
+        throw UsageError(flag + ": output file '" + path + "' must end in " + ext);
+    fs::path dir = p.parent_path();
+    if (dir.empty()) dir = ".";
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec))
+        throw UsageError(flag + ": cannot write '" + path + "': directory '" + dir.string() +
+                         "' does not exist");
+    if (fs::is_directory(p, ec))
+        throw UsageError(flag + ": cannot write '" + path + "': it is a directory");
+    if (::access(dir.c_str(), W_OK) != 0)
+        throw UsageError(flag + ": cannot write '" + path + "': directory '" + dir.string() +
+                         "' is not writable");
+    if (fs::exists(p, ec) && ::access(p.c_str(), W_OK) != 0)
+        throw UsageError(flag + ": cannot write '" + path + "': file is not writable");
+}
+
+/// Parses "WxH" (positive integers up to 16384).
+void parseResolution(const std::string& s, int* w, int* h) {
+    auto bad = [&] {
+        return UsageError("--resolution: expected WIDTHxHEIGHT with positive integers up to "
+                          "16384 (e.g. 640x480), got '" + s + "'");
+    };
+    size_t x = s.find_first_of("xX");
+    if (x == std::string::npos || x == 0 || x + 1 >= s.size()) throw bad();
+    auto parse = [&](const std::string& part) {
+        if (part.size() > 5 || !std::all_of(part.begin(), part.end(), ::isdigit)) throw bad();
+        int v = std::stoi(part);
+        if (v < 1 || v > 16384) throw bad();
+        return v;
+    };
+    *w = parse(s.substr(0, x));
+    *h = parse(s.substr(x + 1));
+}
+
+std::string join(const std::vector<std::string>& v) {
+    std::string s;
+    for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+    return s;
+}
+
+}  // namespace
+
+int runRender(const RenderArgs& args) {
+    // ---- validate everything that does not need the scene ----
+    const auto names = integratorNames();
+    if (std::find(names.begin(), names.end(), args.algorithm) == names.end())
+        throw UsageError("-a/--algorithm: unknown algorithm '" + args.algorithm +
+                         "' (valid: " + join(names) + ")");
+    int width = 0, height = 0;
+    if (!args.resolution.empty()) parseResolution(args.resolution, &width, &height);
+    std::string exrPath = args.exrPath;
+    if (exrPath.empty() && args.pngPath.empty())
+        exrPath = fs::path(args.scene).stem().string() + ".exr";
+    if (!exrPath.empty()) checkOutputPath(exrPath, ".exr", "-o/--output");
+    if (!args.pngPath.empty()) checkOutputPath(args.pngPath, ".png", "--png");
+    if (!fs::exists(args.scene))
+        throw UsageError("scene file '" + args.scene + "' does not exist");
+
+    std::unique_ptr<tbb::global_control> threadLimit;
+    if (args.threads > 0)
+        threadLimit = std::make_unique<tbb::global_control>(
+            tbb::global_control::max_allowed_parallelism, size_t(args.threads));
+
+    // ---- scene and options ----
+    std::unique_ptr<Scene> scene = loadSceneFile(args.scene);
+    if (width > 0) {
+        const Camera& c = scene->camera;
+        Camera resized;
+        resized.setup(c.position(), c.position() + c.forward(), c.up(), c.fovYDeg(), width,
+                      height, c.lensRadius(), c.focusDistance());
+        scene->camera = resized;
+    }
+    RenderOptions options;
+    options.algorithm = args.algorithm;
+    options.maxPathLength = args.maxLength ? *args.maxLength : scene->settings.maxPathLength;
+    options.minPathLength = scene->settings.minPathLength;
+    options.seed = args.seed ? *args.seed : scene->settings.seed;
+    options.heuristic = args.mis == "balance" ? MisHeuristic::Balance : MisHeuristic::Power;
+    if (args.radius) options.radius = *args.radius;
+    if (args.alpha) options.alpha = *args.alpha;
+    std::unique_ptr<Integrator> integrator = makeIntegrator(*scene, options);
+
+    ProgressiveOptions prog;
+    prog.iterations = args.iterations;
+    prog.timeLimitSeconds = args.timeLimit;
+    if (prog.iterations <= 0 && prog.timeLimitSeconds <= 0) prog.iterations = kDefaultIterations;
+    ProgressBar bar(stderr, ::isatty(::fileno(stderr)) != 0);
+    prog.progress = [&](const ProgressInfo& info) { bar.update(info); };
+    const int w = scene->camera.width(), h = scene->camera.height();
+    installStopSignalHandlers();
+    std::fprintf(stderr, "unibeam: rendering %s with %s at %dx%d, max path length %d, seed %llu\n",
+                 args.scene.c_str(), options.algorithm.c_str(), w, h, options.maxPathLength,
+                 static_cast<unsigned long long>(options.seed));
+
+    ProgressiveResult result = renderProgressive(*integrator, w, h, prog);
+    bar.finish();
+    if (result.interrupted)
+        std::fprintf(stderr, "unibeam: stopped by %s after %d iterations; writing the image\n",
+                     lastStopSignal() == SIGTERM ? "SIGTERM" : "SIGINT", result.iterations);
+
+    // ---- output ----
+    ImageMetadata meta;
+    meta["software"] = std::string("unibeam ") + UNIBEAM_VERSION;
+    meta["scene"] = args.scene;
+    meta["technique"] = options.algorithm;
+    meta["iterations"] = std::to_string(result.iterations);
+    char seconds[32];
+    std::snprintf(seconds, sizeof(seconds), "%.3f", result.seconds);
+    meta["renderTimeSeconds"] = seconds;
+    meta["seed"] = std::to_string(options.seed);
+    meta["resolution"] = std::to_string(w) + "x" + std::to_string(h);
+    meta["maxPathLength"] = std::to_string(options.maxPathLength);
+    meta["mis"] = args.mis;
+    meta["interrupted"] = result.interrupted ? "true" : "false";
+    if (!exrPath.empty()) {
+        writeExr(exrPath, result.image, meta);
+        std::fprintf(stderr, "unibeam: wrote %s\n", exrPath.c_str());
+    }
+    if (!args.pngPath.empty()) {
+        writePng(args.pngPath, result.image, args.exposure);
+        std::fprintf(stderr, "unibeam: wrote %s\n", args.pngPath.c_str());
+    }
+    std::fprintf(stderr, "unibeam: %d iterations in %s (%.3f s/iteration)\n", result.iterations,
+                 formatSeconds(result.seconds).c_str(),
+                 result.iterations > 0 ? result.seconds / result.iterations : 0.0);
+    return 0;
+}
+
+}  // namespace ub::app

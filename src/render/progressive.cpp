@@ -1,0 +1,83 @@
+#include "render/progressive.h"
+
+#include <chrono>
+#include <csignal>
+#include <stdexcept>
+
+#include "render/film.h"
+
+namespace ub {
+
+namespace {
+
+std::atomic<bool> gStop{false};
+volatile std::sig_atomic_t gLastSignal = 0;
+
+extern "C" void onStopSignal(int sig) {
+    // Only async-signal-safe work here: a lock-free atomic store and signal().
+    gLastSignal = sig;
+    gStop.store(true, std::memory_order_relaxed);
+    std::signal(sig, SIG_DFL);  // a second signal terminates at once
+}
+
+}  // namespace
+
+std::atomic<bool>& stopRequested() { return gStop; }
+
+int lastStopSignal() { return int(gLastSignal); }
+
+void installStopSignalHandlers() {
+    static_assert(std::atomic<bool>::is_always_lock_free, "stop flag must be lock-free");
+    std::signal(SIGINT, onStopSignal);
+    std::signal(SIGTERM, onStopSignal);
+}
+
+ProgressiveResult renderProgressive(Integrator& integrator, int width, int height,
+                                    const ProgressiveOptions& options) {
+    if (options.iterations <= 0 && options.timeLimitSeconds <= 0)
+        throw std::invalid_argument("renderProgressive: give an iteration count or a time limit");
+    const std::atomic<bool>& stop = options.stop ? *options.stop : gStop;
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
+    auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+
+    Film film(width, height);
+    Image iterationImage(width, height);
+    ProgressiveResult result;
+    for (int it = 0;; ++it) {
+        if (options.iterations > 0 && it >= options.iterations) break;
+        if (it > 0) {
+            if (options.timeLimitSeconds > 0 && elapsed() >= options.timeLimitSeconds) break;
+            if (stop.load(std::memory_order_relaxed)) {
+                result.interrupted = true;
+                break;
+            }
+        }
+        integrator.renderIteration(it, iterationImage);
+        film.addIteration(iterationImage);
+
+        if (options.progress) {
+            ProgressInfo info;
+            info.iteration = it + 1;
+            info.targetIterations = std::max(0, options.iterations);
+            info.elapsedSeconds = elapsed();
+            info.timeLimitSeconds = std::max(0.0, options.timeLimitSeconds);
+            double perIteration = info.elapsedSeconds / info.iteration;
+            double eta = -1;
+            if (options.iterations > 0)
+                eta = perIteration * (options.iterations - info.iteration);
+            if (options.timeLimitSeconds > 0) {
+                double etaTime = std::max(0.0, options.timeLimitSeconds - info.elapsedSeconds);
+                eta = eta < 0 ? etaTime : std::min(eta, etaTime);
+            }
+            info.etaSeconds = eta;
+            options.progress(info);
+        }
+    }
+    result.iterations = film.iterations();
+    result.seconds = elapsed();
+    result.image = film.average();
+    return result;
+}
+
+}  // namespace ub

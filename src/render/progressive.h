@@ -1,0 +1,66 @@
+// Progressive rendering loop: runs iterations of an Integrator (one sample per
+// pixel each) into a Film until an iteration count or a time limit is
+// reached, or a stop is requested.
+//
+// Stopping rules:
+//  * iterations > 0: exactly that many iterations (unless stopped earlier);
+//  * timeLimitSeconds > 0: iterations are started while the elapsed time is
+//    below the limit, so the render ends after the iteration during which the
+//    limit was reached (it may overrun by up to one iteration; at least one
+//    iteration is always rendered);
+//  * both given: whichever comes first;
+//  * stop flag: checked between iterations. A request finishes the current
+//    iteration and returns what has been accumulated (at least one iteration).
+//
+// installStopSignalHandlers() makes SIGINT and SIGTERM set stopRequested();
+// a second SIGINT/SIGTERM restores the default action, so pressing Ctrl-C
+// twice kills the program at once.
+#pragma once
+
+#include <atomic>
+#include <functional>
+
+#include "core/image.h"
+#include "render/integrator.h"
+
+namespace ub {
+
+struct ProgressInfo {
+    int iteration = 0;          ///< iterations finished
+    int targetIterations = 0;   ///< 0 if the render is time-limited only
+    double elapsedSeconds = 0;
+    double timeLimitSeconds = 0;  ///< 0 if none
+    /// Estimated seconds left (from the mean iteration time), < 0 if unknown.
+    double etaSeconds = -1;
+};
+
+struct ProgressiveOptions {
+    int iterations = 0;            ///< > 0: number of iterations
+    double timeLimitSeconds = 0;   ///< > 0: wall-clock limit
+    /// Called after every iteration, on the calling thread.
+    std::function<void(const ProgressInfo&)> progress;
+    /// Stop flag polled between iterations (nullptr: use the global one set by the
+    /// signal handlers, see stopRequested()).
+    const std::atomic<bool>* stop = nullptr;
+};
+
+struct ProgressiveResult {
+    Image image;          ///< average of the rendered iterations
+    int iterations = 0;
+    double seconds = 0;   ///< wall-clock time of the iterations
+    bool interrupted = false;  ///< stopped by the stop flag before the target was reached
+};
+
+/// Renders width x height iterations of `integrator`. Throws std::invalid_argument if
+/// neither an iteration count nor a time limit is given.
+ProgressiveResult renderProgressive(Integrator& integrator, int width, int height,
+                                    const ProgressiveOptions& options);
+
+/// The process-wide stop flag (set by the signal handlers).
+std::atomic<bool>& stopRequested();
+/// Installs SIGINT/SIGTERM handlers that set stopRequested() (see the header comment).
+void installStopSignalHandlers();
+/// Signal number that set the stop flag last (0 if none).
+int lastStopSignal();
+
+}  // namespace ub

@@ -1,0 +1,295 @@
+// End-to-end tests of the `unibeam` program (UNIBEAM_BINARY): rendering a bundled scene,
+// output files and their metadata, exit codes and messages for bad input, `info`,
+// `--version`/`--help`, and SIGINT during a render.
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/image.h"
+
+extern char** environ;
+
+namespace ub {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kBinary = UNIBEAM_BINARY;
+const std::string kScene = std::string(UNIBEAM_SOURCE_DIR) + "/scenes/cornell-large-light.json";
+
+struct RunResult {
+    int exitCode = -1;
+    std::string out, err;
+};
+
+std::string readFile(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+/// Fresh temporary directory per test.
+fs::path tempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    fs::path d = fs::temp_directory_path() /
+                 ("unibeam_cli_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+std::string quote(const std::string& s) {
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+/// Runs the binary with args (each shell-quoted), capturing stdout and stderr.
+RunResult runUnibeam(const std::vector<std::string>& args, const fs::path& dir) {
+    std::string cmd = quote(kBinary);
+    for (const auto& a : args) cmd += " " + quote(a);
+    fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+    cmd += " >" + quote(out.string()) + " 2>" + quote(err.string()) + " </dev/null";
+    int status = std::system(cmd.c_str());
+    RunResult r;
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = readFile(out);
+    r.err = readFile(err);
+    return r;
+}
+
+/// Width and height from a PNG's IHDR chunk (bytes 16..23, big-endian), after checking
+/// the signature.
+bool pngSize(const fs::path& p, int* w, int* h) {
+    std::string d = readFile(p);
+    const std::string sig = "\x89PNG\r\n\x1a\n";
+    if (d.size() < 24 || d.compare(0, 8, sig) != 0 || d.compare(12, 4, "IHDR") != 0) return false;
+    auto be32 = [&](size_t o) {
+        return int((uint32_t(uint8_t(d[o])) << 24) | (uint32_t(uint8_t(d[o + 1])) << 16) |
+                   (uint32_t(uint8_t(d[o + 2])) << 8) | uint32_t(uint8_t(d[o + 3])));
+    };
+    *w = be32(16);
+    *h = be32(20);
+    return true;
+}
+
+TEST(Cli, RenderWritesExrAndPngWithMetadata) {
+    ASSERT_TRUE(fs::exists(kScene)) << kScene;
+    fs::path dir = tempDir();
+    fs::path exr = dir / "out.exr", png = dir / "out.png";
+    RunResult r = runUnibeam({"render", kScene, "--resolution", "32x24", "-i", "2", "-o",
+                              exr.string(), "--png", png.string(), "--seed", "5",
+                              "--max-length", "4", "--threads", "2", "--exposure", "0.5"},
+                             dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    ImageMetadata meta;
+    Image img = readExr(exr.string(), &meta);
+    EXPECT_EQ(img.width, 32);
+    EXPECT_EQ(img.height, 24);
+    EXPECT_EQ(meta["technique"], "pt");
+    EXPECT_EQ(meta["iterations"], "2");
+    EXPECT_EQ(meta["seed"], "5");
+    EXPECT_EQ(meta["resolution"], "32x24");
+    EXPECT_EQ(meta["maxPathLength"], "4");
+    EXPECT_EQ(meta["scene"], kScene);
+    EXPECT_EQ(meta["interrupted"], "false");
+    EXPECT_FALSE(meta["renderTimeSeconds"].empty());
+    EXPECT_GT(luminance(img.mean()), 0.0f) << "the Cornell box should not render black";
+    int w = 0, h = 0;
+    ASSERT_TRUE(pngSize(png, &w, &h));
+    EXPECT_EQ(w, 32);
+    EXPECT_EQ(h, 24);
+    // Non-terminal stderr: plain progress lines, no carriage returns.
+    EXPECT_NE(r.err.find("unibeam: iteration 2/2"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find('\r'), std::string::npos);
+
+    // Same seed, thread count 1: bit-identical image.
+    fs::path exr1 = dir / "out1.exr";
+    RunResult r1 = runUnibeam({"render", kScene, "--resolution", "32x24", "-i", "2", "-o",
+                               exr1.string(), "--seed", "5", "--max-length", "4", "--threads",
+                               "1"},
+                              dir);
+    ASSERT_EQ(r1.exitCode, 0) << r1.err;
+    Image img1 = readExr(exr1.string());
+    ASSERT_EQ(img1.pixels.size(), img.pixels.size());
+    for (size_t i = 0; i < img.pixels.size(); ++i)
+        ASSERT_TRUE(img1.pixels[i].x == img.pixels[i].x && img1.pixels[i].y == img.pixels[i].y &&
+                    img1.pixels[i].z == img.pixels[i].z)
+            << "pixel " << i;
+    fs::remove_all(dir);
+}
+
+TEST(Cli, BadFlagsExitTwoWithMessage) {
+    ASSERT_TRUE(fs::exists(kScene)) << kScene;
+    fs::path dir = tempDir();
+    const std::string out = (dir / "o.exr").string();
+    struct Case {
+        std::vector<std::string> args;
+        std::string message;
+    };
+    const std::vector<Case> cases = {
+        {{"render", kScene, "--bogus"}, "--bogus"},
+        {{"render", kScene, "-t", "1", "-i", "2", "-o", out}, "excludes"},
+        {{"render", kScene, "-i", "0", "-o", out}, "--iterations"},
+        {{"render", kScene, "-i", "-3", "-o", out}, "--iterations"},
+        {{"render", kScene, "-i", "two", "-o", out}, "--iterations"},
+        {{"render", kScene, "-t", "0", "-o", out}, "--time"},
+        {{"render", kScene, "-t", "-1", "-o", out}, "--time"},
+        {{"render", kScene, "--threads", "0", "-o", out}, "--threads"},
+        {{"render", kScene, "--resolution", "32by32", "-o", out}, "--resolution"},
+        {{"render", kScene, "--resolution", "0x32", "-o", out}, "--resolution"},
+        {{"render", kScene, "--resolution", "32x", "-o", out}, "--resolution"},
+        {{"render", kScene, "-a", "nope", "-o", out}, "unknown algorithm 'nope' (valid: pt"},
+        {{"render", kScene, "-o", (dir / "no/such/dir/o.exr").string()}, "does not exist"},
+        {{"render", kScene, "-o", (dir / "o.png").string()}, "must end in .exr"},
+        {{"render", kScene, "-o", out, "--png", (dir / "p.jpg").string()}, "must end in .png"},
+        {{"render", kScene, "-o", dir.string() + "/"}, "-o/--output"},
+        {{"render", kScene, "--mis", "cubic", "-o", out}, "--mis"},
+        {{"render", kScene, "--seed", "-1", "-o", out}, "--seed"},
+        {{"render", kScene, "--max-length", "0", "-o", out}, "--max-length"},
+        {{"render", kScene, "--radius", "-0.1", "-o", out}, "--radius"},
+        {{"render", kScene, "--alpha", "1.5", "-o", out}, "--alpha"},
+        {{"render"}, "scene"},
+        {{"frobnicate"}, "frobnicate"},
+        {{}, "subcommand"},
+    };
+    for (const auto& c : cases) {
+        std::string joined;
+        for (const auto& a : c.args) joined += a + " ";
+        RunResult r = runUnibeam(c.args, dir);
+        EXPECT_EQ(r.exitCode, 2) << joined << "\n" << r.err;
+        EXPECT_NE(r.err.find(c.message), std::string::npos)
+            << joined << ": expected '" << c.message << "' in:\n" << r.err;
+        EXPECT_FALSE(fs::exists(out)) << joined;
+    }
+    fs::remove_all(dir);
+}
+
+TEST(Cli, MissingOrBadSceneExitsTwo) {
+    fs::path dir = tempDir();
+    RunResult r = runUnibeam({"render", (dir / "missing.json").string(), "-o",
+                              (dir / "o.exr").string()},
+                             dir);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("missing.json"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("does not exist"), std::string::npos) << r.err;
+
+    RunResult ri = runUnibeam({"info", (dir / "missing.json").string()}, dir);
+    EXPECT_EQ(ri.exitCode, 2);
+    EXPECT_NE(ri.err.find("missing.json"), std::string::npos) << ri.err;
+
+    // A malformed scene file: the loader's diagnostic is printed, exit 2.
+    fs::path bad = dir / "bad.json";
+    std::ofstream(bad) << "{ \"camera\": [1, 2,, }";
+    RunResult rb = runUnibeam({"render", bad.string(), "-o", (dir / "o.exr").string()}, dir);
+    EXPECT_EQ(rb.exitCode, 2) << rb.err;
+    EXPECT_NE(rb.err.find("bad.json"), std::string::npos) << rb.err;
+    EXPECT_FALSE(fs::exists(dir / "o.exr"));
+    fs::remove_all(dir);
+}
+
+TEST(Cli, InfoDescribesScene) {
+    ASSERT_TRUE(fs::exists(kScene)) << kScene;
+    fs::path dir = tempDir();
+    RunResult r = runUnibeam({"info", kScene}, dir);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_FALSE(r.out.empty());
+    EXPECT_NE(r.out.find("ight"), std::string::npos) << "lights should be listed:\n" << r.out;
+    fs::remove_all(dir);
+}
+
+TEST(Cli, VersionAndHelp) {
+    fs::path dir = tempDir();
+    RunResult v = runUnibeam({"--version"}, dir);
+    EXPECT_EQ(v.exitCode, 0);
+    EXPECT_NE(v.out.find(std::string("unibeam ") + UNIBEAM_VERSION), std::string::npos) << v.out;
+    RunResult h = runUnibeam({"--help"}, dir);
+    EXPECT_EQ(h.exitCode, 0);
+    EXPECT_NE(h.out.find("render"), std::string::npos);
+    EXPECT_NE(h.out.find("info"), std::string::npos);
+    RunResult rh = runUnibeam({"render", "--help"}, dir);
+    EXPECT_EQ(rh.exitCode, 0);
+    for (const char* flag : {"--algorithm", "--time", "--iterations", "--output", "--png",
+                             "--exposure", "--threads", "--seed", "--max-length", "--resolution",
+                             "--mis", "--radius", "--alpha"})
+        EXPECT_NE(rh.out.find(flag), std::string::npos) << flag;
+    RunResult ih = runUnibeam({"info", "--help"}, dir);
+    EXPECT_EQ(ih.exitCode, 0);
+    EXPECT_NE(ih.out.find("scene"), std::string::npos);
+    fs::remove_all(dir);
+}
+
+// SIGINT during a long (time-limited) render: the iteration in progress finishes, the
+// image so far is written with its metadata, and the exit status is 0.
+TEST(Cli, SigintWritesImageAndExitsZero) {
+    ASSERT_TRUE(fs::exists(kScene)) << kScene;
+    fs::path dir = tempDir();
+    fs::path exr = dir / "int.exr", errPath = dir / "stderr.txt";
+    std::vector<std::string> args = {kBinary, "render", kScene, "--resolution", "32x32",
+                                     "-t", "120", "-o", exr.string()};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 2, errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
+    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+    pid_t pid = 0;
+    ASSERT_EQ(posix_spawn(&pid, kBinary.c_str(), &actions, nullptr, argv.data(), environ), 0);
+    posix_spawn_file_actions_destroy(&actions);
+
+    // Wait for the first progress line (printed after the handlers are installed).
+    using Clock = std::chrono::steady_clock;
+    auto start = Clock::now();
+    bool started = false;
+    while (Clock::now() - start < std::chrono::seconds(60)) {
+        if (readFile(errPath).find("unibeam: iteration") != std::string::npos) {
+            started = true;
+            break;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    EXPECT_TRUE(started) << readFile(errPath);
+    ::kill(pid, SIGINT);
+    int status = 0;
+    bool exited = false;
+    start = Clock::now();
+    while (Clock::now() - start < std::chrono::seconds(60)) {
+        if (::waitpid(pid, &status, WNOHANG) == pid) {
+            exited = true;
+            break;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    if (!exited) {
+        ::kill(pid, SIGKILL);
+        ::waitpid(pid, &status, 0);
+        FAIL() << "unibeam did not exit within 60 s of SIGINT";
+    }
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+    EXPECT_EQ(WEXITSTATUS(status), 0) << readFile(errPath);
+    ImageMetadata meta;
+    Image img = readExr(exr.string(), &meta);
+    EXPECT_EQ(img.width, 32);
+    EXPECT_EQ(meta["interrupted"], "true");
+    EXPECT_GE(std::stoi(meta["iterations"]), 1);
+    EXPECT_NE(readFile(errPath).find("stopped by SIGINT"), std::string::npos);
+    fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace ub
