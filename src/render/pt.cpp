@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "core/rng.h"
-#include "kernels/shared/mis_heuristic.h"
+#include "kernels/shared/ub_mis_heuristic.h"
 #include "scene/bsdf.h"
 
 namespace ub {
