@@ -59,9 +59,12 @@ int main(int argc, char** argv) {
     int runs = 7, res = 256;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
-        if (a == "--runs" && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
-        else if (a == "--resolution" && i + 1 < argc) res = std::max(1, std::atoi(argv[++i]));
-        else scenePath = a;
+        if (a == "--runs" && i + 1 < argc)
+            runs = std::max(1, std::atoi(argv[++i]));
+        else if (a == "--resolution" && i + 1 < argc)
+            res = std::max(1, std::atoi(argv[++i]));
+        else
+            scenePath = a;
     }
     std::unique_ptr<Scene> scene;
     try {
@@ -114,10 +117,11 @@ int main(int argc, char** argv) {
 
     std::printf("scene %s, %dx%d, 1 sample/pixel, max path length %d, median of %d runs\n",
                 scenePath.c_str(), res, res, opt.maxPathLength, runs);
-    std::printf("rays of one pt iteration: %llu closest-hit + %llu shadow = %llu "
-                "(%.2f closest-hit rays per pixel)\n",
-                (unsigned long long)closest, (unsigned long long)shadow,
-                (unsigned long long)(closest + shadow), double(closest) / (double(res) * res));
+    std::printf(
+        "rays of one pt iteration: %llu closest-hit + %llu shadow = %llu "
+        "(%.2f closest-hit rays per pixel)\n",
+        (unsigned long long)closest, (unsigned long long)shadow,
+        (unsigned long long)(closest + shadow), double(closest) / (double(res) * res));
     std::printf("| %-38s | %7s | %12s | %12s | %10s |\n", "measurement", "threads", "time [ms]",
                 "rays", "Mrays/s");
     std::printf("|%s|%s|%s|%s|%s|\n", std::string(40, '-').c_str(), std::string(9, '-').c_str(),

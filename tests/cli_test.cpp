@@ -1,8 +1,8 @@
 // End-to-end tests of the `unibeam` program (UNIBEAM_BINARY): rendering a bundled scene,
 // output files and their metadata, exit codes and messages for bad input, `info`,
 // `--version`/`--help`, and SIGINT during a render.
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -90,10 +90,10 @@ TEST(Cli, RenderWritesExrAndPngWithMetadata) {
     ASSERT_TRUE(fs::exists(kScene)) << kScene;
     fs::path dir = tempDir();
     fs::path exr = dir / "out.exr", png = dir / "out.png";
-    RunResult r = runUnibeam({"render", kScene, "--resolution", "32x24", "-i", "2", "-o",
-                              exr.string(), "--png", png.string(), "--seed", "5",
-                              "--max-length", "4", "--threads", "2", "--exposure", "0.5"},
-                             dir);
+    RunResult r = runUnibeam(
+        {"render", kScene, "--resolution", "32x24", "-i", "2", "-o", exr.string(), "--png",
+         png.string(), "--seed", "5", "--max-length", "4", "--threads", "2", "--exposure", "0.5"},
+        dir);
     ASSERT_EQ(r.exitCode, 0) << r.err;
     ImageMetadata meta;
     Image img = readExr(exr.string(), &meta);
@@ -119,8 +119,7 @@ TEST(Cli, RenderWritesExrAndPngWithMetadata) {
     // Same seed, thread count 1: bit-identical image.
     fs::path exr1 = dir / "out1.exr";
     RunResult r1 = runUnibeam({"render", kScene, "--resolution", "32x24", "-i", "2", "-o",
-                               exr1.string(), "--seed", "5", "--max-length", "4", "--threads",
-                               "1"},
+                               exr1.string(), "--seed", "5", "--max-length", "4", "--threads", "1"},
                               dir);
     ASSERT_EQ(r1.exitCode, 0) << r1.err;
     Image img1 = readExr(exr1.string());
@@ -172,7 +171,8 @@ TEST(Cli, BadFlagsExitTwoWithMessage) {
         RunResult r = runUnibeam(c.args, dir);
         EXPECT_EQ(r.exitCode, 2) << joined << "\n" << r.err;
         EXPECT_NE(r.err.find(c.message), std::string::npos)
-            << joined << ": expected '" << c.message << "' in:\n" << r.err;
+            << joined << ": expected '" << c.message << "' in:\n"
+            << r.err;
         EXPECT_FALSE(fs::exists(out)) << joined;
     }
     fs::remove_all(dir);
@@ -180,9 +180,8 @@ TEST(Cli, BadFlagsExitTwoWithMessage) {
 
 TEST(Cli, MissingOrBadSceneExitsTwo) {
     fs::path dir = tempDir();
-    RunResult r = runUnibeam({"render", (dir / "missing.json").string(), "-o",
-                              (dir / "o.exr").string()},
-                             dir);
+    RunResult r = runUnibeam(
+        {"render", (dir / "missing.json").string(), "-o", (dir / "o.exr").string()}, dir);
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("missing.json"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("does not exist"), std::string::npos) << r.err;
@@ -222,9 +221,9 @@ TEST(Cli, VersionAndHelp) {
     EXPECT_NE(h.out.find("info"), std::string::npos);
     RunResult rh = runUnibeam({"render", "--help"}, dir);
     EXPECT_EQ(rh.exitCode, 0);
-    for (const char* flag : {"--algorithm", "--time", "--iterations", "--output", "--png",
-                             "--exposure", "--threads", "--seed", "--max-length", "--resolution",
-                             "--mis", "--radius", "--alpha"})
+    for (const char* flag :
+         {"--algorithm", "--time", "--iterations", "--output", "--png", "--exposure", "--threads",
+          "--seed", "--max-length", "--resolution", "--mis", "--radius", "--alpha"})
         EXPECT_NE(rh.out.find(flag), std::string::npos) << flag;
     RunResult ih = runUnibeam({"info", "--help"}, dir);
     EXPECT_EQ(ih.exitCode, 0);
@@ -239,7 +238,7 @@ TEST(Cli, SigintWritesImageAndExitsZero) {
     fs::path dir = tempDir();
     fs::path exr = dir / "int.exr", errPath = dir / "stderr.txt";
     std::vector<std::string> args = {kBinary, "render", kScene, "--resolution", "32x32",
-                                     "-t", "120", "-o", exr.string()};
+                                     "-t",    "120",    "-o",   exr.string()};
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);

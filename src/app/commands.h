@@ -20,15 +20,15 @@ struct UsageError : std::runtime_error {
 struct RenderArgs {
     std::string scene;
     std::string algorithm = "pt";
-    double timeLimit = 0;       ///< -t, 0 if not given
-    int iterations = 0;         ///< -i, 0 if not given
-    std::string exrPath;        ///< -o
-    std::string pngPath;        ///< --png
+    double timeLimit = 0;  ///< -t, 0 if not given
+    int iterations = 0;    ///< -i, 0 if not given
+    std::string exrPath;   ///< -o
+    std::string pngPath;   ///< --png
     float exposure = 0;
-    int threads = 0;            ///< 0: all cores
+    int threads = 0;  ///< 0: all cores
     std::optional<uint64_t> seed;
     std::optional<int> maxLength;
-    std::string resolution;     ///< "WxH" or empty
+    std::string resolution;  ///< "WxH" or empty
     std::string mis = "power";
     std::optional<float> radius;
     std::optional<float> alpha;

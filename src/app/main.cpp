@@ -5,8 +5,8 @@
 // Exit status: 0 success, 1 unexpected failure, 2 bad input (flags, scene, paths).
 // docs/cli.md documents every option.
 #include <CLI/CLI.hpp>
-
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -36,6 +36,33 @@ uint64_t parseSeed(const std::string& s) {
                               "'");
 }
 
+/// CLI11 validator: a decimal integer > 0.
+CLI::Validator positiveInteger() {
+    return CLI::Validator(
+        [](std::string& s) -> std::string {
+            bool ok = !s.empty() && s.size() <= 9 &&
+                      s.find_first_not_of("0123456789") == std::string::npos;
+            if (ok && std::stol(s) > 0) return {};
+            return "expected an integer > 0, got '" + s + "'";
+        },
+        "");
+}
+
+/// CLI11 validator: a finite real number in (0, max].
+CLI::Validator positiveReal(double max = 1e30) {
+    return CLI::Validator(
+        [max](std::string& s) -> std::string {
+            char* end = nullptr;
+            double v = std::strtod(s.c_str(), &end);
+            if (!s.empty() && end && *end == '\0' && std::isfinite(v) && v > 0 && v <= max)
+                return {};
+            char range[64];
+            std::snprintf(range, sizeof(range), max < 1e30 ? "in (0, %g]" : "> 0", max);
+            return std::string("expected a number ") + range + ", got '" + s + "'";
+        },
+        "");
+}
+
 std::string algorithmList() {
     std::string s;
     for (const auto& n : ub::integratorNames()) s += (s.empty() ? "" : ", ") + n;
@@ -53,56 +80,88 @@ int run(int argc, char** argv) {
     std::string seedText, maxLengthText;
     float radius = 0, alpha = 0;
     CLI::App* render = app.add_subcommand("render", "Render a scene progressively");
-    render->add_option("scene", ra.scene, "Scene file (native .json)")->required();
-    render->add_option("-a,--algorithm", ra.algorithm,
-                       "Rendering algorithm: one of " + algorithmList() + " (default pt)");
+    render->add_option("scene", ra.scene, "Scene file (native .json)")
+        ->required()
+        ->type_name("SCENE");
+    render
+        ->add_option("-a,--algorithm", ra.algorithm,
+                     "Rendering algorithm: one of " + algorithmList() + " (default pt)")
+        ->type_name("ALGO");
     CLI::Option* timeOpt =
-        render->add_option("-t,--time", ra.timeLimit,
-                           "Time limit in seconds (> 0); the iteration running at the limit "
-                           "is finished")
-            ->check(CLI::PositiveNumber);
+        render
+            ->add_option("-t,--time", ra.timeLimit,
+                         "Time limit in seconds (> 0); the iteration running at the limit "
+                         "is finished")
+            ->check(positiveReal())
+            ->type_name("SECONDS");
     CLI::Option* iterOpt =
-        render->add_option("-i,--iterations", ra.iterations,
-                           "Number of iterations, one sample per pixel each (> 0; default " +
-                               std::to_string(ub::app::kDefaultIterations) +
-                               " when neither -t nor -i is given)")
-            ->check(CLI::PositiveNumber);
+        render
+            ->add_option("-i,--iterations", ra.iterations,
+                         "Number of iterations, one sample per pixel each (> 0; default " +
+                             std::to_string(ub::app::kDefaultIterations) +
+                             " when neither -t nor -i is given)")
+            ->check(positiveInteger())
+            ->type_name("N");
     timeOpt->excludes(iterOpt);
-    render->add_option("-o,--output", ra.exrPath,
-                       "OpenEXR output (32-bit float RGB); default SCENE_STEM.exr in the "
-                       "current directory unless only --png is given");
-    render->add_option("--png", ra.pngPath, "Also write an 8-bit sRGB PNG");
-    render->add_option("--exposure", ra.exposure, "PNG exposure in stops (PNG = 2^EV x image)");
+    render
+        ->add_option("-o,--output", ra.exrPath,
+                     "OpenEXR output (32-bit float RGB); default SCENE_STEM.exr in the "
+                     "current directory unless only --png is given")
+        ->type_name("FILE.exr");
+    render->add_option("--png", ra.pngPath, "Also write an 8-bit sRGB PNG")->type_name("FILE.png");
+    render->add_option("--exposure", ra.exposure, "PNG exposure in stops (PNG = 2^EV x image)")
+        ->type_name("EV");
     render->add_option("--threads", ra.threads, "Number of threads (> 0; default: all cores)")
-        ->check(CLI::PositiveNumber);
-    render->add_option("--seed", seedText, "Random seed (non-negative integer; default: scene)");
-    render->add_option("--max-length", maxLengthText,
-                       "Maximum path length in segments (>= 1; a directly visible light is "
-                       "length 1; default: scene)");
-    render->add_option("--resolution", ra.resolution, "Image size WIDTHxHEIGHT (default: scene)");
+        ->check(positiveInteger())
+        ->type_name("N");
+    render->add_option("--seed", seedText, "Random seed (non-negative integer; default: scene)")
+        ->type_name("S");
+    render
+        ->add_option("--max-length", maxLengthText,
+                     "Maximum path length in segments (>= 1; a directly visible light is "
+                     "length 1; default: scene)")
+        ->type_name("L");
+    render->add_option("--resolution", ra.resolution, "Image size WIDTHxHEIGHT (default: scene)")
+        ->type_name("WxH");
     render->add_option("--mis", ra.mis, "MIS heuristic: power or balance (default power)")
-        ->check(CLI::IsMember({"power", "balance"}));
-    CLI::Option* radiusOpt = render->add_option("--radius", radius,
-                       "Merging radius (ppm/bpm/vcm) as a fraction of the scene bounding "
-                       "sphere radius (> 0)")
-        ->check(CLI::PositiveNumber);
-    CLI::Option* alphaOpt = render->add_option("--alpha", alpha,
-                       "Radius reduction exponent of progressive merging, in (0, 1]")
-        ->check(CLI::Range(0.0, 1.0))
-        ->check(CLI::PositiveNumber);
+        ->check(CLI::IsMember({"power", "balance"}).description(""))
+        ->type_name("power|balance");
+    CLI::Option* radiusOpt =
+        render
+            ->add_option("--radius", radius,
+                         "Merging radius (ppm/bpm/vcm) as a fraction of the scene bounding "
+                         "sphere radius (> 0)")
+            ->check(positiveReal())
+            ->type_name("R");
+    CLI::Option* alphaOpt =
+        render
+            ->add_option("--alpha", alpha,
+                         "Radius reduction exponent of progressive merging, in (0, 1]")
+            ->check(positiveReal(1.0))
+            ->type_name("A");
 
     // ---- info ----
     std::string infoScene;
     CLI::App* info = app.add_subcommand("info", "Print what a scene file contains");
-    info->add_option("scene", infoScene, "Scene file")->required();
+    info->add_option("scene", infoScene, "Scene file")->required()->type_name("SCENE");
 
+    if (argc >= 2 && argv[1][0] != '-' && std::string(argv[1]) != "render" &&
+        std::string(argv[1]) != "info") {
+        std::fprintf(stderr,
+                     "unibeam: error: unknown command '%s' (valid: render, info)\n"
+                     "Run 'unibeam --help' for usage.\n",
+                     argv[1]);
+        return kExitBadInput;
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::Success& e) {
         return app.exit(e);  // --help / --version
     } catch (const CLI::ParseError& e) {
-        std::fprintf(stderr, "unibeam: error: %s\nRun 'unibeam --help' or 'unibeam COMMAND --help' "
-                             "for usage.\n", e.what());
+        std::fprintf(stderr,
+                     "unibeam: error: %s\nRun 'unibeam --help' or 'unibeam COMMAND --help' "
+                     "for usage.\n",
+                     e.what());
         return kExitBadInput;
     }
 

@@ -15,14 +15,14 @@
 namespace ub {
 
 class ProgressBar {
-public:
+  public:
     /// interactive: redraw in place (use isatty(fileno(out))).
     ProgressBar(std::FILE* out, bool interactive, double intervalSeconds = 2.0);
     void update(const ProgressInfo& info);
     /// Ends the display (newline after an in-place bar, last plain line if not yet shown).
     void finish();
 
-private:
+  private:
     std::FILE* out_;
     bool interactive_;
     double interval_;

@@ -52,8 +52,10 @@ void checkOutputPath(const std::string& path, const std::string& ext, const std:
 /// Parses "WxH" (positive integers up to 16384).
 void parseResolution(const std::string& s, int* w, int* h) {
     auto bad = [&] {
-        return UsageError("--resolution: expected WIDTHxHEIGHT with positive integers up to "
-                          "16384 (e.g. 640x480), got '" + s + "'");
+        return UsageError(
+            "--resolution: expected WIDTHxHEIGHT with positive integers up to "
+            "16384 (e.g. 640x480), got '" +
+            s + "'");
     };
     size_t x = s.find_first_of("xX");
     if (x == std::string::npos || x == 0 || x + 1 >= s.size()) throw bad();
@@ -88,8 +90,7 @@ int runRender(const RenderArgs& args) {
         exrPath = fs::path(args.scene).stem().string() + ".exr";
     if (!exrPath.empty()) checkOutputPath(exrPath, ".exr", "-o/--output");
     if (!args.pngPath.empty()) checkOutputPath(args.pngPath, ".png", "--png");
-    if (!fs::exists(args.scene))
-        throw UsageError("scene file '" + args.scene + "' does not exist");
+    if (!fs::exists(args.scene)) throw UsageError("scene file '" + args.scene + "' does not exist");
 
     std::unique_ptr<tbb::global_control> threadLimit;
     if (args.threads > 0)
@@ -101,8 +102,8 @@ int runRender(const RenderArgs& args) {
     if (width > 0) {
         const Camera& c = scene->camera;
         Camera resized;
-        resized.setup(c.position(), c.position() + c.forward(), c.up(), c.fovYDeg(), width,
-                      height, c.lensRadius(), c.focusDistance());
+        resized.setup(c.position(), c.position() + c.forward(), c.up(), c.fovYDeg(), width, height,
+                      c.lensRadius(), c.focusDistance());
         scene->camera = resized;
     }
     RenderOptions options;

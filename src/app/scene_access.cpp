@@ -16,6 +16,8 @@ std::unique_ptr<Scene> loadSceneFile(const std::string& path) {
     return scene;
 }
 
-std::string sceneDescription(const Scene& scene) { return describeScene(scene); }
+std::string sceneDescription(const Scene& scene) {
+    return describeScene(scene);
+}
 
 }  // namespace ub::app

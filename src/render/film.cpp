@@ -56,9 +56,7 @@ void SplatBuffer::clear() {
 
 std::pair<size_t, size_t> SplatBuffer::chunkRange(int chunk, size_t pathCount) {
     // Chunk c gets [c * n / K, (c + 1) * n / K): sizes differ by at most one.
-    auto bound = [&](size_t c) {
-        return size_t((unsigned __int128)(c) * pathCount / kChunkCount);
-    };
+    auto bound = [&](size_t c) { return size_t((unsigned __int128)(c)*pathCount / kChunkCount); };
     return {bound(size_t(chunk)), bound(size_t(chunk) + 1)};
 }
 

@@ -41,7 +41,7 @@
 namespace ub {
 
 class Film {
-public:
+  public:
     Film() = default;
     Film(int width, int height) { reset(width, height); }
     void reset(int width, int height);
@@ -54,14 +54,14 @@ public:
     int width() const { return width_; }
     int height() const { return height_; }
 
-private:
+  private:
     int width_ = 0, height_ = 0;
     int iterations_ = 0;
     std::vector<double> sum_;  ///< 3 per pixel
 };
 
 class SplatBuffer {
-public:
+  public:
     /// Number of chunks: fixed, so results never depend on the thread count. 64 chunks
     /// keep 2-64 threads busy with little imbalance.
     static constexpr int kChunkCount = 64;
@@ -72,7 +72,7 @@ public:
     };
 
     class Chunk {
-    public:
+      public:
         /// Adds value to the pixel containing raster position (x right, y down); positions
         /// outside the image are ignored.
         void add(const Vec2& raster, const Rgb& value) {
@@ -87,7 +87,7 @@ public:
         }
         size_t size() const { return splats_.size(); }
 
-    private:
+      private:
         friend class SplatBuffer;
         int width_ = 0, height_ = 0;
         std::vector<Splat> splats_;
@@ -103,8 +103,7 @@ public:
     static std::pair<size_t, size_t> chunkRange(int chunk, size_t pathCount);
     /// Runs body(chunk, begin, end) for every chunk, in parallel (TBB); each chunk is run
     /// by exactly one task. body must only write to its own chunk.
-    void forEachChunk(size_t pathCount,
-                      const std::function<void(Chunk&, size_t, size_t)>& body);
+    void forEachChunk(size_t pathCount, const std::function<void(Chunk&, size_t, size_t)>& body);
     Chunk& chunk(int c) { return chunks_[size_t(c)]; }
 
     /// image += every splat, chunk 0 first, each chunk in recording order.
@@ -112,7 +111,7 @@ public:
     /// Total number of splats recorded since clear().
     size_t splatCount() const;
 
-private:
+  private:
     int width_ = 0, height_ = 0;
     std::vector<Chunk> chunks_;
 };

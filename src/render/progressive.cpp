@@ -22,9 +22,13 @@ extern "C" void onStopSignal(int sig) {
 
 }  // namespace
 
-std::atomic<bool>& stopRequested() { return gStop; }
+std::atomic<bool>& stopRequested() {
+    return gStop;
+}
 
-int lastStopSignal() { return int(gLastSignal); }
+int lastStopSignal() {
+    return int(gLastSignal);
+}
 
 void installStopSignalHandlers() {
     static_assert(std::atomic<bool>::is_always_lock_free, "stop flag must be lock-free");
@@ -64,8 +68,7 @@ ProgressiveResult renderProgressive(Integrator& integrator, int width, int heigh
             info.timeLimitSeconds = std::max(0.0, options.timeLimitSeconds);
             double perIteration = info.elapsedSeconds / info.iteration;
             double eta = -1;
-            if (options.iterations > 0)
-                eta = perIteration * (options.iterations - info.iteration);
+            if (options.iterations > 0) eta = perIteration * (options.iterations - info.iteration);
             if (options.timeLimitSeconds > 0) {
                 double etaTime = std::max(0.0, options.timeLimitSeconds - info.elapsedSeconds);
                 eta = eta < 0 ? etaTime : std::min(eta, etaTime);

@@ -26,8 +26,8 @@
 namespace ub {
 
 struct ProgressInfo {
-    int iteration = 0;          ///< iterations finished
-    int targetIterations = 0;   ///< 0 if the render is time-limited only
+    int iteration = 0;         ///< iterations finished
+    int targetIterations = 0;  ///< 0 if the render is time-limited only
     double elapsedSeconds = 0;
     double timeLimitSeconds = 0;  ///< 0 if none
     /// Estimated seconds left (from the mean iteration time), < 0 if unknown.
@@ -35,8 +35,8 @@ struct ProgressInfo {
 };
 
 struct ProgressiveOptions {
-    int iterations = 0;            ///< > 0: number of iterations
-    double timeLimitSeconds = 0;   ///< > 0: wall-clock limit
+    int iterations = 0;           ///< > 0: number of iterations
+    double timeLimitSeconds = 0;  ///< > 0: wall-clock limit
     /// Called after every iteration, on the calling thread.
     std::function<void(const ProgressInfo&)> progress;
     /// Stop flag polled between iterations (nullptr: use the global one set by the
@@ -45,9 +45,9 @@ struct ProgressiveOptions {
 };
 
 struct ProgressiveResult {
-    Image image;          ///< average of the rendered iterations
+    Image image;  ///< average of the rendered iterations
     int iterations = 0;
-    double seconds = 0;   ///< wall-clock time of the iterations
+    double seconds = 0;        ///< wall-clock time of the iterations
     bool interrupted = false;  ///< stopped by the stop flag before the target was reached
 };
 

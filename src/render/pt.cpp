@@ -72,17 +72,20 @@ Rgb PathTracer::tracePixel(int x, int y, int iteration) const {
 
     Rgb radiance(0.0f);
     Rgb throughput(1.0f);
-    float lastPdfW = 1.0f;   // pdf (solid angle, incl. roulette) of the last sampled direction
-    bool lastDelta = true;   // the last direction came from the camera or a delta lobe
+    float lastPdfW = 1.0f;  // pdf (solid angle, incl. roulette) of the last sampled direction
+    bool lastDelta = true;  // the last direction came from the camera or a delta lobe
 
     // MIS weight of an emitter found by the BSDF-sampled ray of segment `pathLength`,
     // where light sampling would have had solid-angle pdf lightPdfW (selection included).
     auto emitterHitWeight = [&](int pathLength, float lightPdfW) -> float {
         if (pathLength == 1 || lastDelta) return 1.0f;  // no NEE could have found it
         switch (strategy_) {
-            case PtStrategy::BsdfOnly: return 1.0f;
-            case PtStrategy::LightOnly: return 0.0f;
-            case PtStrategy::Mis: break;
+            case PtStrategy::BsdfOnly:
+                return 1.0f;
+            case PtStrategy::LightOnly:
+                return 0.0f;
+            case PtStrategy::Mis:
+                break;
         }
         return ub_mis_weight2(lastPdfW, lightPdfW, misBeta_);
     };
@@ -99,8 +102,8 @@ Rgb PathTracer::tracePixel(int x, int y, int iteration) const {
                 Rgb le = env.radianceAlong(sphere, ray.dir, ray.org, Vec3(0.0f), &directPdfW,
                                            &emissionPdfW);
                 if (!isBlack(le))
-                    radiance += throughput * le *
-                                emitterHitWeight(pathLength, directPdfW * lightPickProb_);
+                    radiance +=
+                        throughput * le * emitterHitWeight(pathLength, directPdfW * lightPickProb_);
             }
             break;
         }
@@ -134,8 +137,8 @@ Rgb PathTracer::tracePixel(int x, int y, int iteration) const {
             const Vec2 lightU = rng.uniform2();
             Vec3 dirToLight;
             float distance = 0.0f, directPdfW = 0.0f, emissionPdfW = 0.0f, cosAtLight = 0.0f;
-            Rgb le = light.illuminate(sphere, hit.pos, lightU, &dirToLight, &distance,
-                                      &directPdfW, &emissionPdfW, &cosAtLight);
+            Rgb le = light.illuminate(sphere, hit.pos, lightU, &dirToLight, &distance, &directPdfW,
+                                      &emissionPdfW, &cosAtLight);
             if (!isBlack(le) && directPdfW > 0.0f) {
                 float cosThetaGen = 0.0f, bsdfPdfW = 0.0f;
                 Rgb f = bsdf.evaluate(dirToLight, &cosThetaGen, &bsdfPdfW, nullptr);
@@ -156,11 +159,10 @@ Rgb PathTracer::tracePixel(int x, int y, int iteration) const {
                             Vec3 lightPos = hit.pos + dirToLight * distance;
                             Vec3 lightOffsetDir =
                                 light.type == LightType::Point ? Vec3(0.0f) : -dirToLight;
-                            blocked = scene_.occluded(hit.pos, hit.geoNormal, lightPos,
-                                                      lightOffsetDir);
+                            blocked =
+                                scene_.occluded(hit.pos, hit.geoNormal, lightPos, lightOffsetDir);
                         } else {
-                            blocked = scene_.occludedToInfinity(hit.pos, hit.geoNormal,
-                                                                dirToLight);
+                            blocked = scene_.occludedToInfinity(hit.pos, hit.geoNormal, dirToLight);
                         }
                         if (!blocked) radiance += contrib;
                     }

@@ -62,7 +62,7 @@ enum class PtStrategy {
 };
 
 class PathTracer : public Integrator {
-public:
+  public:
     PathTracer(const Scene& scene, const RenderOptions& options,
                PtStrategy strategy = PtStrategy::Mis);
     void renderIteration(int iteration, Image& out) override;
@@ -73,7 +73,7 @@ public:
     /// iteration `iteration`.
     Rgb tracePixel(int x, int y, int iteration) const;
 
-private:
+  private:
     const Scene& scene_;
     RenderOptions options_;
     PtStrategy strategy_;
