@@ -30,6 +30,11 @@ void ProgressBar::update(const ProgressInfo& info) {
     if (info.targetIterations > 0) its += "/" + std::to_string(info.targetIterations);
     std::string eta = info.etaSeconds >= 0 ? formatSeconds(info.etaSeconds) : "?";
     if (interactive_) {
+        // Redraw at most 10 times a second; finish() draws the final state.
+        lastShown_ = false;
+        if (drawn_ && info.elapsedSeconds - lastPrinted_ < 0.1) return;
+        lastPrinted_ = info.elapsedSeconds;
+        lastShown_ = true;
         double fraction = 0;
         if (info.targetIterations > 0) fraction = double(info.iteration) / info.targetIterations;
         if (info.timeLimitSeconds > 0)
@@ -56,6 +61,10 @@ void ProgressBar::update(const ProgressInfo& info) {
 
 void ProgressBar::finish() {
     if (interactive_) {
+        if (!lastShown_) {
+            drawn_ = false;
+            update(last_);
+        }
         if (drawn_) std::fputc('\n', out_);
     } else if (!lastShown_) {
         lastPrinted_ = -1e30;

@@ -1,5 +1,5 @@
 // Progress display of a render on stderr.
-//  * On a terminal (isatty): one line redrawn in place,
+//  * On a terminal (isatty): one line redrawn in place (at most 10 times a second),
 //      [##########----------]  12/100 it   3.2 s elapsed   ETA 24.1 s
 //    (for time-limited renders the bar shows elapsed / limit).
 //  * Otherwise (log files, CI): a plain line at most every `intervalSeconds`,
