@@ -332,6 +332,54 @@ TEST(Pt, EnvironmentMisAgreesWithBsdfSampling) {
     expectAgree(sMis, sLight, res, "env: MIS vs light sampling");
 }
 
+// Delta lights (which only NEE can reach): a diffuse plane z = 0 of albedo rho seen straight
+// down through a 0.5 degree field of view, so every pixel sees a point within
+// r = h tan(0.25 deg) of the origin. The exact radiance there is
+//   point light of intensity I at height h:   L = rho/pi * I cos(theta) / d^2,
+//   directional light of irradiance E:        L = rho/pi * E cos(theta_light),
+// and cos(theta) / d^2 varies over the visible disc by < 3 (r/h)^2 = 6e-5 (relative), the
+// only difference allowed besides float rounding: bound 2e-4 relative. There is no noise:
+// each light has one sample, and the plane reflects into the empty sky.
+TEST(Pt, DeltaLightsMatchAnalyticDirectLight) {
+    for (LightType type : {LightType::Point, LightType::Directional}) {
+        Scene scene;
+        Material plane;
+        plane.diffuse = Rgb(0.2f, 0.5f, 0.8f);
+        int planeId = scene.addMaterial(plane);
+        TriangleMesh quad = makeRectangle();
+        transformMesh(quad, Transform::scale(Vec3(10.0f)));
+        scene.addMesh(quad, planeId, -1, "plane");
+        Light light;
+        light.type = type;
+        const float h = 2.0f;
+        Rgb expected;
+        if (type == LightType::Point) {
+            light.position = Vec3(0, 0, h);
+            light.intensity = Rgb(3.0f, 2.0f, 1.0f);
+            expected = plane.diffuse * light.intensity * (kInvPi / (h * h));
+        } else {
+            light.direction = normalize(Vec3(0.6f, 0.0f, -0.8f));
+            light.radiance = Rgb(1.0f, 2.0f, 3.0f);
+            expected = plane.diffuse * light.radiance * (kInvPi * 0.8f);
+        }
+        scene.addLight(light);
+        scene.camera.setup(Vec3(0.0f, 0.0f, h), Vec3(0, 0, 0), Vec3(0, 1, 0), 0.5f, 8, 8);
+        scene.commit();
+        RenderOptions opt;
+        opt.seed = 21;
+        auto pt = makeIntegrator(scene, opt);
+        Image img;
+        for (int it = 0; it < 2; ++it) {
+            pt->renderIteration(it, img);
+            for (const Rgb& p : img.pixels)
+                for (int c = 0; c < 3; ++c)
+                    ASSERT_NEAR(p[c], expected[c], 2e-4f * expected[c])
+                        << (type == LightType::Point ? "point" : "directional")
+                        << " light, channel " << c;
+        }
+    }
+}
+
 TEST(Integrator, UnknownNameListsValidNames) {
     auto scene = furnaceScene(Rgb(0.5f), Rgb(1.0f), 4);
     RenderOptions opt;
