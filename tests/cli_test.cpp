@@ -58,8 +58,10 @@ std::string quote(const std::string& s) {
 }
 
 /// Runs the binary with args (each shell-quoted), capturing stdout and stderr.
-RunResult runUnibeam(const std::vector<std::string>& args, const fs::path& dir) {
-    std::string cmd = quote(kBinary);
+RunResult runUnibeam(const std::vector<std::string>& args, const fs::path& dir,
+                     bool inDir = false) {
+    std::string cmd =
+        (inDir ? "cd " + quote(dir.string()) + " && " : std::string()) + quote(kBinary);
     for (const auto& a : args) cmd += " " + quote(a);
     fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
     cmd += " >" + quote(out.string()) + " 2>" + quote(err.string()) + " </dev/null";
@@ -128,6 +130,24 @@ TEST(Cli, RenderWritesExrAndPngWithMetadata) {
         ASSERT_TRUE(img1.pixels[i].x == img.pixels[i].x && img1.pixels[i].y == img.pixels[i].y &&
                     img1.pixels[i].z == img.pixels[i].z)
             << "pixel " << i;
+    fs::remove_all(dir);
+}
+
+// -t: the render stops after the iteration during which the limit passed; without -o the
+// EXR goes to SCENE_STEM.exr in the current directory.
+TEST(Cli, TimeLimitAndDefaultOutputName) {
+    ASSERT_TRUE(fs::exists(kScene)) << kScene;
+    fs::path dir = tempDir();
+    auto start = std::chrono::steady_clock::now();
+    RunResult r = runUnibeam({"render", kScene, "--resolution", "16x16", "-t", "0.3"}, dir, true);
+    double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    ImageMetadata meta;
+    Image img = readExr((dir / "cornell-large-light.exr").string(), &meta);
+    EXPECT_EQ(img.width, 16);
+    EXPECT_GE(std::stoi(meta["iterations"]), 1);
+    EXPECT_GE(std::stod(meta["renderTimeSeconds"]), 0.3);
+    EXPECT_LT(wall, 60.0);
     fs::remove_all(dir);
 }
 
