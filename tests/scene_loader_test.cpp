@@ -108,6 +108,17 @@ TEST(JsonPositions, ColumnsCountCodePointsAndDuplicatesAreFound) {
     EXPECT_EQ(idx.duplicates()[0].again.column, 20);
 }
 
+TEST(JsonPositions, DeepNestingDoesNotExhaustTheStack) {
+    const int depth = 200000;
+    std::string text = "{\"x\": " + std::string(depth, '[') + std::string(depth, ']') + "}";
+    JsonPositionIndex idx(text);
+    EXPECT_EQ(idx.value("/x").column, 7);
+    EXPECT_EQ(idx.value("/x/0/0/0").column, 10);
+    // The loader reports the document as a scene error, without crashing.
+    auto d = errorsOf(text);
+    EXPECT_FALSE(d.empty());
+}
+
 // ---------------------------------------------------------------- valid scenes
 
 TEST(JsonLoader, MinimalSceneHasExpectedContents) {

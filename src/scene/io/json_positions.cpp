@@ -58,6 +58,8 @@ class JsonScanner {
     std::vector<size_t> lineStarts_;
     size_t i_ = 0;
     bool failed_ = false;
+    int depth_ = 0;
+    static constexpr int kMaxDepth = 256;
 
     SourcePos pos(size_t offset) const {
         auto it = std::upper_bound(lineStarts_.begin(), lineStarts_.end(), offset);
@@ -167,10 +169,17 @@ class JsonScanner {
     }
 
     void value(const std::string& ptr) {
-        if (failed_ || i_ >= s_.size()) {
+        // Deeper nesting than any scene needs: stop (positions below fall back to the
+        // ancestors) rather than risk the stack on a hostile file.
+        if (failed_ || i_ >= s_.size() || depth_ > kMaxDepth) {
             failed_ = true;
             return;
         }
+        struct DepthGuard {
+            int& d;
+            explicit DepthGuard(int& x) : d(x) { ++d; }
+            ~DepthGuard() { --d; }
+        } guard(depth_);
         idx_.values_[ptr] = pos(i_);
         char c = s_[i_];
         if (c == '{') {
