@@ -32,7 +32,7 @@ struct VdbGridBuilder {
                                                 const std::string& label,
                                                 const std::string& gridName) {
         auto fail = [&](const std::string& what) {
-            throw InputError(label, "grid " + quoted(gridName) + ": " + what);
+            throw InputError(label, "grid " + quoted(gridName) + " " + what);
         };
         const openvdb::math::Transform& xform = grid.transform();
         if (!xform.isLinear())
