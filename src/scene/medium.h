@@ -16,6 +16,15 @@
 // blocks that hold no leaf node in one step. The optical depth is then
 // piecewise linear in t, so transmittance T = exp(-sum_i sigma_t,i * len_i) is
 // exact and free-flight sampling inverts it exactly.
+// Why our own DDA and not nanovdb::HDDA (nanovdb/util/HDDA.h): HDDA treats
+// voxel ijk as the box [ijk, ijk + 1) of index space, whereas the value of a
+// voxel belongs to the cell centred on ijk (what nearest-neighbour lookup and
+// OpenVDB's cell-centred convention use); we walk in "cell space" = index
+// space + 1/2, so the pieces of a walk and a point lookup always agree. And
+// nanovdb/CNanoVDB.h, which the OpenCL kernels will use, has no HDDA: this
+// walk needs only "value at ijk" and "does ijk lie in a leaf node" (the
+// latter is where CNanoVDB's read accessor descends to, and caches, a leaf),
+// so it ports to kernels without a DDA library.
 //
 // Free-flight (distance) sampling with RGB coefficients (spectral MIS; Novak
 // et al. 2018, Sec. 5.1): pick channel c uniformly, sample t with density
