@@ -167,3 +167,97 @@ TEST(MisBruteForce, TechniqueSetsFollowSmallVcm) {
     EXPECT_EQ(t[0].index, 0);
     EXPECT_EQ(t[1].index, 3);
 }
+
+// ---- Paths through scenes built in code, every pdf from the real Bsdf / Light ----
+
+#include "tests/support/mis_scene_path.h"
+
+namespace {
+
+std::vector<Material> testMaterials() {
+    std::vector<Material> m(6);
+    m[0].name = "diffuse";
+    m[0].diffuse = Rgb(0.7f, 0.5f, 0.3f);
+    m[1].name = "glossy phong";
+    m[1].type = MaterialType::Phong;
+    m[1].diffuse = Rgb(0.2f);
+    m[1].glossy = Rgb(0.6f);
+    m[1].exponent = 30;
+    m[2].name = "mirror";
+    m[2].type = MaterialType::Mirror;
+    m[3].name = "glass";
+    m[3].type = MaterialType::Dielectric;
+    m[3].ior = 1.5f;
+    m[4].name = "rough conductor";
+    m[4].type = MaterialType::RoughConductor;
+    m[4].alpha = 0.3f;
+    m[5].name = "rough glass";
+    m[5].type = MaterialType::RoughDielectric;
+    m[5].alpha = 0.3f;
+    m[5].ior = 1.5f;
+    return m;
+}
+
+Light quadLight() {
+    Light l;
+    l.type = LightType::Area;
+    l.name = "quad";
+    l.radiance = Rgb(5.0f);
+    Vec3 a(-0.5f, -0.5f, 0), b(0.5f, -0.5f, 0), c(0.5f, 0.5f, 0), d(-0.5f, 0.5f, 0);
+    l.triangles = {a, b, c, a, c, d};  // emits towards +z
+    l.prepare();
+    return l;
+}
+
+Light pointLight() {
+    Light l;
+    l.type = LightType::Point;
+    l.name = "point";
+    l.intensity = Rgb(3.0f);
+    l.position = Vec3(0, 0, 0);
+    l.prepare();
+    return l;
+}
+
+}  // namespace
+
+TEST(MisBruteForce, ScenePathsWithRealBsdfsMatchExplicitPdfWeights) {
+    const std::vector<Material> materials = testMaterials();
+    const Light lights[2] = {quadLight(), pointLight()};
+    const MisLightKind kinds[2] = {MisLightKind::Area, MisLightKind::Point};
+    SceneSphere sphere;
+    sphere.radius = 5.0f;
+    sphere.invRadiusSqr = 1.0f / 25.0f;
+    Rng rng(2024, 3);
+    int paths = 0, compared = 0, attempts = 0;
+    for (const NamedConfig& nc : configs()) {
+        for (int n = 0; n < 600; ++n) {
+            int li = n % 2;
+            int k = 2 + int(rng.uniform() * 6);
+            MisPath p;
+            std::string problem;
+            bool ok = false;
+            for (int tries = 0; tries < 200 && !ok; ++tries, ++attempts) {
+                ok = sampleScenePath(rng, lights[li], kinds[li], 0.5f, sphere, materials, k, &p,
+                                     &problem);
+                ASSERT_TRUE(problem.empty()) << problem;
+            }
+            ASSERT_TRUE(ok) << "could not sample a path of length " << k;
+            ++paths;
+            auto ref = bruteForceWeights(p, nc.cfg);
+            auto rec = recursiveWeights(p, nc.cfg);
+            ASSERT_EQ(ref.size(), rec.size());
+            double sum = 0;
+            for (size_t t = 0; t < ref.size(); ++t) {
+                ASSERT_NEAR(rec[t].weight, ref[t].weight, 1e-4)
+                    << nc.name << " " << lights[li].name << " k=" << k << " technique "
+                    << ref[t].name();
+                sum += rec[t].weight;
+                ++compared;
+            }
+            if (!rec.empty()) ASSERT_NEAR(sum, 1.0, 1e-4) << nc.name << " k=" << k;
+        }
+    }
+    EXPECT_EQ(paths, 6 * 600);
+    EXPECT_GT(compared, 5000);
+}

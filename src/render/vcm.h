@@ -1,0 +1,121 @@
+// The surface bidirectional family in one engine, with SmallVCM's algorithm
+// names (Georgiev et al. 2012, "Light Transport Simulation with Vertex
+// Connection and Merging"; tech. report "Implementing Vertex Connection and
+// Merging", cited as [TR (n)]):
+//
+//   lt   light tracing: light subpaths connected to the camera (no MIS)
+//   bpt  bidirectional path tracing: camera hits, NEE, vertex connections and
+//        light tracing, combined by MIS
+//   ppm  progressive photon mapping (Hachisuka et al. 2008): merging at the first
+//        non-specular camera vertex, no MIS
+//   bpm  bidirectional photon mapping (Vorba 2011): merging at every non-specular
+//        camera vertex, combined by MIS
+//   vcm  vertex connection and merging: all of bpt plus bpm, combined by MIS
+//
+// One iteration (DESIGN.md): (1) one light subpath per pixel, its non-specular
+// vertices stored as LightVertex with MIS partials (render/light_vertex.h),
+// light-tracing splats recorded in a deterministic SplatBuffer; (2) a hashed grid
+// over the light vertices (merging algorithms); (3) one camera subpath per
+// pixel, paired with the light subpath of the same index for connections.
+// The MIS math is kernels/shared/ub_mis.h.
+//
+// Merging radius of iteration i (1-based): r_i = r_1 i^((alpha-1)/2) (Knaus &
+// Zwicker 2011; TR Sec. 4), r_1 = RenderOptions::radius, times the scene
+// bounding-sphere radius if radiusIsRelative.
+//
+// Conventions shared with `pt` (render/pt.h): path length counts segments, a
+// light seen directly has length 1; surfaces that emit and have a material keep
+// scattering; Russian roulette with Bsdf::continuationProb(). Light tracing
+// needs a pinhole camera: lt, bpt and vcm reject thin-lens cameras.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "estimators/hash_grid.h"
+#include "kernels/shared/ub_mis.h"
+#include "render/film.h"
+#include "render/integrator.h"
+#include "render/light_vertex.h"
+#include "scene/bsdf.h"
+
+namespace ub {
+
+class Rng;
+
+class VertexCM : public Integrator {
+public:
+    enum class Algorithm { LightTrace, Bpt, Ppm, Bpm, Vcm };
+
+    /// Reads options.algorithm (lt, bpt, ppm, bpm, vcm). Throws InputError for another
+    /// name, a thin-lens camera with lt/bpt/vcm, or a bad radius/alpha.
+    VertexCM(const Scene& scene, const RenderOptions& options);
+    void renderIteration(int iteration, Image& out) override;
+
+    Algorithm algorithm() const { return algorithm_; }
+    /// Merging radius used by iteration `iteration` (0-based).
+    float radiusAt(int iteration) const;
+    /// Light vertices stored by the last iteration (for tests).
+    const std::vector<LightVertex>& lightVertices() const { return lightVertices_; }
+
+private:
+    /// State of a subpath being traced (SmallVCM's SubPathState).
+    struct SubPath {
+        Ray ray;                  ///< next segment
+        Rgb throughput{1, 1, 1};
+        int pathLength = 1;       ///< segments, including the one being traced
+        bool isFiniteLight = true;
+        bool specularPath = true; ///< every scattering so far was specular (camera side)
+        ub_mis_partials mis{};    ///< dVCM, dVC, dVM
+    };
+
+    // Light pass (vcm_light.cpp): traces light subpaths [begin, end) of an iteration.
+    void traceLightPaths(int iteration, size_t begin, size_t end, SplatBuffer::Chunk& splats,
+                         std::vector<LightVertex>& vertices, std::vector<uint32_t>& pathEnds) const;
+    bool startLightPath(Rng& rng, SubPath& state) const;
+    void connectToCamera(const SubPath& state, const Hit& hit, const Bsdf& bsdf,
+                         SplatBuffer::Chunk& splats) const;
+
+    // Camera pass (vcm_camera.cpp).
+    Rgb traceCameraPath(int x, int y, int iteration) const;
+    Rgb lightHitRadiance(const Light& light, const SubPath& state, const Vec3& rayDir,
+                         const Vec3& hitPos, const Vec3& hitNormal) const;
+    Rgb directIllumination(Rng& rng, const SubPath& state, const Hit& hit,
+                           const Bsdf& bsdf) const;
+    Rgb connectVertices(const LightVertex& lv, const SubPath& state, const Hit& hit,
+                        const Bsdf& bsdf) const;
+    Rgb mergeVertices(const SubPath& state, const Hit& hit, const Bsdf& bsdf) const;
+
+    // Shared: samples the next direction (Russian roulette, MIS update [TR (34)-(36)],
+    // [TR (53)-(55)]). Returns false if the subpath ends.
+    bool sampleScattering(Rng& rng, const Bsdf& bsdf, const Hit& hit, SubPath& state) const;
+
+    const Scene& scene_;
+    RenderOptions options_;
+    Algorithm algorithm_;
+    bool useVC_ = false, useVM_ = false, lightTraceOnly_ = false, ppm_ = false;
+    float baseRadius_ = 0;
+    float lightPickProb_ = 0;
+
+    // Per-iteration state (renderIteration writes, the passes read).
+    ub_mis_constants mis_{};
+    float lightSubPathCount_ = 0;
+    float vmNormalization_ = 0;  ///< 1 / (pi r^2 N_L)
+    std::vector<LightVertex> lightVertices_;
+    std::vector<uint32_t> pathEnds_;  ///< light subpath i owns [pathEnds_[i-1], pathEnds_[i])
+    HashGrid grid_;
+    std::vector<std::vector<LightVertex>> chunkVertices_;  ///< light pass output per chunk
+    std::vector<std::vector<uint32_t>> chunkEnds_;
+    SplatBuffer splats_;
+};
+
+/// Russian-roulette continuation probability of the bidirectional engine at a vertex with
+/// this BSDF. The MIS partials assume that a light and a camera subpath passing through a
+/// vertex would continue with the same probability (SmallVCM's albedo-based roulette).
+/// Bsdf::continuationProb() depends on dirFix for rough conductors (Fresnel at dirFix), so
+/// for those the direction-free bound max(specular) is used; otherwise it is the same.
+float vcmContinuationProb(const Bsdf& bsdf);
+
+std::unique_ptr<Integrator> makeVertexCM(const Scene& scene, const RenderOptions& options);
+
+}  // namespace ub
