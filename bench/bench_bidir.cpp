@@ -22,9 +22,8 @@
 using namespace ub;
 
 int main(int argc, char** argv) {
-    std::string scenePath = argc > 1 ? argv[1]
-                                     : std::string(UNIBEAM_SOURCE_DIR) +
-                                           "/scenes/cornell-small-light.json";
+    std::string scenePath =
+        argc > 1 ? argv[1] : std::string(UNIBEAM_SOURCE_DIR) + "/scenes/cornell-small-light.json";
     const int iterations = argc > 2 ? std::atoi(argv[2]) : 4;
     const int runs = argc > 3 ? std::atoi(argv[3]) : 5;
     const int threads = argc > 4 ? std::atoi(argv[4]) : 0;
@@ -35,8 +34,8 @@ int main(int argc, char** argv) {
     }
     std::unique_ptr<tbb::global_control> limit;
     if (threads > 0)
-        limit = std::make_unique<tbb::global_control>(
-            tbb::global_control::max_allowed_parallelism, size_t(threads));
+        limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                      size_t(threads));
 
     std::unique_ptr<Scene> scene;
     try {

@@ -9,14 +9,13 @@
 #include <tbb/task_arena.h>
 
 #include <cmath>
+#include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "core/error.h"
 #include "render/vcm.h"
-#include <fstream>
-#include <nlohmann/json.hpp>
-
 #include "scene/io/json_loader.h"
 #include "scene/shapes.h"
 #include "tests/support/render_stats.h"
@@ -62,8 +61,8 @@ std::unique_ptr<Scene> furnaceScene(const Rgb& rho, const Rgb& le, int res) {
     for (uint32_t i : cube.indices) light.triangles.push_back(cube.positions[i]);
     int lightId = scene->addLight(light);
     scene->addMesh(cube, matId, lightId, "furnace");
-    scene->camera.setup(Vec3(0.1f, -0.05f, 0.0f), Vec3(0.3f, 0.2f, 1.0f), Vec3(0, 1, 0), 70.0f,
-                        res, res);
+    scene->camera.setup(Vec3(0.1f, -0.05f, 0.0f), Vec3(0.3f, 0.2f, 1.0f), Vec3(0, 1, 0), 70.0f, res,
+                        res);
     scene->commit();
     return scene;
 }
@@ -128,8 +127,8 @@ TEST_P(Bidir, CornellAgreesWithPt) {
                                  << zBlock << ")";
     for (int c = 0; c < 3; ++c) {
         EXPECT_LT(std::fabs(g.meanZ[c]), 3.9)
-            << "channel " << c << ": image mean " << s.imageMean(c) << " +- "
-            << s.imageStdErr(c) << " vs pt " << ref.imageMean(c) << " +- " << ref.imageStdErr(c);
+            << "channel " << c << ": image mean " << s.imageMean(c) << " +- " << s.imageStdErr(c)
+            << " vs pt " << ref.imageMean(c) << " +- " << ref.imageStdErr(c);
         // The test must resolve a 5% error of the mean: both standard errors below 1.25%.
         EXPECT_LT(s.imageStdErr(c), 0.0125 * ref.imageMean(c));
         EXPECT_LT(ref.imageStdErr(c), 0.0125 * ref.imageMean(c));
@@ -140,9 +139,9 @@ TEST_P(Bidir, CornellAgreesWithPt) {
 //
 // Every vertex sees emission Le and reflects with albedo rho, so a path of k segments
 // carries Le rho^(k-1): L = Le sum_{k=0}^{maxLength-1} rho^k exactly. Image mean per
-// channel within 4 standard errors (over 128, or 256 for ppm, independent iterations; two-sided 6e-5 each)
-// plus, for merging, a bound on the kernel bias: radiance and photon density are uniform,
-// so merging is exact except for queries closer than r to an edge of the cube (the ball
+// channel within 4 standard errors (over 128, or 256 for ppm, independent iterations; two-sided
+// 6e-5 each) plus, for merging, a bound on the kernel bias: radiance and photon density are
+// uniform, so merging is exact except for queries closer than r to an edge of the cube (the ball
 // leaves the face and catches photons of the adjacent face). Those bands cover
 // perimeter * r / area = 8 r / 4 = 2 r of each face, and there the estimate is off by at
 // most its own value, so |bias| <= 2 r L, with r = 0.005 x scene radius (~0.009).

@@ -1,12 +1,13 @@
 // HashGrid range queries against brute force: every point within the radius is
 // reported exactly once and nothing farther away, for clustered and spread
 // points, small and large radii (many cells share buckets), and an empty grid.
+#include "estimators/hash_grid.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
 #include "core/rng.h"
-#include "estimators/hash_grid.h"
 
 using namespace ub;
 

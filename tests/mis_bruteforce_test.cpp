@@ -19,7 +19,9 @@ using namespace ub::test;
 
 namespace {
 
-float uniformIn(Rng& rng, float lo, float hi) { return lo + (hi - lo) * rng.uniform(); }
+float uniformIn(Rng& rng, float lo, float hi) {
+    return lo + (hi - lo) * rng.uniform();
+}
 
 // A random path with k segments and primitives in moderate ranges. Specular
 // vertices use equal forward/reverse lobe probabilities, as delta BSDFs do.
@@ -85,8 +87,8 @@ std::vector<NamedConfig> configs() {
     return out;
 }
 
-const MisLightKind kKinds[] = {MisLightKind::Area, MisLightKind::Point,
-                               MisLightKind::Directional, MisLightKind::Environment};
+const MisLightKind kKinds[] = {MisLightKind::Area, MisLightKind::Point, MisLightKind::Directional,
+                               MisLightKind::Environment};
 
 }  // namespace
 
@@ -134,14 +136,14 @@ TEST(MisBruteForce, MergePartialIsConnectionPartialOverEta) {
     ub_mis_constants c = ub_mis_make_constants(0.05f, 1000.0f, 1, 1, UB_MIS_POWER);
     for (int n = 0; n < 1000; ++n) {
         MisPath p = randomPath(rng, 8, MisLightKind::Area, 0.3f);
-        ub_mis_partials lp = ub_mis_init_light(c, p.directPdfA, p.emitPosPdf * p.emitDirPdfW,
-                                               p.cosLight, 0, 1);
+        ub_mis_partials lp =
+            ub_mis_init_light(c, p.directPdfA, p.emitPosPdf * p.emitDirPdfW, p.cosLight, 0, 1);
         for (int i = 1; i < 8; ++i) {
             const MisVertex& x = p.v[i];
             lp = ub_mis_at_hit(c, lp, p.dist[i], x.cosIn, 1);
             ASSERT_NEAR(lp.dVM, lp.dVC * c.vcWeightFactor, 1e-5f * lp.dVM + 1e-30f);
-            lp = ub_mis_scatter(c, lp, x.cosOut, x.pdfFwdW * x.cont, x.pdfRevW * x.cont,
-                                x.specular);
+            lp =
+                ub_mis_scatter(c, lp, x.cosOut, x.pdfFwdW * x.cont, x.pdfRevW * x.cont, x.specular);
         }
     }
 }

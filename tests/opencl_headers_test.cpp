@@ -28,13 +28,15 @@ ClDevice findDevice() {
     ClDevice out;
     cl_uint np = 0;
     if (clGetPlatformIDs(0, nullptr, &np) != CL_SUCCESS || np == 0) {
-        out.error = "no OpenCL platform found (install PoCL: scripts/setup.sh installs "
-                    "pocl-opencl-icd; check /etc/OpenCL/vendors)";
+        out.error =
+            "no OpenCL platform found (install PoCL: scripts/setup.sh installs "
+            "pocl-opencl-icd; check /etc/OpenCL/vendors)";
         return out;
     }
     std::vector<cl_platform_id> platforms(np);
     clGetPlatformIDs(np, platforms.data(), nullptr);
-    for (cl_device_type type : {cl_device_type(CL_DEVICE_TYPE_CPU), cl_device_type(CL_DEVICE_TYPE_ALL)}) {
+    for (cl_device_type type :
+         {cl_device_type(CL_DEVICE_TYPE_CPU), cl_device_type(CL_DEVICE_TYPE_ALL)}) {
         for (cl_platform_id p : platforms) {
             cl_device_id d = nullptr;
             cl_uint nd = 0;
@@ -79,7 +81,8 @@ TEST(OpenClHeaders, EverySharedHeaderBuildsAsOpenClC) {
     ASSERT_FALSE(headers.empty()) << "no headers found in " << includeDir;
     for (const std::string& h : headers) {
         SCOPED_TRACE(h);
-        std::string src = "#include \"" + h + "\"\n__kernel void ub_header_probe(__global int* o) { o[0] = 1; }\n";
+        std::string src = "#include \"" + h +
+                          "\"\n__kernel void ub_header_probe(__global int* o) { o[0] = 1; }\n";
         const char* s = src.c_str();
         size_t len = src.size();
         cl_program prog = clCreateProgramWithSource(ctx, 1, &s, &len, &err);
@@ -96,7 +99,8 @@ TEST(OpenClHeaders, EverySharedHeaderBuildsAsOpenClC) {
         while (!log.empty() && log.back() == '\0') log.pop_back();
         EXPECT_EQ(buildErr, CL_SUCCESS)
             << "kernels/shared/" << h << " does not build as OpenCL C on " << dev.description
-            << ":\n" << log;
+            << ":\n"
+            << log;
         clReleaseProgram(prog);
     }
     clReleaseContext(ctx);

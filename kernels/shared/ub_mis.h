@@ -139,16 +139,16 @@ UB_INLINE ub_mis_partials ub_mis_scatter(ub_mis_constants c, ub_mis_partials p, 
     if (isSpecular) {
         /* For a delta lobe the forward and reverse pdfs are equal and cancel;
          * no connection or merging can use this vertex [TR (53)-(55)]. */
-        q.dVCM = 0.0f;                               /* [TR (53)] */
-        q.dVC = p.dVC * ub_mis(c, cosOut);           /* [TR (54)] */
-        q.dVM = p.dVM * ub_mis(c, cosOut);           /* [TR (55)] */
+        q.dVCM = 0.0f;                     /* [TR (53)] */
+        q.dVC = p.dVC * ub_mis(c, cosOut); /* [TR (54)] */
+        q.dVM = p.dVM * ub_mis(c, cosOut); /* [TR (55)] */
         return q;
     }
     float g = ub_mis(c, cosOut / dirPdfW);
     float rev = ub_mis(c, revPdfW);
-    q.dVC = g * (p.dVC * rev + p.dVCM + c.vmWeightFactor);          /* [TR (34)] */
-    q.dVM = g * (p.dVM * rev + p.dVCM * c.vcWeightFactor + 1.0f);  /* [TR (35)] */
-    q.dVCM = ub_mis(c, 1.0f / dirPdfW);                             /* [TR (36)] */
+    q.dVC = g * (p.dVC * rev + p.dVCM + c.vmWeightFactor);        /* [TR (34)] */
+    q.dVM = g * (p.dVM * rev + p.dVCM * c.vcWeightFactor + 1.0f); /* [TR (35)] */
+    q.dVCM = ub_mis(c, 1.0f / dirPdfW);                           /* [TR (36)] */
     return q;
 }
 
@@ -163,11 +163,11 @@ UB_INLINE float ub_mis_weight_connect(ub_mis_constants c, ub_mis_partials l, ub_
                                       float cameraDirPdfA, float lightRevPdfW, float lightDirPdfA,
                                       float cameraRevPdfW) {
     /* Partial light subpath weight [TR (40)] */
-    float wLight = ub_mis(c, cameraDirPdfA) *
-                   (c.vmWeightFactor + l.dVCM + l.dVC * ub_mis(c, lightRevPdfW));
+    float wLight =
+        ub_mis(c, cameraDirPdfA) * (c.vmWeightFactor + l.dVCM + l.dVC * ub_mis(c, lightRevPdfW));
     /* Partial camera subpath weight [TR (41)] */
-    float wCamera = ub_mis(c, lightDirPdfA) *
-                    (c.vmWeightFactor + e.dVCM + e.dVC * ub_mis(c, cameraRevPdfW));
+    float wCamera =
+        ub_mis(c, lightDirPdfA) * (c.vmWeightFactor + e.dVCM + e.dVC * ub_mis(c, cameraRevPdfW));
     return 1.0f / (wLight + 1.0f + wCamera); /* [TR (37)] */
 }
 
@@ -201,8 +201,8 @@ UB_INLINE float ub_mis_weight_hit_light(ub_mis_constants c, ub_mis_partials e, f
 /* Light tracing: light vertex y (partials l) connected to the camera.
  * cameraPdfA: pdf of the camera sampling y, area measure (p_cam,W |cos_y| / d^2);
  * bsdfRevPdfW: light BSDF at y sampling its previous vertex given the camera direction. */
-UB_INLINE float ub_mis_weight_light_trace(ub_mis_constants c, ub_mis_partials l,
-                                          float cameraPdfA, float bsdfRevPdfW) {
+UB_INLINE float ub_mis_weight_light_trace(ub_mis_constants c, ub_mis_partials l, float cameraPdfA,
+                                          float bsdfRevPdfW) {
     /* Partial light subpath weight [TR (46)]; the camera part is 0 [TR (47)] */
     float wLight = ub_mis(c, cameraPdfA / c.lightSubPathCount) *
                    (c.vmWeightFactor + l.dVCM + l.dVC * ub_mis(c, bsdfRevPdfW));

@@ -20,7 +20,7 @@
 namespace ub {
 
 class HashGrid {
-public:
+  public:
     /// Builds the grid over positions[0..count) (the pointer is read during build only;
     /// `stride` is the distance in bytes between consecutive positions, so callers can
     /// pass a member of an array of structs). cellCount 0 picks max(count, 1).
@@ -46,21 +46,21 @@ public:
     float radius() const { return radius_; }
     size_t cellCount() const { return cellEnds_.size(); }
 
-private:
+  private:
     /// Hash of integer cell coordinates (Teschner et al. 2003) into [0, cellCount).
     uint32_t cellIndex(int x, int y, int z) const {
-        uint32_t h = (uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^
-                     (uint32_t(z) * 83492791u);
+        uint32_t h =
+            (uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ (uint32_t(z) * 83492791u);
         return h % uint32_t(cellEnds_.size());
     }
     static const Vec3& at(const Vec3* base, size_t stride, size_t i) {
         return *reinterpret_cast<const Vec3*>(reinterpret_cast<const char*>(base) + i * stride);
     }
 
-    Vec3 lo_;                          ///< bounding box corner of the points
+    Vec3 lo_;  ///< bounding box corner of the points
     float radius_ = 0, radiusSqr_ = 0, invCellSize_ = 0;
-    std::vector<uint32_t> indices_;    ///< point indices sorted by bucket
-    std::vector<uint32_t> cellEnds_;   ///< end offset in indices_ of each bucket
+    std::vector<uint32_t> indices_;   ///< point indices sorted by bucket
+    std::vector<uint32_t> cellEnds_;  ///< end offset in indices_ of each bucket
 };
 
 template <class Visit>

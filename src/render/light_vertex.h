@@ -20,19 +20,19 @@
 namespace ub {
 
 struct LightVertex {
-    Vec3 position;            ///< world-space hit point
-    uint32_t pathLength;      ///< segments from the light source to this vertex (>= 1)
-    Vec3 throughput;          ///< Le cos / p_emit * prod f cos / p, before this vertex's BSDF
-    uint32_t materialId;      ///< index into Scene::materials
-    Vec3 dirFix;              ///< unit direction to the previous vertex (towards the light)
-    float continuationProb;   ///< Bsdf::continuationProb() of the light BSDF here
-    Vec3 geoNormal;           ///< geometric normal as stored on the surface
-    float dVCM;               ///< MIS partial [TR (31)/(36)]
-    Vec3 shadingNormal;       ///< shading normal as stored on the surface
-    float dVC;                ///< MIS partial [TR (32)/(34)]
-    float dVM;                ///< MIS partial [TR (33)/(35)]
-    uint32_t flags;           ///< reserved (0); e.g. medium vertices in UPBP
-    uint32_t pad0, pad1;      ///< explicit padding to 96 bytes (16-byte multiple)
+    Vec3 position;           ///< world-space hit point
+    uint32_t pathLength;     ///< segments from the light source to this vertex (>= 1)
+    Vec3 throughput;         ///< Le cos / p_emit * prod f cos / p, before this vertex's BSDF
+    uint32_t materialId;     ///< index into Scene::materials
+    Vec3 dirFix;             ///< unit direction to the previous vertex (towards the light)
+    float continuationProb;  ///< Bsdf::continuationProb() of the light BSDF here
+    Vec3 geoNormal;          ///< geometric normal as stored on the surface
+    float dVCM;              ///< MIS partial [TR (31)/(36)]
+    Vec3 shadingNormal;      ///< shading normal as stored on the surface
+    float dVC;               ///< MIS partial [TR (32)/(34)]
+    float dVM;               ///< MIS partial [TR (33)/(35)]
+    uint32_t flags;          ///< reserved (0); e.g. medium vertices in UPBP
+    uint32_t pad0, pad1;     ///< explicit padding to 96 bytes (16-byte multiple)
 };
 
 // Layout check: the struct is read as raw memory by device code later.

@@ -21,8 +21,8 @@ VertexCM::Algorithm parseAlgorithm(const std::string& name) {
     if (name == "ppm") return VertexCM::Algorithm::Ppm;
     if (name == "bpm") return VertexCM::Algorithm::Bpm;
     if (name == "vcm") return VertexCM::Algorithm::Vcm;
-    throw InputError("", "VertexCM: unknown algorithm '" + name +
-                             "' (valid: lt, bpt, ppm, bpm, vcm)");
+    throw InputError("",
+                     "VertexCM: unknown algorithm '" + name + "' (valid: lt, bpt, ppm, bpm, vcm)");
 }
 
 }  // namespace
@@ -30,11 +30,23 @@ VertexCM::Algorithm parseAlgorithm(const std::string& name) {
 VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
     : scene_(scene), options_(options), algorithm_(parseAlgorithm(options.algorithm)) {
     switch (algorithm_) {
-        case Algorithm::LightTrace: lightTraceOnly_ = true; break;
-        case Algorithm::Bpt: useVC_ = true; break;
-        case Algorithm::Ppm: ppm_ = true; useVM_ = true; break;
-        case Algorithm::Bpm: useVM_ = true; break;
-        case Algorithm::Vcm: useVC_ = true; useVM_ = true; break;
+        case Algorithm::LightTrace:
+            lightTraceOnly_ = true;
+            break;
+        case Algorithm::Bpt:
+            useVC_ = true;
+            break;
+        case Algorithm::Ppm:
+            ppm_ = true;
+            useVM_ = true;
+            break;
+        case Algorithm::Bpm:
+            useVM_ = true;
+            break;
+        case Algorithm::Vcm:
+            useVC_ = true;
+            useVM_ = true;
+            break;
     }
     if ((useVC_ || lightTraceOnly_) && !scene.camera.isPinhole())
         throw InputError(scene.sourceFile,
@@ -48,9 +60,8 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
             throw InputError(scene.sourceFile, "merging radius must be a positive number, got " +
                                                    std::to_string(options.radius));
         if (!(options.alpha > 0.0f && options.alpha <= 1.0f))
-            throw InputError(scene.sourceFile,
-                             "radius reduction alpha must be in (0, 1], got " +
-                                 std::to_string(options.alpha));
+            throw InputError(scene.sourceFile, "radius reduction alpha must be in (0, 1], got " +
+                                                   std::to_string(options.alpha));
     }
     baseRadius_ = options.radius * (options.radiusIsRelative ? scene.sceneSphere.radius : 1.0f);
     lightPickProb_ = scene.lights.empty() ? 0.0f : 1.0f / float(scene.lights.size());
@@ -72,9 +83,9 @@ void VertexCM::renderIteration(int iteration, Image& out) {
 
     lightSubPathCount_ = float(pathCount);
     const float radius = radiusAt(iteration);
-    mis_ = ub_mis_make_constants(radius, lightSubPathCount_, useVC_, useVM_,
-                                 options_.heuristic == MisHeuristic::Balance ? UB_MIS_BALANCE
-                                                                             : UB_MIS_POWER);
+    mis_ = ub_mis_make_constants(
+        radius, lightSubPathCount_, useVC_, useVM_,
+        options_.heuristic == MisHeuristic::Balance ? UB_MIS_BALANCE : UB_MIS_POWER);
     // Merging normalisation: density estimate with a disk kernel of radius r over N_L paths.
     vmNormalization_ = 1.0f / (kPi * radius * radius * lightSubPathCount_);
 
@@ -116,8 +127,7 @@ void VertexCM::renderIteration(int iteration, Image& out) {
     splats_.resolve(out);
 }
 
-bool VertexCM::sampleScattering(Rng& rng, const Bsdf& bsdf, const Hit& hit,
-                                SubPath& state) const {
+bool VertexCM::sampleScattering(Rng& rng, const Bsdf& bsdf, const Hit& hit, SubPath& state) const {
     Vec3 dirGen;
     float dirPdfW = 0.0f, cosThetaOut = 0.0f;
     uint32_t event = kEventNone;

@@ -44,7 +44,7 @@ namespace ub {
 class Rng;
 
 class VertexCM : public Integrator {
-public:
+  public:
     enum class Algorithm { LightTrace, Bpt, Ppm, Bpm, Vcm };
 
     /// Reads options.algorithm (lt, bpt, ppm, bpm, vcm). Throws InputError for another
@@ -58,15 +58,15 @@ public:
     /// Light vertices stored by the last iteration (for tests).
     const std::vector<LightVertex>& lightVertices() const { return lightVertices_; }
 
-private:
+  private:
     /// State of a subpath being traced (SmallVCM's SubPathState).
     struct SubPath {
-        Ray ray;                  ///< next segment
+        Ray ray;  ///< next segment
         Rgb throughput{1, 1, 1};
-        int pathLength = 1;       ///< segments, including the one being traced
+        int pathLength = 1;  ///< segments, including the one being traced
         bool isFiniteLight = true;
-        bool specularPath = true; ///< every scattering so far was specular (camera side)
-        ub_mis_partials mis{};    ///< dVCM, dVC, dVM
+        bool specularPath = true;  ///< every scattering so far was specular (camera side)
+        ub_mis_partials mis{};     ///< dVCM, dVC, dVM
     };
 
     // Light pass (vcm_light.cpp): traces light subpaths [begin, end) of an iteration.
@@ -80,8 +80,7 @@ private:
     Rgb traceCameraPath(int x, int y, int iteration) const;
     Rgb lightHitRadiance(const Light& light, const SubPath& state, const Vec3& rayDir,
                          const Vec3& hitPos, const Vec3& hitNormal) const;
-    Rgb directIllumination(Rng& rng, const SubPath& state, const Hit& hit,
-                           const Bsdf& bsdf) const;
+    Rgb directIllumination(Rng& rng, const SubPath& state, const Hit& hit, const Bsdf& bsdf) const;
     Rgb connectVertices(const LightVertex& lv, const SubPath& state, const Hit& hit,
                         const Bsdf& bsdf) const;
     Rgb mergeVertices(const SubPath& state, const Hit& hit, const Bsdf& bsdf) const;

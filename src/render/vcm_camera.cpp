@@ -44,9 +44,9 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration) const {
             SubPath atLight = state;
             atLight.mis = ub_mis_at_hit(mis_, state.mis, hit.dist,
                                         std::fabs(dot(hit.geoNormal, state.ray.dir)), 1);
-            color += state.throughput * lightHitRadiance(scene_.lights[size_t(hit.lightId)],
-                                                         atLight, state.ray.dir, hit.pos,
-                                                         hit.geoNormal);
+            color +=
+                state.throughput * lightHitRadiance(scene_.lights[size_t(hit.lightId)], atLight,
+                                                    state.ray.dir, hit.pos, hit.geoNormal);
         }
         // Light tracing uses the camera pass only for directly visible emitters.
         if (lightTraceOnly_) break;
@@ -108,8 +108,8 @@ Rgb VertexCM::directIllumination(Rng& rng, const SubPath& state, const Hit& hit,
     const Vec2 rnd = rng.uniform2();
     Vec3 dirToLight;
     float distance = 0.0f, directPdfW = 0.0f, emissionPdfW = 0.0f, cosAtLight = 0.0f;
-    Rgb le = light.illuminate(scene_.sceneSphere, hit.pos, rnd, &dirToLight, &distance,
-                              &directPdfW, &emissionPdfW, &cosAtLight);
+    Rgb le = light.illuminate(scene_.sceneSphere, hit.pos, rnd, &dirToLight, &distance, &directPdfW,
+                              &emissionPdfW, &cosAtLight);
     if (isBlack(le) || !(directPdfW > 0.0f)) return Rgb(0.0f);
 
     float cosToLight = 0.0f, bsdfDirPdfW = 0.0f, bsdfRevPdfW = 0.0f;
@@ -120,9 +120,9 @@ Rgb VertexCM::directIllumination(Rng& rng, const SubPath& state, const Hit& hit,
     bsdfDirPdfW *= light.isDelta() ? 0.0f : contProb;
     bsdfRevPdfW *= contProb;
     // Weight of [TR (44), (45)].
-    const float weight = ub_mis_weight_nee(mis_, state.mis, bsdfDirPdfW, bsdfRevPdfW,
-                                           lightPickProb_, directPdfW, emissionPdfW, cosToLight,
-                                           cosAtLight);
+    const float weight =
+        ub_mis_weight_nee(mis_, state.mis, bsdfDirPdfW, bsdfRevPdfW, lightPickProb_, directPdfW,
+                          emissionPdfW, cosToLight, cosAtLight);
     const Rgb contrib = le * f * (weight * cosToLight / (lightPickProb_ * directPdfW));
     if (isBlack(contrib)) return Rgb(0.0f);
     bool blocked;
@@ -153,8 +153,8 @@ Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const
     cameraRevPdfW *= cameraCont;
 
     Bsdf lightBsdf;
-    if (!lightBsdf.setup(scene_.materials[lv.materialId], lv.dirFix, lv.geoNormal,
-                         lv.shadingNormal, /*fromLight=*/true))
+    if (!lightBsdf.setup(scene_.materials[lv.materialId], lv.dirFix, lv.geoNormal, lv.shadingNormal,
+                         /*fromLight=*/true))
         return Rgb(0.0f);
     float cosLight = 0.0f, lightDirPdfW = 0.0f, lightRevPdfW = 0.0f;
     Rgb fLight = lightBsdf.evaluate(-dir, &cosLight, &lightDirPdfW, &lightRevPdfW);

@@ -45,15 +45,14 @@ bool VertexCM::startLightPath(Rng& rng, SubPath& state) const {
     return true;
 }
 
-void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end,
-                               SplatBuffer::Chunk& splats, std::vector<LightVertex>& vertices,
+void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuffer::Chunk& splats,
+                               std::vector<LightVertex>& vertices,
                                std::vector<uint32_t>& pathEnds) const {
     const int maxLength = options_.maxPathLength, minLength = options_.minPathLength;
     vertices.clear();
     pathEnds.assign(end - begin, 0);
     for (size_t pathIndex = begin; pathIndex < end; ++pathIndex) {
-        Rng rng = Rng::forPath(options_.seed, uint64_t(iteration), uint64_t(pathIndex),
-                               kLightSalt);
+        Rng rng = Rng::forPath(options_.seed, uint64_t(iteration), uint64_t(pathIndex), kLightSalt);
         SubPath state;
         bool alive = startLightPath(rng, state);
         for (; alive; ++state.pathLength) {
@@ -61,8 +60,8 @@ void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end,
             if (!scene_.intersect(state.ray, &hit)) break;
             if (hit.materialId < 0) break;  // pure emitter: absorbs
             Bsdf bsdf;
-            if (!bsdf.setup(scene_.materials[size_t(hit.materialId)], -state.ray.dir,
-                            hit.geoNormal, hit.shadingNormal, /*fromLight=*/true))
+            if (!bsdf.setup(scene_.materials[size_t(hit.materialId)], -state.ray.dir, hit.geoNormal,
+                            hit.shadingNormal, /*fromLight=*/true))
                 break;
             // Complete the MIS partials at this vertex [TR (31)-(36)]; the first segment of a
             // light at infinity is in planar measure already [TR Sec. 5.1].
@@ -123,9 +122,9 @@ void VertexCM::connectToCamera(const SubPath& state, const Hit& hit, const Bsdf&
     const float cameraPdfA = imageToSurface;
 
     // Light tracing alone has no MIS; otherwise the weight of [TR (46), (47)].
-    const float weight =
-        lightTraceOnly_ ? 1.0f
-                        : ub_mis_weight_light_trace(mis_, state.mis, cameraPdfA, bsdfRevPdfW);
+    const float weight = lightTraceOnly_
+                             ? 1.0f
+                             : ub_mis_weight_light_trace(mis_, state.mis, cameraPdfA, bsdfRevPdfW);
     const Rgb contrib = state.throughput * f * (weight * imageToSurface / lightSubPathCount_);
     if (isBlack(contrib)) return;
     if (scene_.occluded(hit.pos, hit.geoNormal, camera.position(), Vec3(0.0f))) return;

@@ -26,11 +26,11 @@ namespace ub::test {
 /// Intermediate vertex x_i, 1 <= i <= k-1. "Fwd" is the light direction
 /// (x_{i-1} -> x_i -> x_{i+1}), "Rev" the camera direction.
 struct MisVertex {
-    float cosIn = 1;    ///< |cos| at x_i of the segment to x_{i-1}
-    float cosOut = 1;   ///< |cos| at x_i of the segment to x_{i+1}
-    float pdfFwdW = 1;  ///< p(dir to x_{i+1} | from x_{i-1}), without continuation probability
-    float pdfRevW = 1;  ///< p(dir to x_{i-1} | from x_{i+1}), without continuation probability
-    float cont = 1;     ///< Russian-roulette continuation probability at x_i
+    float cosIn = 1;        ///< |cos| at x_i of the segment to x_{i-1}
+    float cosOut = 1;       ///< |cos| at x_i of the segment to x_{i+1}
+    float pdfFwdW = 1;      ///< p(dir to x_{i+1} | from x_{i-1}), without continuation probability
+    float pdfRevW = 1;      ///< p(dir to x_{i-1} | from x_{i+1}), without continuation probability
+    float cont = 1;         ///< Russian-roulette continuation probability at x_i
     bool specular = false;  ///< delta lobe: pdfs are the discrete lobe probability (equal)
 };
 
@@ -45,10 +45,10 @@ struct MisPath {
     /// NEE: illuminate()'s pdf of choosing x_0 in area measure (finite lights) or solid
     /// angle (environment), without pick probability; 1 for delta lights.
     float directPdfA = 1;
-    float cosLight = 1;           ///< cosine at x_0 of the segment x_0 x_1 (finite area lights)
-    std::vector<float> dist;      ///< dist[i] = |x_i - x_{i-1}|, i = 1..k (dist[0] unused)
-    std::vector<MisVertex> v;     ///< v[i], i = 1..k-1 (v[0] unused)
-    float cameraPdfW = 1;         ///< p_cam,W of the direction from the camera to x_{k-1}
+    float cosLight = 1;        ///< cosine at x_0 of the segment x_0 x_1 (finite area lights)
+    std::vector<float> dist;   ///< dist[i] = |x_i - x_{i-1}|, i = 1..k (dist[0] unused)
+    std::vector<MisVertex> v;  ///< v[i], i = 1..k-1 (v[0] unused)
+    float cameraPdfW = 1;      ///< p_cam,W of the direction from the camera to x_{k-1}
     int k() const { return int(dist.size()) - 1; }
     bool lightIsDelta() const {
         return lightKind == MisLightKind::Point || lightKind == MisLightKind::Directional;
@@ -71,9 +71,7 @@ struct MisTechnique {
     bool merge = false;
     int index = 0;  ///< s for connections, i for merges
     double weight = 0;
-    std::string name() const {
-        return (merge ? "merge@x" : "connect s=") + std::to_string(index);
-    }
+    std::string name() const { return (merge ? "merge@x" : "connect s=") + std::to_string(index); }
 };
 
 /// Which techniques the renderer has for `path` under `cfg` (SmallVCM's semantics: BPM/PPM
@@ -121,7 +119,8 @@ inline std::vector<MisTechnique> bruteForceWeights(const MisPath& p, const MisCo
         double cosHere = i == 0 ? (finite ? p.cosLight : 1.0) : p.v[i].cosOut;
         double d2 = double(p.dist[i + 1]) * p.dist[i + 1];
         if (i == 0 && !finite) d2 = 1;  // solid-angle measure at infinity
-        double pw = i + 1 == k ? double(p.cameraPdfW) : double(p.v[i + 1].pdfRevW) * p.v[i + 1].cont;
+        double pw =
+            i + 1 == k ? double(p.cameraPdfW) : double(p.v[i + 1].pdfRevW) * p.v[i + 1].cont;
         b[i] = pw * cosHere / d2;
     }
     if (p.lightIsDelta()) b[0] = 0;
@@ -163,8 +162,8 @@ inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisCon
 
     // Light subpath: partials stored at x_1..x_{k-1} (after the hit update).
     std::vector<ub_mis_partials> L(k), E(k + 1);
-    ub_mis_partials lp = ub_mis_init_light(c, p.directPdfA * pick, emissionPdfW * pick,
-                                           p.cosLight, p.lightIsDelta(), finite);
+    ub_mis_partials lp = ub_mis_init_light(c, p.directPdfA * pick, emissionPdfW * pick, p.cosLight,
+                                           p.lightIsDelta(), finite);
     for (int i = 1; i <= k - 1; ++i) {
         const MisVertex& x = p.v[i];
         lp = ub_mis_at_hit(c, lp, p.dist[i], x.cosIn, i > 1 || finite);
@@ -195,8 +194,7 @@ inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisCon
             // NEE at x_1: illuminate()'s solid-angle pdf from the area pdf.
             const MisVertex& x = p.v[1];
             float cosAtLight = finite && !p.lightIsDelta() ? p.cosLight : 1.0f;
-            float directPdfW =
-                finite ? p.directPdfA * sq(p.dist[1]) / cosAtLight : p.directPdfA;
+            float directPdfW = finite ? p.directPdfA * sq(p.dist[1]) / cosAtLight : p.directPdfA;
             float bsdfDirPdfW = p.lightIsDelta() ? 0.0f : x.pdfRevW * x.cont;
             w = ub_mis_weight_nee(c, E[1], bsdfDirPdfW, x.pdfFwdW * x.cont, pick, directPdfW,
                                   emissionPdfW, x.cosIn, cosAtLight);

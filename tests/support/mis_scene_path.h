@@ -27,7 +27,9 @@
 
 namespace ub::test {
 
-inline Vec3 randomUnitVector(Rng& rng) { return sampleUniformSphere(rng.uniform2()); }
+inline Vec3 randomUnitVector(Rng& rng) {
+    return sampleUniformSphere(rng.uniform2());
+}
 
 inline bool relClose(float a, float b, float rel) {
     return std::fabs(a - b) <= rel * std::max(std::fabs(a), std::fabs(b)) + 1e-12f;
@@ -93,8 +95,8 @@ inline bool sampleScenePath(Rng& rng, const Light& light, MisLightKind kind, flo
         if (!cameraBsdf.setup(mat, next, n, n, /*fromLight=*/false)) return false;
         std::ostringstream why;
         if (!relClose(vcmContinuationProb(cameraBsdf), v.cont, 1e-6f))
-            why << "continuation probability differs between light and camera roles ("
-                << v.cont << " vs " << vcmContinuationProb(cameraBsdf) << ")";
+            why << "continuation probability differs between light and camera roles (" << v.cont
+                << " vs " << vcmContinuationProb(cameraBsdf) << ")";
         if (!v.specular) {
             float camDir = 0, camRev = 0;
             cameraBsdf.evaluate(-dir, nullptr, &camDir, &camRev);
@@ -104,8 +106,8 @@ inline bool sampleScenePath(Rng& rng, const Light& light, MisLightKind kind, flo
                     << v.pdfFwdW << ")";
         }
         if (!why.str().empty()) {
-            *problem = "material '" + mat.name + "' at vertex " + std::to_string(i) + ": " +
-                       why.str();
+            *problem =
+                "material '" + mat.name + "' at vertex " + std::to_string(i) + ": " + why.str();
             return false;
         }
         p.dist[i] = dist;

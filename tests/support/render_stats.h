@@ -84,7 +84,9 @@ inline BlockStats renderBlockStats(Integrator& integrator, int iterations, int b
 }
 
 /// Two-sided normal p-value of |z|.
-inline double twoSidedP(double z) { return std::erfc(std::fabs(z) / std::sqrt(2.0)); }
+inline double twoSidedP(double z) {
+    return std::erfc(std::fabs(z) / std::sqrt(2.0));
+}
 
 /// Critical |z| for a two-sided test at level alpha (bisection on erfc).
 inline double criticalZ(double alpha) {
@@ -97,15 +99,17 @@ inline double criticalZ(double alpha) {
 }
 
 /// Sidak-corrected per-test level for m tests at family-wise level alpha.
-inline double sidakLevel(double alpha, int m) { return 1.0 - std::pow(1.0 - alpha, 1.0 / m); }
+inline double sidakLevel(double alpha, int m) {
+    return 1.0 - std::pow(1.0 - alpha, 1.0 / m);
+}
 
 struct Agreement {
-    double meanZ[3] = {0, 0, 0};    ///< image mean difference in standard errors, per channel
-    double minBlockP = 1;           ///< smallest per-block two-sided p-value
-    double sidakMinP = 1;           ///< the same, Sidak-adjusted: 1 - (1 - p)^m
+    double meanZ[3] = {0, 0, 0};  ///< image mean difference in standard errors, per channel
+    double minBlockP = 1;         ///< smallest per-block two-sided p-value
+    double sidakMinP = 1;         ///< the same, Sidak-adjusted: 1 - (1 - p)^m
     int worstBlock = -1, worstChannel = 0;
     int tests = 0;
-    std::string report;             ///< one line for logs
+    std::string report;  ///< one line for logs
 };
 
 /// Compares a render against a reference block by block (3 channels each) and by image mean.
@@ -119,8 +123,8 @@ inline Agreement compare(const BlockStats& a, const BlockStats& ref) {
     g.tests = 3 * a.blockCount();
     for (int b = 0; b < a.blockCount(); ++b)
         for (int c = 0; c < 3; ++c) {
-            double se = std::sqrt(a.stdErr(b, c) * a.stdErr(b, c) +
-                                  ref.stdErr(b, c) * ref.stdErr(b, c));
+            double se =
+                std::sqrt(a.stdErr(b, c) * a.stdErr(b, c) + ref.stdErr(b, c) * ref.stdErr(b, c));
             double diff = a.mean(b, c) - ref.mean(b, c);
             double p = se > 0 ? twoSidedP(diff / se) : (diff == 0 ? 1.0 : 0.0);
             if (p < g.minBlockP) {
