@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "render/pt.h"
+#include "render/vcm.h"
 
 namespace ub {
 
@@ -22,6 +23,11 @@ struct IntegratorEntry {
 
 const IntegratorEntry kIntegrators[] = {
     {"pt", makePathTracer},  // path tracing, NEE + MIS (render/pt.h)
+    {"lt", makeVertexCM},    // light tracing (render/vcm.h)
+    {"bpt", makeVertexCM},   // bidirectional path tracing, recursive MIS (render/vcm.h)
+    {"ppm", makeVertexCM},   // progressive photon mapping (render/vcm.h)
+    {"bpm", makeVertexCM},   // bidirectional photon mapping (render/vcm.h)
+    {"vcm", makeVertexCM},   // vertex connection and merging (render/vcm.h)
 };
 
 }  // namespace
