@@ -29,6 +29,9 @@ ub_require(CLI11_FOUND "CLI11" libcli11-dev)
 find_package(tinyobjloader CONFIG QUIET)
 ub_require(tinyobjloader_FOUND "tinyobjloader (OBJ meshes)" libtinyobjloader-dev)
 
+find_package(pugixml CONFIG QUIET)
+ub_require(pugixml_FOUND "pugixml (Mitsuba XML scenes)" libpugixml-dev)
+
 find_package(assimp CONFIG QUIET)
 ub_require(assimp_FOUND "Assimp (PLY meshes)" libassimp-dev)
 

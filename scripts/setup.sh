@@ -10,7 +10,7 @@ PACKAGES=(
   libembree-dev libtbb-dev libopenexr-dev libpng-dev
   libopenvdb-dev libnanovdb-dev libboost-iostreams-dev
   ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd clinfo
-  nlohmann-json3-dev libcli11-dev libtinyobjloader-dev libassimp-dev
+  nlohmann-json3-dev libcli11-dev libtinyobjloader-dev libassimp-dev libpugixml-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 

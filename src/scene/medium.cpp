@@ -1,6 +1,8 @@
 // Regular tracking through homogeneous and NanoVDB grid media (see medium.h).
 #include "scene/medium.h"
 
+#include "scene/medium_trilinear.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -153,11 +155,50 @@ Medium Medium::heterogeneous(std::shared_ptr<const VdbGrid> grid, float densityS
                     float(c & 4 ? bb.max()[2] + 1 : bb.min()[2]));
         m.worldBounds.extend(cellToWorld.point(corner));
     }
+    for (int a = 0; a < 3; ++a) {
+        m.domainLo[a] = bb.min()[a];
+        m.domainHi[a] = bb.max()[a];
+    }
+    return m;
+}
+
+Medium Medium::heterogeneous(std::shared_ptr<const VdbGrid> grid, float densityScale,
+                             const Rgb& albedo, float g, const Transform& localToWorld,
+                             const GridMediumOptions& options) {
+    Medium m = heterogeneous(std::move(grid), densityScale, albedo, g, localToWorld);
+    m.filter = options.filter;
+    const bool given = options.domainLo[0] <= options.domainHi[0] ||
+                       options.domainLo[1] <= options.domainHi[1] ||
+                       options.domainLo[2] <= options.domainHi[2];
+    if (given) {
+        for (int a = 0; a < 3; ++a) {
+            if (options.domainLo[a] > options.domainHi[a])
+                throw std::invalid_argument("grid medium: empty domain");
+            m.domainLo[a] = options.domainLo[a];
+            m.domainHi[a] = options.domainHi[a];
+        }
+        Transform cellToWorld = m.worldToCell.inverse();
+        m.worldBounds = Bounds3();
+        for (int c = 0; c < 8; ++c) {
+            Vec3 corner(float(c & 1 ? m.domainHi[0] + 1 : m.domainLo[0]),
+                        float(c & 2 ? m.domainHi[1] + 1 : m.domainLo[1]),
+                        float(c & 4 ? m.domainHi[2] + 1 : m.domainLo[2]));
+            m.worldBounds.extend(cellToWorld.point(corner));
+        }
+    }
     return m;
 }
 
 MediumCoefficients mediumCoefficientsAt(const Medium& m, const Vec3& p) {
     MediumCoefficients c;
+    if (m.type == MediumType::kGrid && m.filter == GridFilter::kTrilinear) {
+        const float sigmaT = m.densityScale * trilinearDensityAt(m, p);
+        c.sigmaT = Rgb(sigmaT);
+        c.sigmaS = m.albedo * sigmaT;
+        c.sigmaA = c.sigmaT - c.sigmaS;
+        c.Le = Rgb(0.0f);
+        return c;
+    }
     if (m.type == MediumType::kHomogeneous) {
         c.sigmaA = m.sigmaA;
         c.sigmaS = m.sigmaS;
@@ -179,6 +220,8 @@ MediumCoefficients mediumCoefficientsAt(const Medium& m, const Vec3& p) {
 }
 
 Rgb transmittance(const Medium& m, const Vec3& origin, const Vec3& dir, float length) {
+    if (m.type == MediumType::kGrid && m.filter == GridFilter::kTrilinear)
+        return trilinearTransmittance(m, origin, dir, length);
     Rgb tau(0.0f);
     forEachPiece(m, origin, dir, length, [&](float ta, float tb, const Rgb& sigmaT, const Rgb&) {
         tau += sigmaT * (tb - ta);
@@ -189,6 +232,8 @@ Rgb transmittance(const Medium& m, const Vec3& origin, const Vec3& dir, float le
 
 MediumSegment evalMediumSegment(const Medium& m, const Vec3& origin, const Vec3& dir,
                                 float length) {
+    if (m.type == MediumType::kGrid && m.filter == GridFilter::kTrilinear)
+        return trilinearSegment(m, origin, dir, length);
     MediumSegment seg;
     seg.length = length;
     Rgb tau(0.0f);
@@ -213,6 +258,8 @@ MediumSegment evalMediumSegment(const Medium& m, const Vec3& origin, const Vec3&
 
 FreeFlightSample sampleFreeFlight(const Medium& m, const Vec3& origin, const Vec3& dir,
                                   float tMax, float uChannel, float uDistance) {
+    if (m.type == MediumType::kGrid && m.filter == GridFilter::kTrilinear)
+        return trilinearFreeFlight(m, origin, dir, tMax, uChannel, uDistance);
     const int c = std::min(2, int(uChannel * 3.0f));
     // Target optical depth in channel c: tau ~ Exp(1) by inversion.
     const float tauTarget = -std::log1p(-uDistance);

@@ -54,6 +54,29 @@ enum class MediumType : uint32_t {
     kGrid = 1,
 };
 
+/// How a grid medium's density varies inside the grid (an explicit choice, never a silent
+/// switch; docs/mitsuba.md explains when to use which).
+enum class GridFilter : uint32_t {
+    /// Piecewise constant per voxel (the default): regular tracking, exact.
+    kNearest = 0,
+    /// Trilinear interpolation between voxel centres, clamped to the edge voxels of the
+    /// domain and zero outside the domain's cell box (Mitsuba 3's gridvolume default,
+    /// filter_type="trilinear", wrap_mode="clamp"). Along a ray inside one dual cell the
+    /// density is a cubic polynomial in t, so the optical depth is integrated exactly and
+    /// free-flight sampling inverts it by a safeguarded Newton iteration
+    /// (scene/medium_trilinear.h).
+    kTrilinear = 1,
+};
+
+struct GridMediumOptions {
+    GridFilter filter = GridFilter::kNearest;
+    /// Inclusive voxel index range of the grid's domain (kTrilinear: lookups clamp to it and
+    /// the density is 0 outside its cells). lo > hi (the default) means the grid's active
+    /// index bounds. Grids converted from dense files should pass their full extent, since
+    /// zero voxels at the border are not active.
+    int domainLo[3] = {0, 0, 0}, domainHi[3] = {-1, -1, -1};
+};
+
 struct Medium {
     MediumType type = MediumType::kHomogeneous;
     float g = 0.0f;  ///< Henyey-Greenstein mean cosine, |g| < 1 (kernels/shared/ub_phase.h)
@@ -70,6 +93,8 @@ struct Medium {
     // Derived by heterogeneous(); do not set by hand.
     Transform worldToCell;  ///< world -> cell space (index space + 1/2: voxel v covers [v, v+1))
     Bounds3 worldBounds;    ///< world bounds of the grid's active voxels (background outside)
+    GridFilter filter = GridFilter::kNearest;
+    int domainLo[3] = {0, 0, 0}, domainHi[3] = {-1, -1, -1};  ///< set by heterogeneous()
 
     /// Throws std::invalid_argument on negative or non-finite coefficients or |g| >= 1.
     static Medium homogeneous(const Rgb& sigmaA, const Rgb& sigmaS, float g,
@@ -79,6 +104,11 @@ struct Medium {
     static Medium heterogeneous(std::shared_ptr<const VdbGrid> grid, float densityScale,
                                 const Rgb& albedo, float g,
                                 const Transform& localToWorld = Transform());
+    /// Same with a density filter and domain (GridMediumOptions). Throws std::invalid_argument
+    /// also on an empty domain.
+    static Medium heterogeneous(std::shared_ptr<const VdbGrid> grid, float densityScale,
+                                const Rgb& albedo, float g, const Transform& localToWorld,
+                                const GridMediumOptions& options);
 
     bool hasEmission() const { return !isBlack(Le) && !isBlack(sigmaA); }
 };

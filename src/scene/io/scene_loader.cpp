@@ -4,17 +4,28 @@
 #include <filesystem>
 
 #include "scene/io/json_loader.h"
+#include "scene/io/mitsuba_loader.h"
 
 namespace ub {
 
-std::vector<std::string> supportedSceneExtensions() {
-    return {".json"};
-}
+std::vector<std::string> supportedSceneExtensions() { return {".json", ".xml"}; }
 
 std::unique_ptr<Scene> loadScene(const std::string& path, std::vector<Diagnostic>* warnings) {
+    return loadScene(path, {}, warnings);
+}
+
+std::unique_ptr<Scene> loadScene(const std::string& path,
+                                 const std::map<std::string, std::string>& defines,
+                                 std::vector<Diagnostic>* warnings) {
     std::string ext = std::filesystem::path(path).extension().string();
     for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    if (ext == ".json") return loadJsonScene(path, warnings);
+    if (ext == ".xml") return loadMitsubaScene(path, defines, warnings);
+    if (ext == ".json") {
+        if (!defines.empty())
+            throw InputError(path, "scene parameters (-D " + defines.begin()->first +
+                                       "=...) apply only to Mitsuba .xml scenes");
+        return loadJsonScene(path, warnings);
+    }
 
     std::string list;
     for (const auto& e : supportedSceneExtensions()) list += (list.empty() ? "" : ", ") + e;

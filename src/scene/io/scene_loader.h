@@ -1,8 +1,9 @@
 // Entry point for reading a scene file of any supported format, chosen by the
-// file extension: .json (native, docs/scene-format.md). Later: Mitsuba .xml and
-// SmallUPBP .obj + .obj.aux.
+// file extension: .json (native, docs/scene-format.md) and .xml (Mitsuba 3
+// subset, docs/mitsuba.md). Later: SmallUPBP .obj + .obj.aux.
 #pragma once
 
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,6 +20,12 @@ std::vector<std::string> supportedSceneExtensions();
 /// (case-insensitive). Warnings go to *warnings when given. Throws InputError on an
 /// unsupported extension (listing the supported ones) and on any error in the file.
 std::unique_ptr<Scene> loadScene(const std::string& path,
+                                 std::vector<Diagnostic>* warnings = nullptr);
+
+/// Same with scene parameters (`-D name=value`): overrides of a Mitsuba XML scene's
+/// <default> parameters. Non-empty `defines` for a format without parameters is an error.
+std::unique_ptr<Scene> loadScene(const std::string& path,
+                                 const std::map<std::string, std::string>& defines,
                                  std::vector<Diagnostic>* warnings = nullptr);
 
 }  // namespace ub

@@ -1,0 +1,163 @@
+// Mitsuba <bsdf> plugins -> unibeam materials (docs/mitsuba.md lists the mapping).
+#include <cmath>
+
+#include "scene/io/mitsuba_build.h"
+
+namespace ub {
+
+namespace {
+
+const std::vector<std::string> kBsdfs = {"diffuse",         "conductor", "roughconductor",
+                                         "dielectric",      "roughdielectric", "null",
+                                         "twosided"};
+
+constexpr float kAirIor = 1.000277f;  // Mitsuba's default ext_ior ("air")
+constexpr float kBk7Ior = 1.5046f;    // Mitsuba's default int_ior ("bk7")
+
+/// Reads a GGX roughness: `alpha`, or `alpha_u` = `alpha_v` (anisotropy is not supported),
+/// and insists on distribution="ggx" (Mitsuba's default is Beckmann, which unibeam lacks).
+float readGgxAlpha(XmlReader& r, const XmlObject& o) {
+    const XmlProperty* d = o.find("distribution");
+    std::string dist = r.getString(o, "distribution", "beckmann");
+    if (dist != "ggx") {
+        r.error(d ? d->pos : o.pos,
+                o.label() + ": microfacet distribution '" + dist + "'" +
+                    (d ? "" : " (Mitsuba's default)") +
+                    " is not supported; unibeam has GGX only (set <string name=\"distribution\" "
+                    "value=\"ggx\"/>)");
+    }
+    r.getBool(o, "sample_visible", true);  // sampling strategy only: same expectation
+    if (o.find("alpha_u") || o.find("alpha_v")) {
+        float au = r.getFloatIn(o, "alpha_u", 0.1f, 0.0f, 1.0f, true);
+        float av = r.getFloatIn(o, "alpha_v", 0.1f, 0.0f, 1.0f, true);
+        if (o.find("alpha")) r.error(o.find("alpha")->pos, o.label() + ": give either 'alpha' or "
+                                                           "'alpha_u'/'alpha_v', not both");
+        if (au != av)
+            r.error(o.find("alpha_u") ? o.find("alpha_u")->pos : o.pos,
+                    o.label() + ": anisotropic roughness (alpha_u != alpha_v) is not supported");
+        return au;
+    }
+    return r.getFloatIn(o, "alpha", 0.1f, 0.0f, 1.0f, true);
+}
+
+/// Dielectric tints: unibeam has one `specular` tint for reflection and transmission.
+Rgb readDielectricTint(XmlReader& r, const XmlObject& o) {
+    Rgb sr = r.getColor(o, "specular_reflectance", Rgb(1.0f), ColorUse::Reflectance);
+    Rgb st = r.getColor(o, "specular_transmittance", Rgb(1.0f), ColorUse::Reflectance);
+    if (sr.x != st.x || sr.y != st.y || sr.z != st.z) {
+        const XmlProperty* p = o.find("specular_transmittance");
+        r.error(p ? p->pos : o.pos, o.label() + ": different specular_reflectance and "
+                                                "specular_transmittance are not supported "
+                                                "(unibeam has one tint for both)");
+    }
+    return sr;
+}
+
+float readRelativeIor(XmlReader& r, const XmlObject& o) {
+    float intIor = r.getIor(o, "int_ior", kBk7Ior);
+    float extIor = r.getIor(o, "ext_ior", kAirIor);
+    if (o.find("eta")) {
+        if (o.find("int_ior") || o.find("ext_ior"))
+            r.error(o.find("eta")->pos, o.label() + ": give either 'eta' or int_ior/ext_ior");
+        return r.getFloatIn(o, "eta", 1.5f, 0.0f, 10.0f, true);
+    }
+    return intIor / extIor;
+}
+
+void readConductorIor(MitsubaBuild& b, const XmlObject& o, Material& m) {
+    XmlReader& r = b.r;
+    std::string material = r.getString(o, "material", "none");
+    if (o.find("eta") || o.find("k")) {
+        if (o.find("material"))
+            r.error(o.find("material")->pos, o.label() + ": give either 'material' or eta/k");
+        m.eta = r.getColor(o, "eta", Rgb(0.0f), ColorUse::Unbounded);
+        m.k = r.getColor(o, "k", Rgb(1.0f), ColorUse::Unbounded);
+        return;
+    }
+    if (material != "none") {
+        const XmlProperty* p = o.find("material");
+        r.error(p ? p->pos : o.pos,
+                o.label() + ": named conductor '" + material + "' is not supported (its complex "
+                            "IOR is spectral data unibeam does not ship); give <rgb name=\"eta\"> "
+                            "and <rgb name=\"k\"> instead");
+    }
+}
+
+}  // namespace
+
+int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
+    auto cached = b.materialIds.find(&o);
+    if (cached != b.materialIds.end()) return cached->second;
+    XmlReader& r = b.r;
+    const size_t errorsBefore = r.errorCount();
+    Material m;
+    m.name = o.id.empty() ? o.type : o.id;
+    m.twoSided = false;  // Mitsuba's opaque BSDFs are one-sided unless wrapped in `twosided`
+    int id = -2;
+    if (o.type == "null") {
+        r.checkUnused(o);
+        b.materialIds[&o] = -1;
+        return -1;
+    } else if (o.type == "twosided") {
+        std::vector<const XmlObject*> inner = r.children(o, "bsdf");
+        if (inner.size() != 1) {
+            r.error(o.pos, o.label() + ": expected exactly one nested <bsdf> (two different "
+                                       "sides are not supported), got " +
+                               std::to_string(inner.size()));
+        } else if (inner[0]->type == "dielectric" || inner[0]->type == "roughdielectric" ||
+                   inner[0]->type == "null" || inner[0]->type == "twosided") {
+            r.error(inner[0]->pos, o.label() + ": cannot wrap a '" + inner[0]->type + "' BSDF");
+        } else {
+            int innerId = buildMitsubaBsdf(b, *inner[0]);
+            if (innerId >= 0) {
+                m = b.scene.materials[size_t(innerId)];
+                m.twoSided = true;
+                if (!o.id.empty()) m.name = o.id;
+            }
+        }
+    } else if (o.type == "diffuse") {
+        m.type = MaterialType::Diffuse;
+        if (const XmlObject* tex = r.child(o, "texture", "reflectance")) {
+            r.error(tex->pos, o.label() + ": textured reflectance (" + tex->label() +
+                                  ") is not supported yet");
+        } else {
+            m.diffuse = r.getColor(o, "reflectance", Rgb(0.5f), ColorUse::Reflectance);
+        }
+    } else if (o.type == "conductor") {
+        readConductorIor(b, o, m);
+        m.specular = r.getColor(o, "specular_reflectance", Rgb(1.0f), ColorUse::Reflectance);
+        if (o.find("eta") || o.find("k")) {
+            r.error(o.find("eta") ? o.find("eta")->pos : o.find("k")->pos,
+                    o.label() + ": a smooth conductor with a Fresnel term (eta/k) is not "
+                                "supported; only material \"none\" (a perfect mirror) is");
+        }
+        m.type = MaterialType::Mirror;
+    } else if (o.type == "roughconductor") {
+        m.type = MaterialType::RoughConductor;
+        m.alpha = readGgxAlpha(r, o);
+        if (!o.find("eta") && !o.find("k"))
+            r.error(o.pos, o.label() + ": needs <rgb name=\"eta\"> and <rgb name=\"k\"> (named "
+                                       "materials and 'none' are not supported)");
+        readConductorIor(b, o, m);
+        m.specular = r.getColor(o, "specular_reflectance", Rgb(1.0f), ColorUse::Reflectance);
+    } else if (o.type == "dielectric") {
+        m.type = MaterialType::Dielectric;
+        m.ior = readRelativeIor(r, o);
+        m.specular = readDielectricTint(r, o);
+    } else if (o.type == "roughdielectric") {
+        m.type = MaterialType::RoughDielectric;
+        m.ior = readRelativeIor(r, o);
+        m.alpha = readGgxAlpha(r, o);
+        m.specular = readDielectricTint(r, o);
+    } else {
+        r.unsupportedPlugin(o, kBsdfs);
+        b.materialIds[&o] = -2;
+        return -2;
+    }
+    r.checkUnused(o);
+    if (r.errorCount() == errorsBefore) id = b.scene.addMaterial(m);
+    b.materialIds[&o] = id;
+    return id;
+}
+
+}  // namespace ub

@@ -1,0 +1,471 @@
+// Mitsuba 3 XML scene builder: top level, integrator, sensor and film, shapes
+// and emitters. BSDFs are in mitsuba_bsdfs.cpp, media in mitsuba_media.cpp.
+#include "scene/io/mitsuba_loader.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include "core/image.h"
+#include "scene/io/mitsuba_build.h"
+#include "scene/mesh_io.h"
+#include "scene/shapes.h"
+
+namespace ub {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::vector<std::string> kShapes = {"obj", "ply", "rectangle", "cube", "sphere"};
+const std::vector<std::string> kEmitters = {"area", "point", "directional", "constant", "envmap"};
+const std::vector<std::string> kIntegrators = {"path", "volpath", "volpathmis", "moment"};
+const std::vector<std::string> kSamplers = {"independent", "stratified", "multijitter",
+                                            "orthogonal", "ldsampler"};
+
+/// Rotation + translation + uniform scale? Returns the scale (0 if not a similarity).
+float similarityScale(const Transform& t) {
+    Vec3 c0(t.m[0][0], t.m[1][0], t.m[2][0]), c1(t.m[0][1], t.m[1][1], t.m[2][1]),
+        c2(t.m[0][2], t.m[1][2], t.m[2][2]);
+    float s = length(c0);
+    auto near = [&](float a, float b) { return std::fabs(a - b) <= 1e-4f * std::max(1.0f, s * s); };
+    if (!near(length(c1) * length(c1), s * s) || !near(length(c2) * length(c2), s * s)) return 0;
+    if (!near(dot(c0, c1), 0) || !near(dot(c0, c2), 0) || !near(dot(c1, c2), 0)) return 0;
+    return s;
+}
+
+class Builder {
+public:
+    Builder(MitsubaBuild& b) : b_(b), r_(b.r) {}
+    void build();
+
+private:
+    void readIntegrator(const XmlObject& o);
+    void readSensor(const XmlObject& o);
+    void readFilm(const XmlObject& o, int* w, int* h);
+    void readShape(const XmlObject& o);
+    void readEmitter(const XmlObject& o);
+    int defaultMaterial();
+
+    MitsubaBuild& b_;
+    XmlReader& r_;
+    bool integratorSeen_ = false;
+    int defaultMaterial_ = -1;
+    const XmlObject* envObject_ = nullptr;
+};
+
+void Builder::build() {
+    const XmlObject* sensor = nullptr;
+    for (const auto& op : b_.xml.objects) {
+        const XmlObject& o = *op;
+        if (o.tag == "integrator") {
+            if (integratorSeen_) r_.error(o.pos, "more than one <integrator>");
+            integratorSeen_ = true;
+            readIntegrator(o);
+        } else if (o.tag == "sensor") {
+            if (sensor) {
+                r_.error(o.pos, "more than one <sensor> (unibeam renders one camera)");
+                continue;
+            }
+            sensor = &o;
+            readSensor(o);
+        } else if (o.tag == "shape") {
+            readShape(o);
+        } else if (o.tag == "emitter") {
+            readEmitter(o);
+        } else if (o.tag == "bsdf" || o.tag == "medium" || o.tag == "texture" ||
+                   o.tag == "volume" || o.tag == "phase") {
+            if (o.id.empty())
+                r_.error(o.pos, "top-level " + o.label() + " without an id cannot be used (give "
+                                "it an id and attach it with <ref id=\"...\"/>)");
+            else if (o.tag == "bsdf")
+                buildMitsubaBsdf(b_, o);  // validate even when unused
+        } else {
+            r_.error(o.pos, o.label() + " cannot appear at the top level of a scene");
+        }
+    }
+    if (!sensor) r_.error(XmlPos{b_.xml.file, 0, 0}, "the scene has no <sensor> (expected one "
+                                                     "perspective sensor)");
+    if (b_.scene.lights.empty() && r_.errorCount() == 0)
+        r_.error(XmlPos{b_.xml.file, 0, 0}, "the scene has no emitter");
+}
+
+void Builder::readIntegrator(const XmlObject& top) {
+    const XmlObject* o = &top;
+    if (o->type == "moment") {
+        // `moment` only adds a second-moment output; it renders its nested integrator.
+        std::vector<const XmlObject*> inner = r_.children(*o, "integrator");
+        r_.checkUnused(*o);
+        if (inner.size() != 1) {
+            r_.error(o->pos, o->label() + ": expected exactly one nested <integrator>");
+            return;
+        }
+        o = inner[0];
+    }
+    if (o->type != "path" && o->type != "volpath" && o->type != "volpathmis") {
+        r_.unsupportedPlugin(*o, kIntegrators,
+                             "choose unibeam's algorithm with `unibeam render -a`");
+        return;
+    }
+    // Mitsuba's max_depth counts scattering vertices (null / index-matched interfaces do not
+    // count): 1 = directly visible emitters only. That is the number of path segments of
+    // unibeam's maxPathLength (SmallVCM semantics). -1 means unlimited.
+    int maxDepth = r_.getInt(*o, "max_depth", -1, -1, 1 << 20);
+    if (maxDepth == 0)
+        r_.error(o->find("max_depth")->pos, o->label() + ": max_depth 0 renders nothing (expected "
+                                                         "-1 or a value >= 1)");
+    b_.scene.settings.maxPathLength = maxDepth < 0 ? (1 << 20) : maxDepth;
+    r_.getInt(*o, "rr_depth", 5, 1, 1 << 20);  // Russian roulette: variance only
+    if (r_.getBool(*o, "hide_emitters", false))
+        r_.error(o->find("hide_emitters")->pos,
+                 o->label() + ": hide_emitters = true is not supported");
+    r_.checkUnused(*o);
+}
+
+void Builder::readFilm(const XmlObject& f, int* w, int* h) {
+    if (f.type != "hdrfilm") {
+        r_.unsupportedPlugin(f, {"hdrfilm"});
+        return;
+    }
+    *w = r_.getInt(f, "width", 768, 1, 16384);
+    *h = r_.getInt(f, "height", 576, 1, 16384);
+    std::string pf = r_.getString(f, "pixel_format", "rgb");
+    if (pf != "rgb" && pf != "rgba")
+        r_.error(f.find("pixel_format")->pos,
+                 f.label() + ": pixel_format '" + pf + "' is not supported (expected rgb or rgba)");
+    std::string cf = r_.getString(f, "component_format", "float16");
+    if (cf != "float16" && cf != "float32")
+        r_.error(f.find("component_format")->pos,
+                 f.label() + ": component_format '" + cf + "' is not supported (unibeam writes "
+                             "32-bit float EXR)");
+    std::string ff = r_.getString(f, "file_format", "openexr");
+    if (ff != "openexr" && ff != "exr")
+        r_.error(f.find("file_format")->pos, f.label() + ": file_format '" + ff +
+                                                 "' is not supported (unibeam writes OpenEXR)");
+    const XmlObject* rf = r_.child(f, "rfilter", "");
+    if (!rf) {
+        r_.warning(f.pos, f.label() + ": no <rfilter>: Mitsuba's default Gaussian filter is "
+                          "replaced by unibeam's box filter (one uniform sample per pixel)");
+    } else {
+        if (rf->type != "box")
+            r_.error(rf->pos, "unsupported rfilter plugin '" + rf->type +
+                                  "' (supported: box; unibeam integrates each pixel with a box "
+                                  "filter)");
+        r_.checkUnused(*rf);
+    }
+    r_.checkUnused(f);
+}
+
+void Builder::readSensor(const XmlObject& o) {
+    if (o.type != "perspective") {
+        r_.unsupportedPlugin(o, {"perspective"});
+        return;
+    }
+    int w = 768, h = 576;
+    if (const XmlObject* film = r_.child(o, "film", "")) readFilm(*film, &w, &h);
+    if (const XmlObject* s = r_.child(o, "sampler", "")) {
+        bool known = false;
+        for (const auto& k : kSamplers) known = known || s->type == k;
+        if (!known) r_.unsupportedPlugin(*s, kSamplers);
+        // unibeam draws independent uniform samples; the count is chosen on the command line.
+        r_.getInt(*s, "sample_count", 4, 1, 1 << 30);
+        r_.getInt(*s, "seed", 0, 0, 1 << 30);
+        r_.getBool(*s, "jitter", true);
+        r_.checkUnused(*s);
+    }
+    const float aspect = float(w) / float(h);
+    float fovX = 0.0f;
+    if (o.find("fov") && o.find("focal_length"))
+        r_.error(o.find("focal_length")->pos,
+                 o.label() + ": give either 'fov' or 'focal_length', not both");
+    if (o.find("fov")) {
+        float fov = r_.getFloatIn(o, "fov", 45.0f, 0.0f, 180.0f, true, true);
+        std::string axis = r_.getString(o, "fov_axis", "x");
+        if (axis == "smaller") axis = aspect > 1 ? "y" : "x";
+        if (axis == "larger") axis = aspect > 1 ? "x" : "y";
+        const float t = std::tan(0.5f * fov * kPi / 180.0f);
+        if (axis == "x") {
+            fovX = fov;
+        } else if (axis == "y") {
+            fovX = 2.0f * std::atan(t * aspect) * 180.0f / kPi;
+        } else if (axis == "diagonal") {
+            float width = 2.0f * t / std::sqrt(1.0f + 1.0f / (aspect * aspect));
+            fovX = 2.0f * std::atan(0.5f * width) * 180.0f / kPi;
+        } else {
+            r_.error(o.find("fov_axis")->pos, o.label() + ": fov_axis '" + axis +
+                                                  "' is not one of x, y, diagonal, smaller, "
+                                                  "larger");
+        }
+    } else {
+        // Mitsuba's default: a 50 mm lens on a 36 x 24 mm film, fov along the diagonal.
+        std::string f = r_.getString(o, "focal_length", "50mm");
+        std::string num = f.size() > 2 && f.substr(f.size() - 2) == "mm" ? f.substr(0, f.size() - 2)
+                                                                         : f;
+        char* end = nullptr;
+        double mm = std::strtod(num.c_str(), &end);
+        if (num.empty() || *end != '\0' || !(mm > 0)) {
+            r_.error(o.find("focal_length")->pos,
+                     o.label() + ": focal_length '" + f + "' is not of the form <x>mm");
+            mm = 50;
+        }
+        double diag = 2.0 * std::atan(std::sqrt(36.0 * 36.0 + 24.0 * 24.0) / (2.0 * mm));
+        double width = 2.0 * std::tan(0.5 * diag) / std::sqrt(1.0 + 1.0 / (aspect * aspect));
+        fovX = float(2.0 * std::atan(0.5 * width) * 180.0 / kPi);
+    }
+    if (o.find("near_clip") || o.find("far_clip")) {
+        r_.getFloatIn(o, "near_clip", 0.01f, 0.0f, kInf, true);
+        r_.getFloatIn(o, "far_clip", 1e4f, 0.0f, kInf, true);
+        r_.warning(o.pos, o.label() + ": near_clip/far_clip are not applied (unibeam's camera "
+                                      "has no clipping planes)");
+    }
+    Transform m = r_.getTransform(o, "to_world");
+    r_.checkUnused(o);
+    // Camera space: +z forward, +y up, +x to the left of the image (Mitsuba's convention).
+    Vec3 origin = m.point(Vec3(0.0f)), fwd = m.vector(Vec3(0, 0, 1)), up = m.vector(Vec3(0, 1, 0)),
+         left = m.vector(Vec3(1, 0, 0));
+    const XmlProperty* tp = o.find("to_world");
+    float s = similarityScale(m);
+    if (!(s > 0) || std::fabs(s - 1.0f) > 1e-3f || dot(cross(up, fwd), left) <= 0) {
+        r_.error(tp ? tp->pos : o.pos,
+                 o.label() + ": to_world must be a rotation and translation (no scale or "
+                             "mirroring; use <lookat>)");
+        return;
+    }
+    if (!(fovX > 0.0f)) return;
+    float fovY = 2.0f * std::atan(std::tan(0.5f * fovX * kPi / 180.0f) / aspect) * 180.0f / kPi;
+    b_.scene.camera.setup(origin, origin + normalize(fwd), normalize(up), fovY, w, h);
+    b_.cameraSet = true;
+}
+
+int Builder::defaultMaterial() {
+    if (defaultMaterial_ < 0) {
+        Material m;  // Mitsuba's default: one-sided diffuse, reflectance 0.5
+        m.name = "default diffuse";
+        m.type = MaterialType::Diffuse;
+        m.diffuse = Rgb(0.5f);
+        m.twoSided = false;
+        defaultMaterial_ = b_.scene.addMaterial(m);
+    }
+    return defaultMaterial_;
+}
+
+void Builder::readShape(const XmlObject& o) {
+    const size_t before = r_.errorCount();
+    bool known = false;
+    for (const auto& k : kShapes) known = known || o.type == k;
+    if (!known) {
+        r_.unsupportedPlugin(o, kShapes);
+        return;
+    }
+    const std::string name = o.id.empty() ? o.type + " " + std::to_string(b_.scene.shapes.size())
+                                          : o.id;
+    Transform toWorld = r_.getTransform(o, "to_world");
+    bool flipNormals = r_.getBool(o, "flip_normals", false);
+    TriangleMesh mesh;
+    bool isSphere = false;
+    Vec3 center;
+    float radius = 1.0f;
+    if (o.type == "obj" || o.type == "ply") {
+        std::string file = r_.getString(o, "filename", "");
+        bool faceNormals = r_.getBool(o, "face_normals", false);
+        bool flipTex = o.type == "obj" ? r_.getBool(o, "flip_tex_coords", true) : false;
+        if (file.empty()) {
+            r_.error(o.pos, o.label() + ": needs <string name=\"filename\">");
+        } else {
+            std::string path = b_.resolveFile(o, "filename", file);
+            if (!path.empty()) {
+                Diagnostics meshDiags;
+                mesh = loadMeshFile(path, meshDiags, o.label());
+                for (const Diagnostic& d : meshDiags.all()) {
+                    const XmlProperty* p = o.find("filename");
+                    std::string msg = o.label() + ": " + d.format();
+                    if (d.warning) r_.warning(p->pos, msg);
+                    else r_.error(p->pos, msg);
+                }
+            }
+        }
+        if (faceNormals) mesh.normals.clear();
+        if (flipTex)  // Mitsuba's OBJ reader flips v by default
+            for (Vec2& uv : mesh.uvs) uv.y = 1.0f - uv.y;
+    } else if (o.type == "rectangle") {
+        mesh = makeRectangle();
+    } else if (o.type == "cube") {
+        mesh = makeCube();
+    } else {
+        isSphere = true;
+        center = r_.getPoint(o, "center", Vec3(0.0f));
+        radius = r_.getFloatIn(o, "radius", 1.0f, 0.0f, kInf, true);
+        float s = similarityScale(toWorld);
+        if (!(s > 0)) {
+            const XmlProperty* p = o.find("to_world");
+            r_.error(p ? p->pos : o.pos, o.label() + ": a sphere's to_world must be a rotation, "
+                                                     "translation and uniform scale");
+        }
+        center = toWorld.point(center);
+        radius *= s;
+        if (flipNormals)
+            r_.error(o.find("flip_normals")->pos,
+                     o.label() + ": flip_normals is not supported for spheres");
+    }
+    if (!isSphere && !mesh.indices.empty()) {
+        if (flipNormals) {
+            for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
+                std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+            for (Vec3& n : mesh.normals) n = -n;
+        }
+        transformMesh(mesh, toWorld);
+    }
+
+    int materialId = -2;
+    if (const XmlObject* bsdf = r_.child(o, "bsdf", "")) materialId = buildMitsubaBsdf(b_, *bsdf);
+    else materialId = defaultMaterial();
+
+    int lightId = -1;
+    Light light;
+    const XmlObject* em = r_.child(o, "emitter", "");
+    if (em) {
+        if (em->type != "area") {
+            r_.error(em->pos, "a shape can only carry an 'area' emitter, got '" + em->type + "'");
+        } else {
+            light.type = LightType::Area;
+            light.name = name;
+            light.radiance = r_.getColor(*em, "radiance", Rgb(1.0f), ColorUse::Emission);
+            light.twoSided = false;  // Mitsuba's area emitters emit on the normal's side only
+            r_.checkUnused(*em);
+            if (isSphere) {
+                light.isSphere = true;
+                light.position = center;
+                light.sphereRadius = radius;
+            } else {
+                for (uint32_t idx : mesh.indices) light.triangles.push_back(mesh.positions[idx]);
+            }
+        }
+    }
+    for (const char* side : {"interior", "exterior"})
+        if (const XmlObject* med = r_.child(o, "medium", side))
+            r_.error(med->pos, o.label() + ": participating media on shapes (" + side + " " +
+                                   med->label() + ") are not supported yet");
+    r_.checkUnused(o);
+    if (r_.errorCount() != before) return;
+    if (materialId == -1 && !em) {
+        r_.warning(o.pos, o.label() + " '" + name + "' has a null BSDF and no medium: it is "
+                                                    "invisible and is left out");
+        return;
+    }
+    if (materialId == -1) materialId = defaultMaterial();  // null emitter: black surface
+    if (em) {
+        try {
+            lightId = b_.scene.addLight(std::move(light));
+        } catch (const InputError& e) {
+            for (const Diagnostic& d : e.diagnostics()) r_.error(em->pos, em->label() + ": " + d.message);
+            return;
+        }
+    }
+    if (isSphere)
+        b_.scene.addSphere(center, radius, materialId, lightId, name);
+    else
+        b_.scene.addMesh(std::move(mesh), materialId, lightId, name);
+}
+
+void Builder::readEmitter(const XmlObject& o) {
+    const size_t before = r_.errorCount();
+    Light light;
+    light.name = o.id.empty() ? o.type : o.id;
+    if (o.type == "point") {
+        light.type = LightType::Point;
+        light.intensity = r_.getColor(o, "intensity", Rgb(1.0f), ColorUse::Emission);
+        if (o.find("position") && o.find("to_world"))
+            r_.error(o.find("position")->pos, o.label() + ": give either 'position' or 'to_world'");
+        light.position = o.find("position") ? r_.getPoint(o, "position", Vec3(0.0f))
+                                            : r_.getTransform(o, "to_world").point(Vec3(0.0f));
+    } else if (o.type == "directional") {
+        light.type = LightType::Directional;
+        light.radiance = r_.getColor(o, "irradiance", Rgb(1.0f), ColorUse::Emission);
+        if (o.find("direction") && o.find("to_world"))
+            r_.error(o.find("direction")->pos,
+                     o.label() + ": give either 'direction' or 'to_world'");
+        light.direction = o.find("direction")
+                              ? r_.getVector(o, "direction", Vec3(0, 0, 1))
+                              : r_.getTransform(o, "to_world").vector(Vec3(0, 0, 1));
+        if (!(length(light.direction) > 0))
+            r_.error(o.pos, o.label() + ": the direction must not be zero");
+    } else if (o.type == "constant") {
+        light.type = LightType::ConstantEnv;
+        light.radiance = r_.getColor(o, "radiance", Rgb(1.0f), ColorUse::Emission);
+    } else if (o.type == "envmap") {
+        light.type = LightType::EnvMap;
+        light.radiance = Rgb(r_.getFloatIn(o, "scale", 1.0f, 0.0f, kInf));
+        Transform m = r_.getTransform(o, "to_world");
+        light.envToWorld = m;
+        light.worldToEnv = m.inverse();
+        std::string file = r_.getString(o, "filename", "");
+        if (file.empty()) r_.error(o.pos, o.label() + ": needs <string name=\"filename\">");
+        else if (std::string path = b_.resolveFile(o, "filename", file); !path.empty()) {
+            try {
+                light.envMap = std::make_shared<Image>(readExr(path));
+            } catch (const InputError& e) {
+                for (const Diagnostic& d : e.diagnostics())
+                    r_.error(o.find("filename")->pos, o.label() + ": " + d.format());
+            }
+        }
+    } else if (o.type == "area") {
+        r_.error(o.pos, "an 'area' emitter must be nested inside a <shape>");
+        return;
+    } else {
+        r_.unsupportedPlugin(o, kEmitters);
+        return;
+    }
+    r_.checkUnused(o);
+    if (r_.errorCount() != before) return;
+    if (light.isEnvironment()) {
+        if (envObject_) {
+            r_.error(o.pos, "more than one environment emitter (constant/envmap); the first is at "
+                            "line " + std::to_string(envObject_->pos.line));
+            return;
+        }
+        envObject_ = &o;
+    }
+    try {
+        int id = b_.scene.addLight(std::move(light));
+        if (b_.scene.lights[size_t(id)].isEnvironment()) b_.scene.backgroundLightId = id;
+    } catch (const InputError& e) {
+        for (const Diagnostic& d : e.diagnostics()) r_.error(o.pos, o.label() + ": " + d.message);
+    }
+}
+
+std::unique_ptr<Scene> buildFromXml(const XmlScene& xml, Diagnostics& diags,
+                                    std::vector<Diagnostic>* warnings) {
+    diags.throwIfErrors();
+    auto scene = std::make_unique<Scene>();
+    scene->sourceFile = xml.file;
+    XmlReader reader(diags);
+    MitsubaBuild b{reader, xml, *scene, {}, false};
+    Builder(b).build();
+    diags.throwIfErrors();
+    if (warnings) *warnings = diags.warnings();
+    scene->commit();
+    return scene;
+}
+
+}  // namespace
+
+std::unique_ptr<Scene> loadMitsubaScene(const std::string& path,
+                                        const std::map<std::string, std::string>& defines,
+                                        std::vector<Diagnostic>* warnings) {
+    Diagnostics diags;
+    if (!fs::is_regular_file(path))
+        throw InputError(path, "cannot open the scene file (not found or not a file)");
+    XmlScene xml = parseMitsubaXml(path, defines, diags);
+    return buildFromXml(xml, diags, warnings);
+}
+
+std::unique_ptr<Scene> loadMitsubaSceneFromString(const std::string& text,
+                                                  const std::string& fileName,
+                                                  const std::string& baseDir,
+                                                  const std::map<std::string, std::string>& defines,
+                                                  std::vector<Diagnostic>* warnings) {
+    Diagnostics diags;
+    XmlScene xml = parseMitsubaXmlString(text, fileName, baseDir, defines, diags);
+    return buildFromXml(xml, diags, warnings);
+}
+
+}  // namespace ub

@@ -1,0 +1,180 @@
+// Per-pixel z-test (src/core/ztest.*) and Mitsuba .vol reading
+// (src/scene/vol_grid.*).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "core/error.h"
+#include "core/ztest.h"
+#include "scene/vol_grid.h"
+
+using namespace ub;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Image of `n` iterations of Gaussian noise (sd `sigma`) around `mu`, and its per-sample
+/// variance estimate.
+void noisyImage(int w, int h, int n, float mu, float sigma, uint32_t seed, Image* mean,
+                Image* var) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> g(mu, sigma);
+    *mean = Image(w, h);
+    *var = Image(w, h);
+    for (auto& px : mean->pixels) {
+        size_t i = size_t(&px - mean->pixels.data());
+        for (int c = 0; c < 3; ++c) {
+            double s = 0, s2 = 0;
+            for (int k = 0; k < n; ++k) {
+                double x = g(rng);
+                s += x;
+                s2 += x * x;
+            }
+            double m = s / n;
+            px[c] = float(m);
+            var->pixels[i][c] = float((s2 - n * m * m) / (n - 1));
+        }
+    }
+}
+
+Image constant(int w, int h, float v) {
+    Image img(w, h);
+    for (auto& p : img.pixels) p = Rgb(v);
+    return img;
+}
+
+}  // namespace
+
+TEST(ZTest, SidakLevelAndIdenticalImagesPass) {
+    Image ref = constant(8, 4, 0.5f), var = constant(8, 4, 0.01f);
+    ZTestOptions o;
+    o.alpha = 0.01;
+    o.samples = 16;
+    ZTestResult r = zTest(ref, nullptr, ref, var, o);
+    EXPECT_TRUE(r.passed);
+    EXPECT_EQ(r.tests, 96u);
+    EXPECT_NEAR(r.perTestLevel, 1 - std::pow(0.99, 1.0 / 96), 1e-12);
+    EXPECT_DOUBLE_EQ(r.minPValue, 1.0);
+}
+
+TEST(ZTest, UnbiasedNoisyImagePassesAndBiasedFails) {
+    // 32x32 pixels, 256 iterations, sd 1: the mean's sd is 1/16. An unbiased image passes
+    // with probability >= 0.99 (fixed seed: deterministic). A bias of 0.5 = 8 sd gives
+    // p ~ 1e-15, far below the per-test level ~3.3e-6, in every pixel.
+    Image mean, var;
+    noisyImage(32, 32, 256, 1.0f, 1.0f, 7, &mean, &var);
+    Image ref = constant(32, 32, 1.0f), refVar = constant(32, 32, 1.0f);
+    ZTestOptions o;
+    o.samples = 256;
+    ZTestResult good = zTest(mean, &var, ref, refVar, o);
+    EXPECT_TRUE(good.passed) << describeZTest(good, o);
+    EXPECT_GT(good.minPValue, good.perTestLevel);
+    Image biased = constant(32, 32, 1.5f);
+    ZTestResult bad = zTest(biased, &var, ref, refVar, o);
+    EXPECT_FALSE(bad.passed);
+    EXPECT_EQ(bad.failingPixels, 32u * 32u);
+    // A single bad pixel is found and named.
+    Image one = mean;
+    one.at(5, 9) = Rgb(3.0f);
+    ZTestResult single = zTest(one, &var, ref, refVar, o);
+    EXPECT_EQ(single.failingPixels, 1u);
+    EXPECT_EQ(single.failures[0].x, 5);
+    EXPECT_EQ(single.failures[0].y, 9);
+    EXPECT_EQ(single.minX, 5);
+}
+
+TEST(ZTest, RejectsMismatchedSizesAndBadValues) {
+    Image a = constant(4, 4, 1), b = constant(4, 5, 1);
+    ZTestOptions o;
+    o.samples = 4;
+    EXPECT_THROW(zTest(a, nullptr, b, b, o), InputError);
+    Image neg = constant(4, 4, -1);
+    EXPECT_THROW(zTest(a, nullptr, a, neg, o), InputError);
+    o.alpha = 1.5;
+    EXPECT_THROW(zTest(a, nullptr, a, a, o), InputError);
+}
+
+namespace {
+
+std::string volBytes(int nx, int ny, int nz, int channels, const std::vector<float>& data,
+                     uint8_t version = 3, int32_t encoding = 1) {
+    std::string s = "VOL";
+    s += char(version);
+    auto i32 = [&](int32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); };
+    auto f32 = [&](float v) { s.append(reinterpret_cast<const char*>(&v), 4); };
+    i32(encoding);
+    i32(nx);
+    i32(ny);
+    i32(nz);
+    i32(channels);
+    for (float v : {0.f, 0.f, 0.f, 1.f, 1.f, 1.f}) f32(v);
+    for (float v : data) f32(v);
+    return s;
+}
+
+std::string writeVol(const std::string& name, const std::string& bytes) {
+    fs::path p = fs::temp_directory_path() / ("unibeam_vol_test_" + name + ".vol");
+    std::ofstream(p, std::ios::binary) << bytes;
+    return p.string();
+}
+
+std::string volError(const std::string& name, const std::string& bytes) {
+    try {
+        readVolFile(writeVol(name, bytes));
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+}  // namespace
+
+TEST(VolFile, ReadsDenseGridXFastest) {
+    std::vector<float> d(2 * 3 * 4);
+    for (size_t i = 0; i < d.size(); ++i) d[i] = float(i);
+    VolGrid v = readVolFile(writeVol("ok", volBytes(2, 3, 4, 1, d)));
+    EXPECT_EQ(v.nx, 2);
+    EXPECT_EQ(v.ny, 3);
+    EXPECT_EQ(v.nz, 4);
+    EXPECT_FLOAT_EQ(v.at(1, 2, 3, 0), float((3 * 3 + 2) * 2 + 1));
+    DenseFloatGrid g = volChannelToDense(v, 0);
+    EXPECT_FLOAT_EQ(g.at(1, 0, 2), v.at(1, 0, 2, 0));
+}
+
+TEST(VolFile, HeaderValidationMessages) {
+    std::vector<float> d(8, 1.0f);
+    EXPECT_NE(volError("magic", "XOL" + volBytes(2, 2, 2, 1, d).substr(3)).find("'VOL' magic"),
+              std::string::npos);
+    EXPECT_NE(volError("version", volBytes(2, 2, 2, 1, d, 2)).find("version 2 (expected 3)"),
+              std::string::npos);
+    EXPECT_NE(volError("enc", volBytes(2, 2, 2, 1, d, 3, 2)).find("encoding 2 (expected 1"),
+              std::string::npos);
+    EXPECT_NE(volError("res", volBytes(0, 2, 2, 1, {})).find("resolution 0 x 2 x 2"),
+              std::string::npos);
+    EXPECT_NE(volError("chan", volBytes(2, 2, 2, 2, std::vector<float>(16))).find("2 channels"),
+              std::string::npos);
+    std::string shortFile = volError("short", volBytes(2, 2, 2, 1, std::vector<float>(7)));
+    EXPECT_NE(shortFile.find("announces 2 x 2 x 2 x 1 float32 values (80 bytes with the header), "
+                             "but the file has 76 bytes"),
+              std::string::npos) << shortFile;
+    std::vector<float> nan(8, 1.0f);
+    nan[5] = NAN;
+    EXPECT_NE(volError("nan", volBytes(2, 2, 2, 1, nan)).find("non-finite value at voxel (1, 0, 1)"),
+              std::string::npos);
+    EXPECT_NE(volError("tiny", "VOL").find("shorter than the 48-byte header"), std::string::npos);
+}
+
+TEST(VolFile, SharedSceneGridReads) {
+    std::string path = std::string(UNIBEAM_SHARED_DIR) +
+                       "/scenes/mitsuba/tests/scenes/participating_media/textures/sigmat.vol";
+    if (!fs::exists(path)) GTEST_SKIP() << "shared scenes not present";
+    VolGrid v = readVolFile(path);
+    EXPECT_EQ(v.nx, 16);
+    EXPECT_EQ(v.channels, 1);
+    // create_volume_data.py: sigmat_f = 5 where x > 0.2, y > 0.7, z < 0.5 (x = i / 16).
+    EXPECT_FLOAT_EQ(v.at(15, 15, 0, 0), 5.0f);
+}
