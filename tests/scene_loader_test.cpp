@@ -659,7 +659,7 @@ TEST(SceneLoader, UnsupportedExtensionListsSupportedOnes) {
     } catch (const InputError& e) {
         EXPECT_STREQ(e.what(),
                      "scene.yaml: error: unsupported scene file extension '.yaml' (supported: "
-                     ".json)");
+                     ".json, .xml)");
     }
 }
 

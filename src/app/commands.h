@@ -7,9 +7,11 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace ub::app {
 
@@ -32,12 +34,26 @@ struct RenderArgs {
     std::string mis = "power";
     std::optional<float> radius;
     std::optional<float> alpha;
+    std::map<std::string, std::string> defines;  ///< -D name=value (Mitsuba XML parameters)
+    std::string variancePath;                    ///< --variance: per-iteration variance EXR
+};
+
+struct CompareArgs {
+    std::string reference, referenceVariance, image, imageVariance;
+    double samples = 0;           ///< --spp: iterations averaged into IMAGE
+    double referenceSamples = 0;  ///< --ref-spp (0: exact reference)
+    double alpha = 0.01;
 };
 
 /// Default number of iterations when neither -t nor -i is given.
 constexpr int kDefaultIterations = 16;
 
 int runRender(const RenderArgs& args);
-int runInfo(const std::string& scenePath);
+int runInfo(const std::string& scenePath,
+            const std::map<std::string, std::string>& defines = {});
+/// `unibeam compare --ztest`: 0 pass, 1 fail, 2 bad input (UsageError / InputError).
+int runCompareZTest(const CompareArgs& args);
+/// Parses the values of -D flags ("name=value"); throws UsageError on a malformed one.
+std::map<std::string, std::string> parseDefines(const std::vector<std::string>& values);
 
 }  // namespace ub::app

@@ -7,10 +7,10 @@
 
 namespace ub::app {
 
-int runInfo(const std::string& scenePath) {
+int runInfo(const std::string& scenePath, const std::map<std::string, std::string>& defines) {
     if (!std::filesystem::exists(scenePath))
         throw UsageError("scene file '" + scenePath + "' does not exist");
-    std::unique_ptr<Scene> scene = loadSceneFile(scenePath);
+    std::unique_ptr<Scene> scene = loadSceneFile(scenePath, defines);
     std::string text = sceneDescription(*scene);
     std::fputs(text.c_str(), stdout);
     if (!text.empty() && text.back() != '\n') std::fputc('\n', stdout);

@@ -1,6 +1,7 @@
 // `unibeam`: the command-line program (CLI11). Commands:
 //   unibeam render SCENE [options]   render a scene progressively, write EXR / PNG
 //   unibeam info SCENE               print what a scene contains
+//   unibeam compare --ztest REF REF_VAR IMAGE   per-pixel z-test against a reference
 //   unibeam --version | --help, and --help on every command.
 // Exit status: 0 success, 1 unexpected failure, 2 bad input (flags, scene, paths).
 // docs/cli.md documents every option.
@@ -140,15 +141,66 @@ int run(int argc, char** argv) {
             ->check(positiveReal(1.0))
             ->type_name("A");
 
+    std::vector<std::string> renderDefines, infoDefines;
+    render
+        ->add_option("-D,--define", renderDefines,
+                     "Scene parameter NAME=VALUE: overrides a Mitsuba XML <default> (repeatable)")
+        ->type_name("NAME=VALUE")
+        ->take_all()
+        ->allow_extra_args(false);
+    render
+        ->add_option("--variance", ra.variancePath,
+                     "Also write the per-pixel sample variance of one iteration (OpenEXR; needs "
+                     ">= 2 iterations; divide by the iteration count for the mean's variance)")
+        ->type_name("FILE.exr");
+
     // ---- info ----
     std::string infoScene;
     CLI::App* info = app.add_subcommand("info", "Print what a scene file contains");
     info->add_option("scene", infoScene, "Scene file")->required()->type_name("SCENE");
+    info->add_option("-D,--define", infoDefines,
+                     "Scene parameter NAME=VALUE: overrides a Mitsuba XML <default> (repeatable)")
+        ->type_name("NAME=VALUE")
+        ->allow_extra_args(false);
+
+    // ---- compare ----
+    ub::app::CompareArgs ca;
+    std::vector<std::string> ztestFiles;
+    CLI::App* compare = app.add_subcommand(
+        "compare", "Compare a rendered image with a reference (exit 0 pass, 1 fail, 2 bad input)");
+    compare
+        ->add_option("--ztest", ztestFiles,
+                     "Per-pixel z-test: reference mean, reference per-sample variance, image "
+                     "(all OpenEXR)")
+        ->expected(3)
+        ->required()
+        ->type_name("REF REF_VAR IMAGE");
+    compare
+        ->add_option("--image-var", ca.imageVariance,
+                     "Per-sample variance of the image (unibeam render --variance); default: "
+                     "the reference variance stands for it")
+        ->type_name("VAR.exr");
+    compare->add_option("--spp", ca.samples, "Iterations averaged into IMAGE (required)")
+        ->required()
+        ->check(positiveReal())
+        ->type_name("N");
+    compare
+        ->add_option("--ref-spp", ca.referenceSamples,
+                     "Samples per pixel of the reference (adds its own error); default: the "
+                     "reference is treated as exact")
+        ->check(positiveReal())
+        ->type_name("M");
+    compare
+        ->add_option("--alpha", ca.alpha,
+                     "Family-wise significance level, Sidak-corrected over all pixel-channels "
+                     "(default 0.01)")
+        ->check(positiveReal(0.999))
+        ->type_name("A");
 
     if (argc >= 2 && argv[1][0] != '-' && std::string(argv[1]) != "render" &&
-        std::string(argv[1]) != "info") {
+        std::string(argv[1]) != "info" && std::string(argv[1]) != "compare") {
         std::fprintf(stderr,
-                     "unibeam: error: unknown command '%s' (valid: render, info)\n"
+                     "unibeam: error: unknown command '%s' (valid: render, info, compare)\n"
                      "Run 'unibeam --help' for usage.\n",
                      argv[1]);
         return kExitBadInput;
@@ -179,9 +231,16 @@ int run(int argc, char** argv) {
             }
             if (radiusOpt->count() > 0) ra.radius = radius;
             if (alphaOpt->count() > 0) ra.alpha = alpha;
+            ra.defines = ub::app::parseDefines(renderDefines);
             return ub::app::runRender(ra);
         }
-        if (*info) return ub::app::runInfo(infoScene);
+        if (*info) return ub::app::runInfo(infoScene, ub::app::parseDefines(infoDefines));
+        if (*compare) {
+            ca.reference = ztestFiles.at(0);
+            ca.referenceVariance = ztestFiles.at(1);
+            ca.image = ztestFiles.at(2);
+            return ub::app::runCompareZTest(ca);
+        }
     } catch (const ub::app::UsageError& e) {
         std::fprintf(stderr, "unibeam: error: %s\n", e.what());
         return kExitBadInput;

@@ -90,6 +90,7 @@ int runRender(const RenderArgs& args) {
         exrPath = fs::path(args.scene).stem().string() + ".exr";
     if (!exrPath.empty()) checkOutputPath(exrPath, ".exr", "-o/--output");
     if (!args.pngPath.empty()) checkOutputPath(args.pngPath, ".png", "--png");
+    if (!args.variancePath.empty()) checkOutputPath(args.variancePath, ".exr", "--variance");
     if (!fs::exists(args.scene)) throw UsageError("scene file '" + args.scene + "' does not exist");
 
     std::unique_ptr<tbb::global_control> threadLimit;
@@ -98,7 +99,7 @@ int runRender(const RenderArgs& args) {
             tbb::global_control::max_allowed_parallelism, size_t(args.threads));
 
     // ---- scene and options ----
-    std::unique_ptr<Scene> scene = loadSceneFile(args.scene);
+    std::unique_ptr<Scene> scene = loadSceneFile(args.scene, args.defines);
     if (width > 0) {
         const Camera& c = scene->camera;
         Camera resized;
@@ -119,6 +120,7 @@ int runRender(const RenderArgs& args) {
     ProgressiveOptions prog;
     prog.iterations = args.iterations;
     prog.timeLimitSeconds = args.timeLimit;
+    prog.computeVariance = !args.variancePath.empty();
     if (prog.iterations <= 0 && prog.timeLimitSeconds <= 0) prog.iterations = kDefaultIterations;
     ProgressBar bar(stderr, ::isatty(::fileno(stderr)) != 0);
     prog.progress = [&](const ProgressInfo& info) { bar.update(info); };
@@ -151,6 +153,16 @@ int runRender(const RenderArgs& args) {
     if (!exrPath.empty()) {
         writeExr(exrPath, result.image, meta);
         std::fprintf(stderr, "unibeam: wrote %s\n", exrPath.c_str());
+    }
+    if (!args.variancePath.empty()) {
+        if (result.iterations < 2)
+            throw UsageError("--variance: needs at least 2 iterations, rendered " +
+                             std::to_string(result.iterations));
+        ImageMetadata vmeta = meta;
+        vmeta["content"] = "per-pixel sample variance of one iteration (divide by iterations "
+                           "for the variance of the mean image)";
+        writeExr(args.variancePath, result.variance, vmeta);
+        std::fprintf(stderr, "unibeam: wrote %s\n", args.variancePath.c_str());
     }
     if (!args.pngPath.empty()) {
         writePng(args.pngPath, result.image, args.exposure);

@@ -9,9 +9,10 @@
 
 namespace ub::app {
 
-std::unique_ptr<Scene> loadSceneFile(const std::string& path) {
+std::unique_ptr<Scene> loadSceneFile(const std::string& path,
+                                     const std::map<std::string, std::string>& defines) {
     std::vector<Diagnostic> warnings;
-    std::unique_ptr<Scene> scene = loadScene(path, &warnings);
+    std::unique_ptr<Scene> scene = loadScene(path, defines, &warnings);
     for (const auto& w : warnings) std::fprintf(stderr, "%s\n", w.format().c_str());
     return scene;
 }

@@ -1,6 +1,7 @@
 // The CLI's one entry to the scene loaders (scene/io/) and the scene summary.
 #pragma once
 
+#include <map>
 #include <memory>
 #include <string>
 
@@ -10,7 +11,8 @@ namespace ub::app {
 
 /// Loads a scene file (any supported format); prints loader warnings to stderr.
 /// Throws InputError with every problem found.
-std::unique_ptr<Scene> loadSceneFile(const std::string& path);
+std::unique_ptr<Scene> loadSceneFile(const std::string& path,
+                                     const std::map<std::string, std::string>& defines = {});
 /// Human-readable description for `unibeam info`.
 std::string sceneDescription(const Scene& scene);
 

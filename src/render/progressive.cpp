@@ -3,6 +3,7 @@
 #include <chrono>
 #include <csignal>
 #include <stdexcept>
+#include <vector>
 
 #include "render/film.h"
 
@@ -48,6 +49,12 @@ ProgressiveResult renderProgressive(Integrator& integrator, int width, int heigh
     Film film(width, height);
     Image iterationImage(width, height);
     ProgressiveResult result;
+    // Welford's running mean and sum of squared deviations, per pixel and channel.
+    std::vector<double> wMean, wM2;
+    if (options.computeVariance) {
+        wMean.assign(size_t(width) * height * 3, 0.0);
+        wM2.assign(size_t(width) * height * 3, 0.0);
+    }
     for (int it = 0;; ++it) {
         if (options.iterations > 0 && it >= options.iterations) break;
         if (it > 0) {
@@ -59,6 +66,16 @@ ProgressiveResult renderProgressive(Integrator& integrator, int width, int heigh
         }
         integrator.renderIteration(it, iterationImage);
         film.addIteration(iterationImage);
+        if (options.computeVariance) {
+            for (size_t i = 0; i < iterationImage.pixels.size(); ++i)
+                for (int c = 0; c < 3; ++c) {
+                    const double x = iterationImage.pixels[i][c];
+                    double& mean = wMean[i * 3 + c];
+                    const double delta = x - mean;
+                    mean += delta / double(it + 1);
+                    wM2[i * 3 + c] += delta * (x - mean);
+                }
+        }
 
         if (options.progress) {
             ProgressInfo info;
@@ -80,6 +97,12 @@ ProgressiveResult renderProgressive(Integrator& integrator, int width, int heigh
     result.iterations = film.iterations();
     result.seconds = elapsed();
     result.image = film.average();
+    if (options.computeVariance && result.iterations >= 2) {
+        result.variance = Image(width, height);
+        for (size_t i = 0; i < result.variance.pixels.size(); ++i)
+            for (int c = 0; c < 3; ++c)
+                result.variance.pixels[i][c] = float(wM2[i * 3 + c] / (result.iterations - 1));
+    }
     return result;
 }
 

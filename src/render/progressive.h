@@ -42,10 +42,16 @@ struct ProgressiveOptions {
     /// Stop flag polled between iterations (nullptr: use the global one set by the
     /// signal handlers, see stopRequested()).
     const std::atomic<bool>* stop = nullptr;
+    /// Also estimate the per-pixel variance of one iteration (ProgressiveResult::variance).
+    bool computeVariance = false;
 };
 
 struct ProgressiveResult {
     Image image;  ///< average of the rendered iterations
+    /// With computeVariance and >= 2 iterations: per-pixel, per-channel unbiased sample
+    /// variance of the iteration images, sum (x_i - mean)^2 / (n - 1) (Welford's update in
+    /// double precision). The variance of `image` is variance / iterations.
+    Image variance;
     int iterations = 0;
     double seconds = 0;        ///< wall-clock time of the iterations
     bool interrupted = false;  ///< stopped by the stop flag before the target was reached

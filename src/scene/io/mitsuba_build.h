@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "scene/io/mitsuba_xml.h"
+#include "scene/medium.h"
 #include "scene/scene.h"
 
 namespace ub {
@@ -89,5 +90,8 @@ struct MitsubaBuild {
 /// Builds a material from a <bsdf>. Returns the material id (cached per object), -1 for a
 /// `null` BSDF, or -2 on an error (already reported). *oneSidedEmit is unused here.
 int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& bsdf);
+
+/// Builds a medium from a <medium>; false on an error (already reported).
+bool buildMitsubaMedium(MitsubaBuild& b, const XmlObject& medium, Medium* out);
 
 }  // namespace ub

@@ -341,9 +341,12 @@ void Builder::readShape(const XmlObject& o) {
         }
     }
     for (const char* side : {"interior", "exterior"})
-        if (const XmlObject* med = r_.child(o, "medium", side))
-            r_.error(med->pos, o.label() + ": participating media on shapes (" + side + " " +
-                                   med->label() + ") are not supported yet");
+        if (const XmlObject* med = r_.child(o, "medium", side)) {
+            Medium medium;
+            if (buildMitsubaMedium(b_, *med, &medium))
+                r_.error(med->pos, o.label() + ": participating media on shapes (" + side + " " +
+                                       med->label() + ") are not supported yet");
+        }
     r_.checkUnused(o);
     if (r_.errorCount() != before) return;
     if (materialId == -1 && !em) {

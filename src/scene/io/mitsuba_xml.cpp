@@ -87,7 +87,10 @@ public:
 
 private:
     XmlPos pos(const FileCtx& f, const pugi::xml_node& n) const {
-        return xmlPosOfOffset(f.path, f.text, size_t(std::max<ptrdiff_t>(0, n.offset_debug())));
+        // offset_debug() of an element is its name; report the '<' before it.
+        size_t off = size_t(std::max<ptrdiff_t>(0, n.offset_debug()));
+        if (off > 0 && off <= f.text.size() && f.text[off - 1] == '<') --off;
+        return xmlPosOfOffset(f.path, f.text, off);
     }
     void error(const XmlPos& p, const std::string& msg) {
         Diagnostic d;
