@@ -352,8 +352,55 @@ uint32_t Scene::addSphere(const Vec3& center, float radius, int materialId, int 
     return id;
 }
 
+int Scene::addMedium(const Medium& m, const std::string& name) {
+    if (impl_->committed) throw std::logic_error("Scene::addMedium called after commit()");
+    media.push_back(m);
+    mediumNames.push_back(name);
+    return int(media.size()) - 1;
+}
+
+void Scene::setMediumBoundary(uint32_t shapeId, int interiorMediumId, int priority,
+                              bool imaginary) {
+    if (impl_->committed) throw std::logic_error("Scene::setMediumBoundary called after commit()");
+    if (shapeId >= shapes.size()) throw std::out_of_range("Scene::setMediumBoundary: bad shape id");
+    ShapeInfo& s = shapes[shapeId];
+    s.isMediumBoundary = true;
+    s.interiorMediumId = interiorMediumId;
+    s.mediumPriority = priority;
+    s.imaginary = imaginary;
+}
+
+void Scene::meshTriangle(uint32_t shapeId, uint32_t tri, Vec3 p[3]) const {
+    const ShapeGeom& g = impl_->geoms.at(shapeId);
+    if (g.isSphere) throw std::logic_error("Scene::meshTriangle called on a sphere");
+    const uint32_t* idx = g.indices + 3 * size_t(tri);
+    for (int i = 0; i < 3; ++i) p[i] = impl_->vertex(g, idx[i]);
+}
+
+Vec3 Scene::offsetRayOrigin(const Vec3& p, const Vec3& n, const Vec3& dir) {
+    return offsetOrigin(p, n, dir);
+}
+
 void Scene::commit() {
     if (impl_->committed) throw std::logic_error("Scene::commit called twice");
+    {
+        std::vector<MediumIssue> issues = mediumIssues();
+        if (!issues.empty()) {
+            std::vector<Diagnostic> diags;
+            for (const MediumIssue& i : issues) {
+                Diagnostic d;
+                d.file = sourceFile;
+                d.where = i.shapeId >= 0 ? "shape '" + shapes[size_t(i.shapeId)].name + "'"
+                                         : (i.mediumId >= 0 ? "medium '" +
+                                                                  mediumNames[size_t(i.mediumId)] +
+                                                                  "'"
+                                                            : std::string());
+                d.message = i.message;
+                diags.push_back(d);
+            }
+            throw InputError(std::move(diags));
+        }
+    }
     rtcCommitScene(impl_->scene);
     impl_->check("building the BVH");
 
@@ -372,6 +419,7 @@ void Scene::commit() {
     }
     sceneSphere.invRadiusSqr = 1.0f / (sceneSphere.radius * sceneSphere.radius);
     impl_->committed = true;
+    cameraMediumStack = mediumStackAt(camera.position());
 }
 
 bool Scene::intersect(const Ray& ray, Hit* hit) const {

@@ -12,6 +12,9 @@
 #include "scene/camera.h"
 #include "scene/light.h"
 #include "scene/material.h"
+#include "scene/medium.h"
+#include "scene/medium_stack.h"
+#include "scene/medium_trace.h"
 
 namespace ub {
 
@@ -51,6 +54,11 @@ struct ShapeInfo {
     int lightId = -1;
     size_t triangleCount = 0;  ///< 0 for spheres
     Bounds3 bounds;
+    // Medium boundary (scene/medium_stack.h); set by Scene::setMediumBoundary.
+    bool isMediumBoundary = false;
+    int interiorMediumId = -1;  ///< index into Scene::media, -1 = vacuum
+    int mediumPriority = 0;
+    bool imaginary = false;     ///< changes the medium only: never scatters nor emits
 };
 
 class Scene {
@@ -67,8 +75,18 @@ public:
     uint32_t addMesh(TriangleMesh mesh, int materialId, int lightId, const std::string& name);
     uint32_t addSphere(const Vec3& center, float radius, int materialId, int lightId,
                        const std::string& name);
+    /// Adds a participating medium; returns its id (index into media).
+    int addMedium(const Medium& m, const std::string& name);
+    /// Declares shape shapeId a medium boundary (scene/medium_stack.h): interior medium
+    /// (-1 = vacuum), priority, imaginary or not.
+    void setMediumBoundary(uint32_t shapeId, int interiorMediumId, int priority, bool imaginary);
+    /// Problems with the media set-up (open boundary meshes, conflicting priorities, too
+    /// deep nesting, bad medium ids), one per offending shape or medium; empty if valid.
+    /// Callable before commit() (loaders use it to point at the file position).
+    std::vector<MediumIssue> mediumIssues() const;
     /// Builds the BVH and the scene bounding sphere. Must be called once, after which the
-    /// scene is read-only.
+    /// scene is read-only. Throws InputError (naming sourceFile and each shape) if
+    /// mediumIssues() is not empty; computes cameraMediumStack.
     void commit();
 
     // ---- queries (thread-safe after commit) ----
@@ -84,6 +102,43 @@ public:
     bool occludedToInfinity(const Vec3& from, const Vec3& geoNormal, const Vec3& dir) const;
     /// Ray leaving a surface hit in direction dir, with its origin offset to the side of dir.
     Ray spawnRay(const Hit& hit, const Vec3& dir) const;
+    /// The origin offset spawnRay/occluded use: p moved off the surface with unit normal n
+    /// (zero: not on a surface, not moved) to the side of dir.
+    static Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n, const Vec3& dir);
+    /// Vertices of triangle `tri` of mesh shape shapeId (world space).
+    void meshTriangle(uint32_t shapeId, uint32_t tri, Vec3 p[3]) const;
+
+    // ---- media (thread-safe after commit; scene/medium_trace.h) ----
+    /// True if any medium can be met: a global medium or a boundary.
+    bool hasMedia() const;
+    /// Stack of the media containing point p (traces to infinity, counting crossings).
+    MediumStack mediumStackAt(const Vec3& p) const;
+    /// Crosses boundary shapeId along direction dir at a hit with geometric normal n
+    /// (push or pop). False if the stack is full (the path must end).
+    bool crossBoundary(uint32_t shapeId, const Vec3& geoNormal, const Vec3& dir,
+                       MediumStack* stack) const;
+    /// At a real surface hit reached along -dirFix with stack *stack (the incoming side):
+    /// updates the stack for a continuation dirGen (crosses the shape if dirGen leaves on the
+    /// other side of the geometric surface). False on stack overflow.
+    bool crossSurface(const Hit& hit, const Vec3& dirFix, const Vec3& dirGen,
+                      MediumStack* stack) const;
+    /// Traces ray to the next real surface (or to infinity), recording the medium segments
+    /// it crosses; imaginary and skipped boundaries update *stack and create no vertex.
+    /// On return *stack is the stack on the incoming side of the real hit, *hit the hit
+    /// (valid if trace->hitSurface; hit->dist is the distance from the last crossing).
+    void traceMedia(const Ray& ray, MediumStack* stack, MediumTrace* trace, Hit* hit) const;
+    /// The media that traceMedia crossed up to (not including) segment k: applies the first
+    /// k crossings of trace to *stack (which must be the stack the trace started with).
+    void replayCrossings(const MediumTrace& trace, int k, MediumStack* stack) const;
+    /// Transmittance (0 if a real surface blocks) of the segment a -> b through media and
+    /// imaginary/skipped boundaries, with the distance pdfs of both directions. stackA is
+    /// the stack at a for the direction towards b. Ends are offset as in occluded().
+    MediumShadow shadowTransmittance(const Vec3& a, const Vec3& geoNormalA,
+                                     const MediumStack& stackA, const Vec3& b,
+                                     const Vec3& geoNormalB) const;
+    /// Same towards infinity along dir (directional and environment lights).
+    MediumShadow shadowTransmittanceToInfinity(const Vec3& a, const Vec3& geoNormalA,
+                                               const MediumStack& stackA, const Vec3& dir) const;
 
     // ---- data ----
     Camera camera;
@@ -95,6 +150,10 @@ public:
     Bounds3 bounds;
     std::vector<ShapeInfo> shapes;
     std::string sourceFile;       ///< path the scene was loaded from
+    std::vector<Medium> media;
+    std::vector<std::string> mediumNames;  ///< parallel to media
+    int globalMediumId = -1;      ///< medium outside every boundary (-1 = vacuum)
+    MediumStack cameraMediumStack;  ///< set by commit(): media at the camera position
 
 private:
     struct Impl;
