@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "render/pt.h"
 #include "render/vcm.h"
+#include "render/vpt.h"
 
 namespace ub {
 
@@ -19,15 +20,17 @@ using IntegratorFactory = std::unique_ptr<Integrator> (*)(const Scene&, const Re
 struct IntegratorEntry {
     const char* name;
     IntegratorFactory make;
+    bool handlesMedia;  ///< false: scenes with participating media are rejected
 };
 
 const IntegratorEntry kIntegrators[] = {
-    {"pt", makePathTracer},  // path tracing, NEE + MIS (render/pt.h)
-    {"lt", makeVertexCM},    // light tracing (render/vcm.h)
-    {"bpt", makeVertexCM},   // bidirectional path tracing, recursive MIS (render/vcm.h)
-    {"ppm", makeVertexCM},   // progressive photon mapping (render/vcm.h)
-    {"bpm", makeVertexCM},   // bidirectional photon mapping (render/vcm.h)
-    {"vcm", makeVertexCM},   // vertex connection and merging (render/vcm.h)
+    {"pt", makePathTracer, false},     // path tracing, NEE + MIS (render/pt.h)
+    {"lt", makeVertexCM, false},       // light tracing (render/vcm.h)
+    {"bpt", makeVertexCM, false},      // bidirectional path tracing, recursive MIS (render/vcm.h)
+    {"ppm", makeVertexCM, false},      // progressive photon mapping (render/vcm.h)
+    {"bpm", makeVertexCM, false},      // bidirectional photon mapping (render/vcm.h)
+    {"vcm", makeVertexCM, false},      // vertex connection and merging (render/vcm.h)
+    {"vpt", makeVolPathTracer, true},  // volumetric path tracing, NEE + MIS (render/vpt.h)
 };
 
 }  // namespace
@@ -40,7 +43,19 @@ std::vector<std::string> integratorNames() {
 
 std::unique_ptr<Integrator> makeIntegrator(const Scene& scene, const RenderOptions& options) {
     for (const auto& e : kIntegrators)
-        if (options.algorithm == e.name) return e.make(scene, options);
+        if (options.algorithm == e.name) {
+            if (!e.handlesMedia && scene.hasMedia()) {
+                std::string media;
+                for (const auto& m : kIntegrators)
+                    if (m.handlesMedia) media += (media.empty() ? "" : ", ") + std::string(m.name);
+                throw InputError(scene.sourceFile,
+                                 "the scene has participating media, which '" +
+                                     options.algorithm +
+                                     "' does not render (it would ignore them); use a volumetric "
+                                     "algorithm: " + media);
+            }
+            return e.make(scene, options);
+        }
     std::string valid;
     for (const auto& e : kIntegrators) valid += (valid.empty() ? "" : ", ") + std::string(e.name);
     throw InputError("", "unknown algorithm '" + options.algorithm + "' (valid: " + valid + ")");

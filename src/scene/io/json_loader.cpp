@@ -242,7 +242,9 @@ void readJsonLights(JsonReader& r, const Json& lights, JsonSceneParts& parts) {
 void readRoot(JsonReader& r, const Json& root, JsonSceneParts& parts) {
     if (!r.isObject(root, "", "a scene object with \"camera\", \"materials\", \"shapes\" ..."))
         return;
-    r.checkKeys(root, "", {"description", "camera", "settings", "materials", "shapes", "lights"},
+    r.checkKeys(root, "",
+                {"description", "camera", "settings", "materials", "media", "medium", "shapes",
+                 "lights"},
                 "the scene");
     if (const Json* d = r.member(root, "", "description", Presence::Optional, ""))
         r.string(*d, "/description", true);
@@ -253,6 +255,11 @@ void readRoot(JsonReader& r, const Json& root, JsonSceneParts& parts) {
         readSettings(r, *s, parts);
     if (const Json* m = r.member(root, "", "materials", Presence::Optional, ""))
         readJsonMaterials(r, *m, parts);
+    // Media before shapes (shapes name their interior medium) and the global medium.
+    if (const Json* m = r.member(root, "", "media", Presence::Optional, ""))
+        readJsonMedia(r, *m, parts);
+    if (const Json* g = r.member(root, "", "medium", Presence::Optional, ""))
+        readJsonMediumRef(r, *g, "/medium", parts, &parts.globalMedium);
     // Shapes before lights: area lights of emissive shapes come first in Scene::lights
     // (in shape order), then the entries of "lights".
     size_t lightEntries = 0;
@@ -273,7 +280,8 @@ void readRoot(JsonReader& r, const Json& root, JsonSceneParts& parts) {
                 "an \"emission\")");
 }
 
-std::unique_ptr<Scene> buildScene(JsonSceneParts& parts, const std::string& fileName) {
+std::unique_ptr<Scene> buildScene(JsonSceneParts& parts, const std::string& fileName,
+                                  JsonReader& reader) {
     auto scene = std::make_unique<Scene>();
     scene->sourceFile = fileName;
     const JsonCameraDesc& c = parts.camera;
@@ -292,14 +300,25 @@ std::unique_ptr<Scene> buildScene(JsonSceneParts& parts, const std::string& file
             if (x.file.empty()) x.file = fileName;
         throw InputError(std::move(d));
     }
+    for (size_t i = 0; i < parts.media.size(); ++i)
+        scene->addMedium(parts.media[i], parts.mediumNames[i]);
+    scene->globalMediumId = parts.globalMedium;
     for (JsonShapeDesc& s : parts.shapes) {
         int lightId = s.lightIndex >= 0 ? lightIds[size_t(s.lightIndex)] : -1;
-        int materialId = materialIds[size_t(s.materialId)];
-        if (s.isSphere)
-            scene->addSphere(s.center, s.radius, materialId, lightId, s.name);
-        else
-            scene->addMesh(std::move(s.mesh), materialId, lightId, s.name);
+        int materialId = s.materialId >= 0 ? materialIds[size_t(s.materialId)] : -1;
+        uint32_t id = s.isSphere ? scene->addSphere(s.center, s.radius, materialId, lightId, s.name)
+                                 : scene->addMesh(std::move(s.mesh), materialId, lightId, s.name);
+        if (s.isMediumBoundary)
+            scene->setMediumBoundary(id, s.interiorMedium, s.priority, s.imaginary);
     }
+    // Media set-up errors (open boundary meshes, conflicting priorities), at the shape.
+    for (const MediumIssue& issue : scene->mediumIssues()) {
+        std::string ptr = issue.shapeId >= 0 ? parts.shapes[size_t(issue.shapeId)].ptr
+                          : issue.mediumId >= 0 ? parts.mediumPtrs[size_t(issue.mediumId)]
+                                                : std::string("/shapes");
+        reader.error(ptr, issue.message);
+    }
+    reader.diagnostics().throwIfErrors();
     scene->backgroundLightId =
         parts.backgroundLight >= 0 ? lightIds[size_t(parts.backgroundLight)] : -1;
     scene->commit();
@@ -327,7 +346,7 @@ std::unique_ptr<Scene> loadJsonSceneFromString(const std::string& text, const st
     readRoot(reader, root, parts);
     diags.throwIfErrors();
     if (warnings) *warnings = diags.warnings();
-    return buildScene(parts, fileName);
+    return buildScene(parts, fileName, reader);
 }
 
 std::unique_ptr<Scene> loadJsonScene(const std::string& path, std::vector<Diagnostic>* warnings) {

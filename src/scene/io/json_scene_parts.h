@@ -12,6 +12,7 @@
 #include "scene/io/json_reader.h"
 #include "scene/light.h"
 #include "scene/material.h"
+#include "scene/medium.h"
 #include "scene/scene.h"
 
 namespace ub {
@@ -31,6 +32,12 @@ struct JsonShapeDesc {
     float radius = 0.0f;  ///< spheres, world space
     int materialId = -1;  ///< index into JsonSceneParts::materials
     int lightIndex = -1;  ///< index into JsonSceneParts::lights, or -1
+    std::string ptr;  ///< JSON pointer of the shape, for messages after reading
+    // Medium boundary ("interior_medium", "priority", "imaginary").
+    bool isMediumBoundary = false;
+    int interiorMedium = -1;  ///< index into JsonSceneParts::media, -1 = vacuum
+    int priority = 0;
+    bool imaginary = false;
 };
 
 struct JsonSceneParts {
@@ -45,6 +52,11 @@ struct JsonSceneParts {
     std::vector<Light> lights;
     int backgroundLight = -1;    ///< index into lights
     std::string environmentPtr;  ///< JSON pointer of the environment light, for messages
+    std::vector<Medium> media;
+    std::vector<std::string> mediumNames;  ///< in file order
+    std::vector<std::string> mediumPtrs;   ///< JSON pointer of each medium
+    std::map<std::string, int> mediumIds;  ///< by name
+    int globalMedium = -1;                 ///< "medium" at the top level, -1 vacuum
 };
 
 /// Resolves a path from the scene file: absolute paths stay, others start at baseDir.
@@ -52,6 +64,12 @@ std::string resolveScenePath(const std::string& baseDir, const std::string& path
 
 /// Reads "/materials" (an object: name -> material).
 void readJsonMaterials(JsonReader& r, const Json& materials, JsonSceneParts& parts);
+/// Reads "/media" (an object: name -> medium).
+void readJsonMedia(JsonReader& r, const Json& media, JsonSceneParts& parts);
+/// Reads a medium reference: a medium name, or null for vacuum. Returns false (after an
+/// error) on an unknown name or a wrong type; *id = -1 for vacuum.
+bool readJsonMediumRef(JsonReader& r, const Json& v, const std::string& ptr,
+                       const JsonSceneParts& parts, int* id);
 /// Reads "/shapes" (an array), creating area lights for emissive shapes.
 void readJsonShapes(JsonReader& r, const Json& shapes, JsonSceneParts& parts);
 /// Reads a "transform" value: {"scale", "rotate", "translate"} or {"matrix"}.

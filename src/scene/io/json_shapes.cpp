@@ -162,7 +162,8 @@ void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
     std::string type = r.string(*typeJson, typePtr);
     if (type.empty()) return;
     std::vector<std::string> keys = {"type",      "name",     "material",
-                                     "transform", "emission", "emission_two_sided"};
+                                     "transform", "emission", "emission_two_sided",
+                                     "interior_medium", "priority", "imaginary"};
     if (type == "obj" || type == "ply") {
         keys.push_back("file");
     } else if (type == "sphere") {
@@ -195,10 +196,39 @@ void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
         r.error(jsonPointerChild(ptr, "emission_two_sided"),
                 "\"emission_two_sided\" needs an \"emission\" on the same shape");
 
-    // Material: required, except on emitters (which are then black).
-    if (const Json* mj = r.member(v, ptr, "material",
-                                  v.contains("emission") ? Presence::Optional : Presence::Required,
-                                  "the name of a material defined in \"materials\"")) {
+    // Medium boundary (docs/scene-format.md, "Media in shapes").
+    shape.ptr = ptr;
+    shape.imaginary = r.getBool(v, ptr, "imaginary", false);
+    if (const Json* im = r.member(v, ptr, "interior_medium", Presence::Optional, "")) {
+        shape.isMediumBoundary = readJsonMediumRef(
+            r, *im, jsonPointerChild(ptr, "interior_medium"), parts, &shape.interiorMedium);
+    }
+    shape.priority =
+        int(r.getInteger(v, ptr, "priority", Presence::Optional, -1000000, 1000000, 0));
+    if (!v.contains("interior_medium")) {
+        for (const char* key : {"priority", "imaginary"})
+            if (v.contains(key))
+                r.error(jsonPointerChild(ptr, key),
+                        std::string("\"") + key +
+                            "\" needs an \"interior_medium\" on the same shape (a medium name, "
+                            "or null for vacuum)");
+    }
+    if (shape.imaginary) {
+        if (v.contains("emission"))
+            r.error(jsonPointerChild(ptr, "emission"),
+                    "an imaginary shape only changes the medium: it cannot emit light");
+        if (v.contains("material"))
+            r.error(jsonPointerChild(ptr, "material"),
+                    "an imaginary shape has no surface: remove its \"material\"");
+    }
+
+    // Material: required, except on emitters (which are then black) and imaginary shapes.
+    if (shape.imaginary) {
+        // no material: the surface is never a path vertex
+    } else if (const Json* mj = r.member(
+                   v, ptr, "material",
+                   v.contains("emission") ? Presence::Optional : Presence::Required,
+                   "the name of a material defined in \"materials\"")) {
         std::string mPtr = jsonPointerChild(ptr, "material");
         std::string name = r.string(*mj, mPtr);
         auto it = parts.materialIds.find(name);
