@@ -357,5 +357,31 @@ TEST(MediaJson, HomogeneousFormsGiveTheSameCoefficients) {
     EXPECT_EQ(scene->mediumNames[1], "b");
 }
 
+TEST(BundledMediaScenes, LoadWithTheirMediaAndNeedVpt) {
+    struct Expect {
+        const char* file;
+        size_t media;
+        int cameraMedium;  // the camera is outside every boundary in all five
+    };
+    const Expect scenes[] = {{"cornell-fog.json", 1, -1},
+                             {"cornell-smoke.json", 1, -1},
+                             {"glass-medium-caustics.json", 2, -1},
+                             {"forward-scattering.json", 1, -1},
+                             {"medium-specular-light.json", 1, -1}};
+    for (const Expect& e : scenes) {
+        auto scene = loadJsonScene(std::string(UNIBEAM_SOURCE_DIR) + "/scenes/" + e.file);
+        EXPECT_EQ(scene->media.size(), e.media) << e.file;
+        EXPECT_EQ(scene->cameraMediumStack.mediumId(), e.cameraMedium) << e.file;
+        EXPECT_EQ(scene->camera.width(), 256) << e.file;
+        EXPECT_TRUE(scene->hasMedia()) << e.file;
+        RenderOptions opt;
+        EXPECT_THROW(makeIntegrator(*scene, opt), InputError) << e.file;  // pt
+    }
+    // Inside the fog of the Cornell box, and inside the glass sphere (vacuum, priority 1).
+    auto fog = loadJsonScene(std::string(UNIBEAM_SOURCE_DIR) + "/scenes/cornell-fog.json");
+    EXPECT_EQ(fog->mediumStackAt(Vec3(0, 0, 0.5f)).mediumId(), 0);
+    EXPECT_EQ(fog->mediumStackAt(Vec3(0.55831f, 0.02453f, -0.78002f)).mediumId(), -1);
+}
+
 }  // namespace
 }  // namespace ub
