@@ -5,6 +5,8 @@
 // (a sanity check that the scene renders something). Not run by ctest.
 //
 // Usage: bench_vpt [--runs N] [SCENE ...]   (default: the five media scenes in scenes/)
+#include <tbb/info.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -12,8 +14,6 @@
 #include <ctime>
 #include <string>
 #include <vector>
-
-#include <tbb/info.h>
 
 #include "core/error.h"
 #include "render/integrator.h"
@@ -46,8 +46,7 @@ int main(int argc, char** argv) {
                               "forward-scattering", "medium-specular-light"})
             scenes.push_back(std::string(UNIBEAM_SOURCE_DIR) + "/scenes/" + s + ".json");
 
-    std::printf("vpt, median of %d runs, %d threads\n", runs,
-                tbb::info::default_concurrency());
+    std::printf("vpt, median of %d runs, %d threads\n", runs, tbb::info::default_concurrency());
     std::printf("%-28s %9s %12s %12s %12s\n", "scene", "size", "wall s/it", "cpu s/it",
                 "image mean");
     for (const std::string& path : scenes) {

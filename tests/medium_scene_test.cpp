@@ -3,9 +3,8 @@
 // boundaries, validation (open boundary meshes, conflicting priorities) and
 // the JSON "media" errors (docs/scene-format.md).
 #include <gtest/gtest.h>
-
-#include <openvdb/openvdb.h>
 #include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
 
 #include <cmath>
 #include <filesystem>
@@ -32,8 +31,9 @@ struct TempDir {
     fs::path path;
     TempDir() {
         path = fs::temp_directory_path() /
-               ("ub_medium_scene_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-                "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+               ("ub_medium_scene_" +
+                std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
         fs::create_directories(path);
     }
     ~TempDir() {
@@ -46,13 +46,16 @@ struct TempDir {
 /// point light and a camera at (0, 0.5, 5) looking at the origin.
 std::string mediaScene(const std::string& media, const std::string& globalMedium,
                        const std::string& shapes) {
-    std::string s = "{\n\"camera\": {\"position\": [0, 0.5, 5], \"target\": [0, 0, 0], "
-                    "\"resolution\": [16, 16]},\n"
-                    "\"materials\": {\"glass\": {\"type\": \"dielectric\", \"ior\": 1.5},"
-                    " \"white\": {\"type\": \"diffuse\"}},\n"
-                    "\"media\": {" + media + "},\n";
+    std::string s =
+        "{\n\"camera\": {\"position\": [0, 0.5, 5], \"target\": [0, 0, 0], "
+        "\"resolution\": [16, 16]},\n"
+        "\"materials\": {\"glass\": {\"type\": \"dielectric\", \"ior\": 1.5},"
+        " \"white\": {\"type\": \"diffuse\"}},\n"
+        "\"media\": {" +
+        media + "},\n";
     if (!globalMedium.empty()) s += "\"medium\": " + globalMedium + ",\n";
-    s += "\"shapes\": [" + shapes + "],\n"
+    s += "\"shapes\": [" + shapes +
+         "],\n"
          "\"lights\": [{\"type\": \"point\", \"position\": [0, 2.5, 0], \"intensity\": 1}]\n}\n";
     return s;
 }
@@ -98,7 +101,7 @@ TEST(MediumStack, HighestPriorityWinsAndPopRemovesAnyEntry) {
     EXPECT_EQ(s.mediumId(), 30);
     EXPECT_TRUE(s.pop(3));
     EXPECT_EQ(s.mediumId(), 20);
-    EXPECT_FALSE(s.pop(3));        // not on the stack any more: no-op
+    EXPECT_FALSE(s.pop(3));         // not on the stack any more: no-op
     EXPECT_TRUE(s.push(2, 20, 3));  // already inside: no duplicate
     EXPECT_EQ(s.count, 2);
     EXPECT_TRUE(s.pop(2));
@@ -114,14 +117,14 @@ TEST(MediumStack, OverflowIsReportedNotACrash) {
 }
 
 TEST(NestedMedia, GlassOfMilkInFogHasTheRightMediumEverywhere) {
-    auto scene = loadJsonSceneFromString(mediaScene(kFogMilk, "\"fog\"", kGlassOfMilk),
-                                         "milk.json", "");
+    auto scene =
+        loadJsonSceneFromString(mediaScene(kFogMilk, "\"fog\"", kGlassOfMilk), "milk.json", "");
     ASSERT_EQ(scene->media.size(), 2u);
     const int fog = 0, milk = 1, vacuum = -1;
     EXPECT_EQ(scene->globalMediumId, fog);
     EXPECT_EQ(scene->cameraMediumStack.mediumId(), fog);
     EXPECT_TRUE(scene->hasMedia());
-    EXPECT_EQ(scene->mediumStackAt(Vec3(2, 0, 0)).mediumId(), fog);          // room
+    EXPECT_EQ(scene->mediumStackAt(Vec3(2, 0, 0)).mediumId(), fog);         // room
     EXPECT_EQ(scene->mediumStackAt(Vec3(0, 0.85f, 0)).mediumId(), vacuum);  // glass, above milk
     EXPECT_EQ(scene->mediumStackAt(Vec3(0, 0.0f, 0)).mediumId(), milk);     // milk in the glass
     // Milk poking out below the glass (y in (-1.05, -1)): milk, priority 2 beats the fog.
@@ -139,8 +142,7 @@ TEST(NestedMedia, GlassOfMilkInFogHasTheRightMediumEverywhere) {
         float hitY;
         std::vector<int> media;  // of the trace's segments
     };
-    const Expected expected[] = {
-        {1.0f, {fog}}, {0.75f, {vacuum}}, {-1.05f, {milk, milk}}};
+    const Expected expected[] = {{1.0f, {fog}}, {0.75f, {vacuum}}, {-1.05f, {milk, milk}}};
     for (const Expected& e : expected) {
         MediumTrace trace;
         Hit hit;
@@ -169,8 +171,8 @@ TEST(NestedMedia, GlassOfMilkInFogHasTheRightMediumEverywhere) {
 }
 
 TEST(NestedMedia, PtRejectsScenesWithMedia) {
-    auto scene = loadJsonSceneFromString(mediaScene(kFogMilk, "\"fog\"", kGlassOfMilk),
-                                         "milk.json", "");
+    auto scene =
+        loadJsonSceneFromString(mediaScene(kFogMilk, "\"fog\"", kGlassOfMilk), "milk.json", "");
     RenderOptions opt;
     opt.algorithm = "pt";
     try {
@@ -187,8 +189,10 @@ TEST(NestedMedia, PtRejectsScenesWithMedia) {
 TEST(NestedMedia, ShadowRaysPassImaginaryBoundariesWithTransmittance) {
     // An imaginary cube [-1, 1]^3 of sigma_t = (1, 2, 3) in vacuum: a shadow ray along x from
     // -3 to 3 crosses 2 units of it; T = exp(-2 sigma_t), pass probability = mean of T.
-    const char* media = R"("m": {"type": "homogeneous", "sigma_a": [0.5, 1, 1.5], "sigma_s": [0.5, 1, 1.5]})";
-    const char* shapes = R"({"type": "cube", "name": "box", "interior_medium": "m", "imaginary": true})";
+    const char* media =
+        R"("m": {"type": "homogeneous", "sigma_a": [0.5, 1, 1.5], "sigma_s": [0.5, 1, 1.5]})";
+    const char* shapes =
+        R"({"type": "cube", "name": "box", "interior_medium": "m", "imaginary": true})";
     auto scene = loadJsonSceneFromString(mediaScene(media, "", shapes), "imag.json", "");
     MediumStack stack = scene->mediumStackAt(Vec3(-3, 0.1f, 0.2f));
     EXPECT_EQ(stack.mediumId(), -1);
@@ -210,25 +214,28 @@ TEST(NestedMedia, ShadowRaysPassImaginaryBoundariesWithTransmittance) {
     const float Th[3] = {std::exp(-1.0f), std::exp(-2.0f), std::exp(-3.0f)};
     EXPECT_NEAR(half.pdfScatterRevL, (1 * Th[0] + 2 * Th[1] + 3 * Th[2]) / 3.0f, 1e-5f);
     // A real (non-boundary) wall blocks.
-    const char* wall = R"({"type": "cube", "name": "box", "interior_medium": "m", "imaginary": true},
+    const char* wall =
+        R"({"type": "cube", "name": "box", "interior_medium": "m", "imaginary": true},
         {"type": "rectangle", "material": "white", "transform": {"rotate": {"axis": [0, 1, 0], "angle": 90}, "translate": [2, 0, 0]}})";
     auto walled = loadJsonSceneFromString(mediaScene(media, "", wall), "wall.json", "");
-    MediumShadow blocked = walled->shadowTransmittance(
-        Vec3(-3, 0.1f, 0.2f), Vec3(0.0f), walled->mediumStackAt(Vec3(-3, 0.1f, 0.2f)),
-        Vec3(3, 0.1f, 0.2f), Vec3(0.0f));
+    MediumShadow blocked = walled->shadowTransmittance(Vec3(-3, 0.1f, 0.2f), Vec3(0.0f),
+                                                       walled->mediumStackAt(Vec3(-3, 0.1f, 0.2f)),
+                                                       Vec3(3, 0.1f, 0.2f), Vec3(0.0f));
     EXPECT_TRUE(blocked.blocked);
     EXPECT_TRUE(isBlack(blocked.transmittance));
 }
 
 TEST(MediumValidation, OpenMeshBoundaryIsAnError) {
-    const char* shapes = R"({"type": "rectangle", "name": "sheet", "material": "white", "interior_medium": "fog"})";
+    const char* shapes =
+        R"({"type": "rectangle", "name": "sheet", "material": "white", "interior_medium": "fog"})";
     std::string err = allErrors(mediaScene(kFogMilk, "", shapes));
     EXPECT_TRUE(contains(err, "scene.json:")) << err;
     EXPECT_TRUE(contains(err, "/shapes/0")) << err;
     EXPECT_TRUE(contains(err, "shape 'sheet' is a medium boundary but its mesh is not closed"))
         << err;
     // A cube (closed after welding its 24 vertices by position) is accepted.
-    const char* cube = R"({"type": "cube", "name": "box", "material": "white", "interior_medium": "fog"})";
+    const char* cube =
+        R"({"type": "cube", "name": "box", "material": "white", "interior_medium": "fog"})";
     EXPECT_EQ(allErrors(mediaScene(kFogMilk, "", cube)), "");
 }
 
@@ -241,8 +248,9 @@ TEST(MediumValidation, ConflictingPrioritiesAreAnError) {
     ASSERT_EQ(d.size(), 1u);  // 'far' does not overlap 'a'
     std::string err = d[0].format();
     EXPECT_TRUE(contains(err, "/shapes/1")) << err;
-    EXPECT_TRUE(contains(err, "conflicting medium priorities: shapes 'a' and 'b' overlap, have "
-                              "the same priority 3"))
+    EXPECT_TRUE(contains(err,
+                         "conflicting medium priorities: shapes 'a' and 'b' overlap, have "
+                         "the same priority 3"))
         << err;
 }
 
@@ -274,7 +282,8 @@ TEST(MediaJson, BadCoefficientsGAndNamesAreReported) {
            "hg": {"type": "homogeneous", "sigma_s": 1, "g": 1},
            "both": {"type": "homogeneous", "sigma_s": 1, "sigma_t": 2, "albedo": 0.5},
            "vdbg": {"type": "heterogeneous", "file": "x.vdb", "g": -1.5})";
-    const char* shapes = R"({"type": "sphere", "material": "white", "radius": 1, "interior_medium": "mlik"})";
+    const char* shapes =
+        R"({"type": "sphere", "material": "white", "radius": 1, "interior_medium": "mlik"})";
     std::string err = allErrors(mediaScene(media, "\"nowhere\"", shapes));
     EXPECT_TRUE(contains(err, "at /media/neg/sigma_a/1:")) << err;
     EXPECT_TRUE(contains(err, "at /media/hg/g:")) << err;
@@ -318,8 +327,7 @@ TEST(MediaJson, VdbFileErrorsNameFileAndGrid) {
     EXPECT_TRUE(contains(err, "at /media/smoke/file: cannot use VDB file 'corrupt.vdb'")) << err;
     EXPECT_TRUE(contains(err, "not a readable OpenVDB file")) << err;
     err = allErrors(scene("ok.vdb", "smoke"), base);
-    EXPECT_TRUE(contains(err, "no grid of that name in the file; grids present: 'density'"))
-        << err;
+    EXPECT_TRUE(contains(err, "no grid of that name in the file; grids present: 'density'")) << err;
     err = allErrors(scene("vector.vdb", "velocity"), base);
     EXPECT_TRUE(contains(err, "expected a float (density) grid")) << err;
     err = allErrors(scene("missing.vdb", "density"), base);

@@ -41,7 +41,8 @@ TriangleMesh inwardCube(float halfSize) {
 struct Stats {
     int n = 0, block = 4, bw = 0, bh = 0;
     std::vector<double> imageMeans[3];
-    std::vector<std::vector<double>> blockMeans;  // [block] -> per iteration (luminance-free: sum of RGB)
+    std::vector<std::vector<double>>
+        blockMeans;  // [block] -> per iteration (luminance-free: sum of RGB)
     void add(const Image& img) {
         bw = img.width / block;
         bh = img.height / block;
@@ -107,8 +108,8 @@ std::unique_ptr<Scene> volumeFurnace(const Medium& medium, const Rgb& le, int re
     transformMesh(outward, Transform::scale(Vec3(1.001f)));
     uint32_t b = scene->addMesh(outward, -1, -1, "medium boundary");
     scene->setMediumBoundary(b, med, 0, /*imaginary=*/true);
-    scene->camera.setup(Vec3(0.1f, -0.05f, 0.0f), Vec3(0.3f, 0.2f, 1.0f), Vec3(0, 1, 0), 70.0f,
-                        res, res);
+    scene->camera.setup(Vec3(0.1f, -0.05f, 0.0f), Vec3(0.3f, 0.2f, 1.0f), Vec3(0, 1, 0), 70.0f, res,
+                        res);
     scene->commit();
     return scene;
 }
@@ -189,8 +190,7 @@ std::unique_ptr<Scene> mediumBoxScene(const Medium& medium, int res) {
     scene->addMesh(back, mat, -1, "back");
     TriangleMesh lamp = makeRectangle();
     transformMesh(lamp, Transform::translate(Vec3(0, 1.2f, 0)) *
-                            Transform::rotate(90.0f, Vec3(1, 0, 0)) *
-                            Transform::scale(Vec3(0.3f)));
+                            Transform::rotate(90.0f, Vec3(1, 0, 0)) * Transform::scale(Vec3(0.3f)));
     Light light;
     light.type = LightType::Area;
     light.radiance = Rgb(15.0f);
@@ -230,7 +230,8 @@ TEST(Vpt, ConstantVdbMatchesHomogeneous) {
     // Image mean per channel: two-sample z-test at 5 standard errors.
     for (int c = 0; c < 3; ++c) {
         double d = Stats::meanOf(a.imageMeans[c]) - Stats::meanOf(b.imageMeans[c]);
-        double se = std::sqrt(Stats::varOfMean(a.imageMeans[c]) + Stats::varOfMean(b.imageMeans[c]));
+        double se =
+            std::sqrt(Stats::varOfMean(a.imageMeans[c]) + Stats::varOfMean(b.imageMeans[c]));
         EXPECT_LT(std::fabs(d), 5.0 * se) << "channel " << c;
         EXPECT_LT(se, 0.02 * Stats::meanOf(b.imageMeans[c]));
     }
@@ -240,7 +241,8 @@ TEST(Vpt, ConstantVdbMatchesHomogeneous) {
     int failures = 0;
     for (size_t k = 0; k < a.blockMeans.size(); ++k) {
         double d = Stats::meanOf(a.blockMeans[k]) - Stats::meanOf(b.blockMeans[k]);
-        double se = std::sqrt(Stats::varOfMean(a.blockMeans[k]) + Stats::varOfMean(b.blockMeans[k]));
+        double se =
+            std::sqrt(Stats::varOfMean(a.blockMeans[k]) + Stats::varOfMean(b.blockMeans[k]));
         if (!(std::fabs(d) <= 4.5 * se + 1e-7) && failures++ < 5)
             ADD_FAILURE() << "block " << k << ": difference " << d << " stderr " << se;
     }
@@ -289,8 +291,8 @@ TEST(Vpt, MatchesPtWithoutMedia) {
                 sumPt += x;
                 sumVpt += y;
                 if (!(std::fabs(x - y) <= 1e-4 * std::max(std::fabs(x), 1.0)) && failures++ < 5)
-                    ADD_FAILURE() << "iteration " << it << " pixel " << i << ": pt " << x
-                                  << " vpt " << y;
+                    ADD_FAILURE() << "iteration " << it << " pixel " << i << ": pt " << x << " vpt "
+                                  << y;
             }
     }
     EXPECT_EQ(failures, 0);

@@ -49,10 +49,10 @@ std::unique_ptr<Integrator> makeIntegrator(const Scene& scene, const RenderOptio
                 for (const auto& m : kIntegrators)
                     if (m.handlesMedia) media += (media.empty() ? "" : ", ") + std::string(m.name);
                 throw InputError(scene.sourceFile,
-                                 "the scene has participating media, which '" +
-                                     options.algorithm +
+                                 "the scene has participating media, which '" + options.algorithm +
                                      "' does not render (it would ignore them); use a volumetric "
-                                     "algorithm: " + media);
+                                     "algorithm: " +
+                                     media);
             }
             return e.make(scene, options);
         }

@@ -15,8 +15,12 @@ namespace ub {
 
 namespace {
 
-inline ub_float3 toF3(const Vec3& v) { return ub_make_float3(v.x, v.y, v.z); }
-inline Vec3 fromF3(const ub_float3& v) { return Vec3(v.x, v.y, v.z); }
+inline ub_float3 toF3(const Vec3& v) {
+    return ub_make_float3(v.x, v.y, v.z);
+}
+inline Vec3 fromF3(const ub_float3& v) {
+    return Vec3(v.x, v.y, v.z);
+}
 
 inline float pdfAtoW(float pdfA, float dist, float cosAtLight) {
     return cosAtLight > 0.0f ? pdfA * dist * dist / cosAtLight : 0.0f;
@@ -76,8 +80,7 @@ Rgb VolPathTracer::tracePixel(int x, int y, int iteration) const {
     // Next-event estimation from pos (geoNormal zero in a medium). evalDir(dir, &pdfW)
     // returns f * |cos| (phase: the phase value) and the direction pdf incl. roulette;
     // stackFor(dir, &s) sets the stack for a shadow ray along dir (false: overflow).
-    auto nextEvent = [&](const Vec3& pos, const Vec3& geoNormal, auto&& evalDir,
-                         auto&& stackFor) {
+    auto nextEvent = [&](const Vec3& pos, const Vec3& geoNormal, auto&& evalDir, auto&& stackFor) {
         const int lightId = std::min(int(rng.uniform() * float(lightCount)), lightCount - 1);
         const Light& light = scene_.lights[size_t(lightId)];
         const Vec2 lightU = rng.uniform2();

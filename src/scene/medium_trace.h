@@ -27,8 +27,8 @@ constexpr float kMediumFarDistance = 1e30f;
 
 struct MediumTraceSegment {
     Vec3 origin;
-    float length = 0.0f;    ///< kMediumFarDistance for the last segment of an escaping ray
-    int32_t mediumId = -1;  ///< -1 vacuum
+    float length = 0.0f;         ///< kMediumFarDistance for the last segment of an escaping ray
+    int32_t mediumId = -1;       ///< -1 vacuum
     int32_t crossingShape = -1;  ///< boundary crossed at the end (-1: the real hit / infinity)
     int32_t crossingEntering = 0;
 };

@@ -23,7 +23,9 @@ std::string fmtPoint(const Vec3& p) {
     return buf;
 }
 
-bool finiteNonNegative(const Rgb& c) { return isFinite(c) && minComponent(c) >= 0.0f; }
+bool finiteNonNegative(const Rgb& c) {
+    return isFinite(c) && minComponent(c) >= 0.0f;
+}
 
 bool boundsOverlap(const Bounds3& a, const Bounds3& b) {
     return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y &&
@@ -36,13 +38,16 @@ bool mayOverlap(const ShapeInfo& a, const ShapeInfo& b) {
     if (!boundsOverlap(a.bounds, b.bounds)) return false;
     if (a.isSphere && b.isSphere) {
         Vec3 ca = a.bounds.center(), cb = b.bounds.center();
-        float ra = 0.5f * (a.bounds.hi.x - a.bounds.lo.x), rb = 0.5f * (b.bounds.hi.x - b.bounds.lo.x);
+        float ra = 0.5f * (a.bounds.hi.x - a.bounds.lo.x),
+              rb = 0.5f * (b.bounds.hi.x - b.bounds.lo.x);
         return length(ca - cb) < ra + rb;
     }
     return true;
 }
 
-uint64_t edgeKey(uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; }
+uint64_t edgeKey(uint32_t a, uint32_t b) {
+    return (uint64_t(a) << 32) | b;
+}
 
 /// Mesh closedness check: after welding vertices by exact position, every directed edge
 /// (a, b) of a triangle must occur exactly once and its reverse (b, a) exactly once, i.e.
@@ -95,9 +100,9 @@ size_t countBadEdges(const Scene& scene, uint32_t shapeId, size_t triangleCount,
 // Free-flight pdf products over a segment chain (medium_trace.h).
 struct ChainPdfs {
     Rgb T{1.0f};
-    float probPass = 1.0f;         // prod over all segments
-    float passBeforeLast = 1.0f;   // prod over all but the last
-    float passAfterFirst = 1.0f;   // prod over all but the first
+    float probPass = 1.0f;        // prod over all segments
+    float passBeforeLast = 1.0f;  // prod over all but the last
+    float passAfterFirst = 1.0f;  // prod over all but the first
     float fwdLast = 0.0f, revFirst = 0.0f;
     int count = 0;
 
@@ -108,8 +113,10 @@ struct ChainPdfs {
         const float pass = seg.probPass();
         T *= seg.transmittance;
         passBeforeLast = probPass;
-        if (count > 0) passAfterFirst *= pass;
-        else revFirst = seg.pdfScatterRevL();
+        if (count > 0)
+            passAfterFirst *= pass;
+        else
+            revFirst = seg.pdfScatterRevL();
         probPass *= pass;
         fwdLast = seg.pdfScatterFwdL();
         ++count;
@@ -144,17 +151,21 @@ std::vector<MediumIssue> Scene::mediumIssues() const {
         const Medium& m = media[i];
         const std::string name = "medium '" + (i < mediumNames.size() ? mediumNames[i] : "") + "'";
         if (!(std::fabs(m.g) < 1.0f))
-            add(-1, int(i), name + ": the Henyey-Greenstein g must lie in (-1, 1), got " +
-                                std::to_string(m.g));
+            add(-1, int(i),
+                name + ": the Henyey-Greenstein g must lie in (-1, 1), got " + std::to_string(m.g));
         if (m.type == MediumType::kHomogeneous) {
             if (!finiteNonNegative(m.sigmaA) || !finiteNonNegative(m.sigmaS) ||
                 !finiteNonNegative(m.Le))
-                add(-1, int(i), name + ": negative or non-finite coefficients (sigma_a, "
-                                       "sigma_s and emission must be finite and >= 0)");
+                add(-1, int(i),
+                    name +
+                        ": negative or non-finite coefficients (sigma_a, "
+                        "sigma_s and emission must be finite and >= 0)");
         } else if (!m.grid || !(m.densityScale >= 0.0f) || !std::isfinite(m.densityScale) ||
                    !finiteNonNegative(m.albedo) || maxComponent(m.albedo) > 1.0f) {
-            add(-1, int(i), name + ": needs a grid, a finite density scale >= 0 and an albedo "
-                                   "in [0, 1]");
+            add(-1, int(i),
+                name +
+                    ": needs a grid, a finite density scale >= 0 and an albedo "
+                    "in [0, 1]");
         }
     }
     if (globalMediumId < -1 || globalMediumId >= int(media.size()))
@@ -167,8 +178,9 @@ std::vector<MediumIssue> Scene::mediumIssues() const {
         boundaries.push_back(uint32_t(s));
         const std::string name = "shape '" + sh.name + "'";
         if (sh.interiorMediumId < -1 || sh.interiorMediumId >= int(media.size()))
-            add(int(s), -1, name + ": interior medium id " + std::to_string(sh.interiorMediumId) +
-                                " is out of range");
+            add(int(s), -1,
+                name + ": interior medium id " + std::to_string(sh.interiorMediumId) +
+                    " is out of range");
         if (sh.imaginary && sh.lightId >= 0)
             add(int(s), -1, name + " is an imaginary medium boundary and cannot emit light");
         if (!sh.isSphere) {
@@ -176,10 +188,11 @@ std::vector<MediumIssue> Scene::mediumIssues() const {
             size_t bad = countBadEdges(*this, uint32_t(s), sh.triangleCount, &a, &b);
             if (bad > 0)
                 add(int(s), -1,
-                    name + " is a medium boundary but its mesh is not closed: " +
-                        std::to_string(bad) +
+                    name +
+                        " is a medium boundary but its mesh is not closed: " + std::to_string(bad) +
                         " edges are not shared by exactly two triangles of opposite orientation "
-                        "(first: " + fmtPoint(a) + " - " + fmtPoint(b) +
+                        "(first: " +
+                        fmtPoint(a) + " - " + fmtPoint(b) +
                         "); a medium boundary must be a closed, consistently oriented surface");
         }
     }
@@ -205,9 +218,10 @@ std::vector<MediumIssue> Scene::mediumIssues() const {
         maxOverlap = std::max(maxOverlap, overlap);
     }
     if (maxOverlap + 1 > MediumStack::kCapacity)
-        add(-1, -1, "up to " + std::to_string(maxOverlap) +
-                        " medium boundaries overlap (bounding boxes); at most " +
-                        std::to_string(MediumStack::kCapacity - 1) + " can be nested");
+        add(-1, -1,
+            "up to " + std::to_string(maxOverlap) +
+                " medium boundaries overlap (bounding boxes); at most " +
+                std::to_string(MediumStack::kCapacity - 1) + " can be nested");
     return issues;
 }
 

@@ -124,6 +124,32 @@ std::string describeScene(const Scene& scene) {
         os << (int(i) == scene.backgroundLightId ? " (background)" : "") << "\n";
     }
 
+    if (!scene.media.empty() || scene.hasMedia()) {
+        os << "media: " << scene.media.size() << ", global medium "
+           << (scene.globalMediumId >= 0
+                   ? "'" + scene.mediumNames[size_t(scene.globalMediumId)] + "'"
+                   : std::string("vacuum"))
+           << "\n";
+        for (size_t i = 0; i < scene.media.size(); ++i) {
+            const Medium& m = scene.media[i];
+            os << "  medium " << i << ": '" << scene.mediumNames[i] << "' ";
+            if (m.type == MediumType::kHomogeneous)
+                os << "homogeneous, sigma_a " << vec(m.sigmaA) << ", sigma_s " << vec(m.sigmaS);
+            else
+                os << "heterogeneous, grid '" << (m.grid ? m.grid->name() : "")
+                   << "', density scale " << num(m.densityScale) << ", albedo " << vec(m.albedo);
+            os << ", g " << num(m.g) << "\n";
+        }
+        for (const ShapeInfo& sh : scene.shapes)
+            if (sh.isMediumBoundary)
+                os << "  boundary '" << sh.name << "': interior "
+                   << (sh.interiorMediumId >= 0
+                           ? "'" + scene.mediumNames[size_t(sh.interiorMediumId)] + "'"
+                           : std::string("vacuum"))
+                   << ", priority " << sh.mediumPriority << (sh.imaginary ? ", imaginary" : "")
+                   << "\n";
+    }
+
     if (scene.bounds.empty())
         os << "bounds: empty\n";
     else

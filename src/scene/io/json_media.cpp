@@ -19,15 +19,17 @@ const std::vector<std::string> kMediumTypes = {"homogeneous", "heterogeneous"};
 const NumberRange kG = NumberRange::open(-1.0, 1.0);
 
 void readHomogeneous(JsonReader& r, const Json& v, const std::string& ptr, Medium& med) {
-    r.checkKeys(v, ptr, {"type", "sigma_a", "sigma_s", "sigma_t", "albedo", "scale", "emission", "g"},
+    r.checkKeys(v, ptr,
+                {"type", "sigma_a", "sigma_s", "sigma_t", "albedo", "scale", "emission", "g"},
                 "homogeneous medium");
     const NumberRange nonNeg = NumberRange::nonNegative();
     const bool absorbScatter = v.contains("sigma_a") || v.contains("sigma_s");
     const bool extinctionAlbedo = v.contains("sigma_t") || v.contains("albedo");
     Rgb sigmaA(0.0f), sigmaS(0.0f);
     if (absorbScatter && extinctionAlbedo) {
-        r.error(ptr, "give either \"sigma_a\"/\"sigma_s\" or \"sigma_t\"/\"albedo\", not both "
-                     "forms");
+        r.error(ptr,
+                "give either \"sigma_a\"/\"sigma_s\" or \"sigma_t\"/\"albedo\", not both "
+                "forms");
     } else if (extinctionAlbedo) {
         Rgb sigmaT = r.getRgb(v, ptr, "sigma_t", Presence::Required, nonNeg, Rgb(0.0f));
         Rgb albedo = r.getRgb(v, ptr, "albedo", Presence::Required, NumberRange::closed(0.0, 1.0),
@@ -39,8 +41,9 @@ void readHomogeneous(JsonReader& r, const Json& v, const std::string& ptr, Mediu
         sigmaA = r.getRgb(v, ptr, "sigma_a", Presence::Optional, nonNeg, Rgb(0.0f));
         sigmaS = r.getRgb(v, ptr, "sigma_s", Presence::Optional, nonNeg, Rgb(0.0f));
     } else {
-        r.error(ptr, "a homogeneous medium needs its coefficients: \"sigma_a\" and/or "
-                     "\"sigma_s\", or \"sigma_t\" and \"albedo\" (per unit length, RGB)");
+        r.error(ptr,
+                "a homogeneous medium needs its coefficients: \"sigma_a\" and/or "
+                "\"sigma_s\", or \"sigma_t\" and \"albedo\" (per unit length, RGB)");
     }
     float scale = r.getNumber(v, ptr, "scale", Presence::Optional, nonNeg, 1.0f);
     Rgb emission = r.getRgb(v, ptr, "emission", Presence::Optional, nonNeg, Rgb(0.0f));
@@ -56,15 +59,15 @@ void readHomogeneous(JsonReader& r, const Json& v, const std::string& ptr, Mediu
                   "the medium emits nothing: emission is scaled by sigma_a, which is 0");
 }
 
-void readHeterogeneous(JsonReader& r, const Json& v, const std::string& ptr,
-                       JsonSceneParts& parts, Medium& med) {
+void readHeterogeneous(JsonReader& r, const Json& v, const std::string& ptr, JsonSceneParts& parts,
+                       Medium& med) {
     r.checkKeys(v, ptr, {"type", "file", "grid", "density_scale", "albedo", "g", "transform"},
                 "heterogeneous medium");
     size_t before = r.errorCount();
     float densityScale =
         r.getNumber(v, ptr, "density_scale", Presence::Optional, NumberRange::nonNegative(), 1.0f);
-    Rgb albedo = r.getRgb(v, ptr, "albedo", Presence::Optional, NumberRange::closed(0.0, 1.0),
-                          Rgb(1.0f));
+    Rgb albedo =
+        r.getRgb(v, ptr, "albedo", Presence::Optional, NumberRange::closed(0.0, 1.0), Rgb(1.0f));
     float g = r.getNumber(v, ptr, "g", Presence::Optional, kG, 0.0f);
     Transform toWorld;
     if (const Json* tj = r.member(v, ptr, "transform", Presence::Optional, ""))
@@ -144,19 +147,21 @@ bool readJsonMediumRef(JsonReader& r, const Json& v, const std::string& ptr,
     *id = -1;
     if (v.is_null()) return true;
     if (!v.is_string()) {
-        r.error(ptr, "expected the name of a medium defined in \"media\", or null for vacuum, "
-                     "got " + JsonReader::describeValue(v));
+        r.error(ptr,
+                "expected the name of a medium defined in \"media\", or null for vacuum, "
+                "got " +
+                    JsonReader::describeValue(v));
         return false;
     }
     std::string name = r.string(v, ptr);
     if (name.empty()) return false;
     auto it = parts.mediumIds.find(name);
     if (it == parts.mediumIds.end()) {
-        r.error(ptr, "unknown medium '" + name + "'" + didYouMean(name, parts.mediumNames) +
-                         (parts.mediumNames.empty()
-                              ? std::string(" (no media are defined in \"media\")")
-                              : " (defined: " + joinNames(parts.mediumNames) +
-                                    "; null means vacuum)"));
+        r.error(ptr,
+                "unknown medium '" + name + "'" + didYouMean(name, parts.mediumNames) +
+                    (parts.mediumNames.empty()
+                         ? std::string(" (no media are defined in \"media\")")
+                         : " (defined: " + joinNames(parts.mediumNames) + "; null means vacuum)"));
         return false;
     }
     *id = it->second;
