@@ -9,9 +9,12 @@
 #include <ImfOutputFile.h>
 #include <ImfStandardAttributes.h>
 #include <ImfStringAttribute.h>
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
+#include <vector>
 
 #include "core/error.h"
 
@@ -89,6 +92,76 @@ void writeExr(const std::string& path, const Image& img, const ImageMetadata& me
     } catch (const std::exception& e) {
         throw std::runtime_error("cannot write OpenEXR image '" + path + "': " + e.what());
     }
+}
+
+float srgbToLinear(float c) {
+    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+Image readPng(const std::string& path, bool linearize) {
+    if (!std::filesystem::is_regular_file(path)) throw InputError(path, "image file does not exist");
+    FILE* fp = std::fopen(path.c_str(), "rb");
+    if (!fp) throw InputError(path, "cannot open the PNG image");
+    unsigned char sig[8] = {};
+    if (std::fread(sig, 1, 8, fp) != 8 || png_sig_cmp(sig, 0, 8) != 0) {
+        std::fclose(fp);
+        throw InputError(path, "not a PNG file (bad signature)");
+    }
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    png_infop info = png ? png_create_info_struct(png) : nullptr;
+    // Declared before setjmp: libpng longjmps here on a corrupt file.
+    std::vector<unsigned char> data;
+    std::vector<png_bytep> rows;
+    int width = 0, height = 0, bitDepth = 8;
+    if (!png || !info || setjmp(png_jmpbuf(png))) {
+        png_destroy_read_struct(&png, &info, nullptr);
+        std::fclose(fp);
+        throw InputError(path, "corrupt or unsupported PNG image");
+    }
+    png_init_io(png, fp);
+    png_set_sig_bytes(png, 8);
+    png_read_info(png, info);
+    width = int(png_get_image_width(png, info));
+    height = int(png_get_image_height(png, info));
+    bitDepth = png_get_bit_depth(png, info);
+    const int colorType = png_get_color_type(png, info);
+    // Normalise to 8/16-bit RGB without alpha.
+    if (colorType == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
+    if (colorType == PNG_COLOR_TYPE_GRAY && bitDepth < 8) png_set_expand_gray_1_2_4_to_8(png);
+    if (png_get_valid(png, info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(png);
+    if (colorType == PNG_COLOR_TYPE_GRAY || colorType == PNG_COLOR_TYPE_GRAY_ALPHA)
+        png_set_gray_to_rgb(png);
+    png_set_strip_alpha(png);
+    if (bitDepth == 16) png_set_swap(png);  // little-endian byte order in the rows
+    png_read_update_info(png, info);
+    bitDepth = png_get_bit_depth(png, info);
+    const size_t rowBytes = png_get_rowbytes(png, info);
+    data.resize(rowBytes * size_t(height));
+    rows.resize(size_t(height));
+    for (int y = 0; y < height; ++y) rows[size_t(y)] = data.data() + size_t(y) * rowBytes;
+    png_read_image(png, rows.data());
+    png_read_end(png, nullptr);
+    png_destroy_read_struct(&png, &info, nullptr);
+    std::fclose(fp);
+    if (width <= 0 || height <= 0) throw InputError(path, "PNG image is empty");
+
+    Image img(width, height);
+    const float maxValue = bitDepth == 16 ? 65535.0f : 255.0f;
+    // Decode through a lookup table (at most 65536 entries).
+    std::vector<float> lut(size_t(maxValue) + 1);
+    for (size_t i = 0; i < lut.size(); ++i) {
+        float v = float(i) / maxValue;
+        lut[i] = linearize ? srgbToLinear(v) : v;
+    }
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                size_t i = size_t(y) * rowBytes + (size_t(x) * 3 + size_t(c)) * (bitDepth / 8);
+                unsigned v = bitDepth == 16 ? unsigned(data[i]) | (unsigned(data[i + 1]) << 8)
+                                            : unsigned(data[i]);
+                img.at(x, y)[c] = lut[v];
+            }
+    return img;
 }
 
 static unsigned char toSrgb8(float v) {

@@ -27,6 +27,14 @@ using ImageMetadata = std::map<std::string, std::string>;
 /// Reads the R, G, B channels of an OpenEXR file (Y only is replicated to RGB).
 /// Throws InputError if the file is missing, not an EXR, or has no colour channels.
 Image readExr(const std::string& path, ImageMetadata* metadata = nullptr);
+/// Reads an 8- or 16-bit PNG (grey, grey+alpha, RGB, RGBA or palette; alpha is dropped,
+/// grey is replicated to RGB). PNG values are sRGB-encoded, as Mitsuba 3 assumes for every
+/// PNG (gAMA/iCCP chunks are ignored): with linearize = true each value is decoded with the
+/// sRGB transfer function (IEC 61966-2-1), otherwise it is returned as value / max.
+/// Throws InputError if the file is missing or not a readable PNG.
+Image readPng(const std::string& path, bool linearize = true);
+/// The sRGB transfer function (IEC 61966-2-1): encoded value in [0,1] -> linear.
+float srgbToLinear(float encoded);
 /// Writes 32-bit float RGB with the given string attributes. Throws std::runtime_error on I/O failure.
 void writeExr(const std::string& path, const Image& img, const ImageMetadata& metadata = {});
 /// Writes an 8-bit sRGB PNG of img * 2^exposure (clamped). Throws std::runtime_error on failure.

@@ -23,6 +23,10 @@
 //                   (eta_o^2 with o = dirFix, the camera side); importance transport
 //                   uses its adjoint, eta_gen^2 in place of eta_fix^2, so
 //                   f_radiance(a, b) = f_importance(b, a).
+//  Plastic, RoughPlastic, ThinDielectric: Mitsuba 3's coated-diffuse and thin-sheet
+//                   models, in bsdf_plastic.cpp (banner there).
+// RGB parameters come from SurfaceColors (colors_): the Material's constants, or its
+// textures looked up at the hit by Scene::setupBsdf.
 //
 // Sidedness: opaque two-sided materials flip both normals to dirFix's side of the
 // shading normal; one-sided ones are black from the back (valid, contProb 0).
@@ -76,11 +80,22 @@ bool isDielectric(MaterialType t) {
     return t == MaterialType::Dielectric || t == MaterialType::RoughDielectric;
 }
 
+/// Materials whose normals are never flipped to dirFix's side.
+bool keepsNormalSide(MaterialType t) {
+    return isDielectric(t) || t == MaterialType::ThinDielectric;
+}
+
 }  // namespace
 
 bool Bsdf::setup(const Material& mat, const Vec3& dirFix, const Vec3& geoNormal,
                  const Vec3& shadingNormal, bool fromLight) {
+    return setup(mat, SurfaceColors::of(mat), dirFix, geoNormal, shadingNormal, fromLight);
+}
+
+bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& dirFix,
+                 const Vec3& geoNormal, const Vec3& shadingNormal, bool fromLight) {
     mat_ = &mat;
+    colors_ = colors;
     fromLight_ = fromLight;
     valid_ = false;
     black_ = false;
@@ -88,10 +103,13 @@ bool Bsdf::setup(const Material& mat, const Vec3& dirFix, const Vec3& geoNormal,
     probDiffuse_ = probGlossy_ = 0.0f;
     etaFix_ = etaOther_ = 1.0f;
     fresnelFix_ = 0.0f;
-    isDelta_ = mat.type == MaterialType::Mirror || mat.type == MaterialType::Dielectric;
+    specularWeight_ = 0.0f;
+    plasticBase_ = Rgb(0.0f);
+    isDelta_ = mat.type == MaterialType::Mirror || mat.type == MaterialType::Dielectric ||
+               mat.type == MaterialType::ThinDielectric;
 
     Vec3 ns = shadingNormal, ng = geoNormal;
-    if (!isDielectric(mat.type) && dot(dirFix, ns) < 0.0f) {
+    if (!keepsNormalSide(mat.type) && dot(dirFix, ns) < 0.0f) {
         if (mat.twoSided) {
             ns = -ns;
             ng = -ng;
@@ -108,11 +126,12 @@ bool Bsdf::setup(const Material& mat, const Vec3& dirFix, const Vec3& geoNormal,
     switch (mat.type) {
         case MaterialType::Diffuse:
             probDiffuse_ = 1.0f;
-            contProb_ = maxComponent(mat.diffuse);
+            contProb_ = maxComponent(colors_.diffuse);
             break;
         case MaterialType::Phong: {
             // Lobe selection proportional to the albedo estimates (SmallVCM).
-            float albedoDiffuse = luminance(mat.diffuse), albedoGlossy = luminance(mat.glossy);
+            float albedoDiffuse = luminance(colors_.diffuse),
+                  albedoGlossy = luminance(colors_.glossy);
             float total = albedoDiffuse + albedoGlossy;
             if (total > 1e-9f) {
                 probDiffuse_ = albedoDiffuse / total;
@@ -120,11 +139,11 @@ bool Bsdf::setup(const Material& mat, const Vec3& dirFix, const Vec3& geoNormal,
             } else {
                 black_ = true;
             }
-            contProb_ = maxComponent(mat.diffuse + mat.glossy);
+            contProb_ = maxComponent(colors_.diffuse + colors_.glossy);
             break;
         }
         case MaterialType::Mirror:
-            contProb_ = maxComponent(mat.specular);
+            contProb_ = maxComponent(colors_.specular);
             break;
         case MaterialType::Dielectric:
         case MaterialType::RoughDielectric:
@@ -136,11 +155,16 @@ bool Bsdf::setup(const Material& mat, const Vec3& dirFix, const Vec3& geoNormal,
                 etaOther_ = 1.0f;
             }
             fresnelFix_ = ub_fresnel_dielectric(std::fabs(localDirFix_.z), etaOther_ / etaFix_);
-            contProb_ = maxComponent(mat.specular);
+            contProb_ = maxComponent(colors_.specular);
             break;
         case MaterialType::RoughConductor:
             contProb_ =
-                maxComponent(mat.specular * fresnelConductor(localDirFix_.z, mat.eta, mat.k));
+                maxComponent(colors_.specular * fresnelConductor(localDirFix_.z, mat.eta, mat.k));
+            break;
+        case MaterialType::Plastic:
+        case MaterialType::RoughPlastic:
+        case MaterialType::ThinDielectric:
+            setupPlastic();
             break;
     }
     if (black_) contProb_ = 0.0f;
@@ -197,6 +221,12 @@ Rgb Bsdf::evalLocal(const Vec3& localGen, float cosGeoGen, float* directPdfW,
         case MaterialType::RoughDielectric:
             f = evalRoughDielectric(localGen, directPdfW, reversePdfW);
             break;
+        case MaterialType::Plastic:
+            f = evalPlastic(localGen, directPdfW, reversePdfW);
+            break;
+        case MaterialType::RoughPlastic:
+            f = evalRoughPlastic(localGen, directPdfW, reversePdfW);
+            break;
         default:
             break;
     }
@@ -208,7 +238,7 @@ Rgb Bsdf::evalPhong(const Vec3& gen, float* directPdfW, float* reversePdfW) cons
     if (fix.z <= 0.0f || gen.z <= 0.0f) return Rgb(0.0f);  // reflection above the surface only
     Rgb f(0.0f);
     if (probDiffuse_ > 0.0f) {
-        f += mat_->diffuse * kInvPi;
+        f += colors_.diffuse * kInvPi;
         *directPdfW += probDiffuse_ * ub_lambert_pdf(gen.z);
         *reversePdfW += probDiffuse_ * ub_lambert_pdf(fix.z);
     }
@@ -218,7 +248,7 @@ Rgb Bsdf::evalPhong(const Vec3& gen, float* directPdfW, float* reversePdfW) cons
         const Vec3 mirrorFix(-fix.x, -fix.y, fix.z);
         float cosAlpha = dot(mirrorFix, gen);
         float lobePdf = probGlossy_ * ub_power_cos_pdf(cosAlpha, mat_->exponent);
-        f += mat_->glossy * ub_phong_lobe(cosAlpha, mat_->exponent);
+        f += colors_.glossy * ub_phong_lobe(cosAlpha, mat_->exponent);
         *directPdfW += lobePdf;
         *reversePdfW += lobePdf;
     }
@@ -237,7 +267,7 @@ Rgb Bsdf::evalRoughConductor(const Vec3& gen, float* directPdfW, float* reverseP
     *directPdfW = ub_ggx_visible_pdf(fix.z, cosFixH, h.z, alpha) * ub_jacobian_reflect(cosGenH);
     *reversePdfW = ub_ggx_visible_pdf(gen.z, cosGenH, h.z, alpha) * ub_jacobian_reflect(cosFixH);
     // Walter eq. 20: F D G / (4 |i.n| |o.n|).
-    return mat_->specular * fresnelConductor(cosFixH, mat_->eta, mat_->k) *
+    return colors_.specular * fresnelConductor(cosFixH, mat_->eta, mat_->k) *
            (d * g2 / (4.0f * fix.z * gen.z));
 }
 
@@ -267,7 +297,7 @@ Rgb Bsdf::evalRoughDielectric(const Vec3& gen, float* directPdfW, float* reverse
         *directPdfW = fresnelFix * visFix * ub_jacobian_reflect(aGen);
         *reversePdfW = fresnelGen * visGen * ub_jacobian_reflect(aFix);
         const float g2 = ub_ggx_g2_correlated(cFix, cGen, alpha);
-        return mat_->specular * (fresnelFix * d * g2 / (4.0f * cFix * cGen));
+        return colors_.specular * (fresnelFix * d * g2 / (4.0f * cFix * cGen));
     }
     // Refraction: gen is on the side of IOR etaGen = etaOther_. F(cos_i, eta) equals
     // F(cos_t, 1/eta); it is computed from the outside direction whichever of the two is
@@ -281,7 +311,8 @@ Rgb Bsdf::evalRoughDielectric(const Vec3& gen, float* directPdfW, float* reverse
     // (dirFix towards the camera) and etaGen for importance (the adjoint BTDF).
     const float etaO = fromLight_ ? etaGen : etaFix_;
     const float g2 = ub_ggx_g2_separable(cFix, cGen, alpha);
-    return mat_->specular * (transmit * d * g2 * aFix * aGen * etaO * etaO / (cFix * cGen * denom));
+    return colors_.specular *
+           (transmit * d * g2 * aFix * aGen * etaO * etaO / (cFix * cGen * denom));
 }
 
 Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
@@ -314,6 +345,24 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
             gen = 2.0f * dot(fix, m) * m - fix;
             break;
         }
+        case MaterialType::Plastic:
+            // Delta coating reflection with probability plasticSpecularProb, else the base.
+            if (rnd.z < plasticSpecularProb(fix.z))
+                return sampleDelta(rnd, dirGen, pdfW, cosThetaGen, sampledEvent);
+            gen = sampleCosineHemisphere(Vec2(rnd.x, rnd.y));
+            event = kEventDiffuse;
+            break;
+        case MaterialType::RoughPlastic:
+            if (rnd.z < plasticSpecularProb(fix.z)) {
+                Vec3 m;
+                ub_ggx_sample_visible(fix.x, fix.y, fix.z, ggxAlpha(*mat_), rnd.x, rnd.y, &m.x,
+                                      &m.y, &m.z);
+                gen = 2.0f * dot(fix, m) * m - fix;
+            } else {
+                gen = sampleCosineHemisphere(Vec2(rnd.x, rnd.y));
+                event = kEventDiffuse;
+            }
+            break;
         case MaterialType::RoughDielectric: {
             // Work mirrored to dirFix's side (GGX is symmetric under z -> -z).
             const float side = fix.z < 0.0f ? -1.0f : 1.0f;
@@ -359,13 +408,30 @@ Rgb Bsdf::sampleDelta(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThet
     const Vec3& fix = localDirFix_;
     Vec3 gen(-fix.x, -fix.y, fix.z);  // mirror direction
     float prob = 1.0f;
-    Rgb weight = mat_->specular;
+    Rgb weight = colors_.specular;
     uint32_t event = kEventReflect;
-    if (mat_->type == MaterialType::Dielectric) {
+    if (mat_->type == MaterialType::Plastic) {
+        // Coating reflection: f cos / pdf = specular F(fix) / P(specular) (Mitsuba 3).
+        prob = plasticSpecularProb(fix.z);
+        weight = colors_.specular * fresnelFix_;
+    } else if (mat_->type == MaterialType::ThinDielectric) {
+        // Reflection 2r/(1+r) (ub_plastic.h), else straight through: the two refractions
+        // of the sheet cancel, so no eta^2 factor in either transport mode.
+        const float reflectance = fresnelFix_;
+        if (rnd.z < reflectance) {
+            prob = reflectance;
+            weight = colors_.specular * reflectance;
+        } else {
+            gen = -fix;
+            prob = 1.0f - reflectance;
+            weight = colors_.transmittance * (1.0f - reflectance);
+            event = kEventRefract;
+        }
+    } else if (mat_->type == MaterialType::Dielectric) {
         const float fresnel = fresnelFix_;
         if (rnd.z < fresnel) {
             prob = fresnel;
-            weight = mat_->specular * fresnel;
+            weight = colors_.specular * fresnel;
         } else {
             const float eta = etaFix_ / etaOther_;  // n_fix / n_gen
             float cosT;
@@ -373,7 +439,7 @@ Rgb Bsdf::sampleDelta(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThet
             gen = Vec3(-eta * fix.x, -eta * fix.y, fix.z > 0.0f ? -cosT : cosT);
             prob = 1.0f - fresnel;
             // Radiance is scaled by (n_fix/n_gen)^2 across the interface; importance is not.
-            weight = mat_->specular * ((1.0f - fresnel) * (fromLight_ ? 1.0f : eta * eta));
+            weight = colors_.specular * ((1.0f - fresnel) * (fromLight_ ? 1.0f : eta * eta));
             event = kEventRefract;
         }
     }

@@ -36,6 +36,22 @@
 
 namespace ub {
 
+/// A material's RGB parameters at one surface point: the constants of the Material, or
+/// its textures looked up at the hit's uv (Scene::setupBsdf).
+struct SurfaceColors {
+    Rgb diffuse, glossy, specular, transmittance;
+    /// The material's constants (no textures).
+    static SurfaceColors of(const Material& m) {
+        return {m.diffuse, m.glossy, m.specular, m.transmittance};
+    }
+};
+
+/// Precomputes a material's derived data (Plastic: Fdr of the coating; RoughPlastic: the
+/// coating transmittance table and internal reflectance). Scene::addMaterial calls it;
+/// code that builds a Bsdf from a Material of its own must call it after changing ior or
+/// alpha. Cheap for the other types (nothing to do).
+void prepareMaterial(Material& m);
+
 /// Which lobe sample() picked (for MIS bookkeeping and debugging).
 enum BsdfEvent : uint32_t {
     kEventNone = 0,
@@ -56,6 +72,10 @@ public:
     /// grazing the shading hemisphere (|cos| < 1e-6); callers then stop the path.
     bool setup(const Material& mat, const Vec3& dirFix, const Vec3& geoNormal,
                const Vec3& shadingNormal, bool fromLight);
+    /// Same, with the RGB parameters given (textures resolved at the hit); the Material
+    /// supplies the type and the scalar parameters.
+    bool setup(const Material& mat, const SurfaceColors& colors, const Vec3& dirFix,
+               const Vec3& geoNormal, const Vec3& shadingNormal, bool fromLight);
 
     /// f_s(dirFix, dirGen) for the non-delta lobes; 0 for pure delta materials.
     /// Any of the out pointers may be null.
@@ -72,7 +92,9 @@ public:
     float pdf(const Vec3& dirGen, bool reverse = false) const;
 
     bool isValid() const { return valid_; }
-    /// True if every lobe is a delta (mirror, smooth dielectric).
+    /// True if every lobe is a delta (mirror, smooth dielectric, thin dielectric). Plastic
+    /// mixes a delta reflection with a diffuse lobe: isDelta() is false, evaluate() and pdf()
+    /// cover the diffuse lobe and sample() reports kEventReflect for the delta one.
     bool isDelta() const { return isDelta_; }
     /// Russian-roulette continuation probability: max over RGB of the albedo
     /// estimate, clamped to [0,1] (SmallVCM's mContinuationProb).
@@ -91,6 +113,15 @@ private:
     Rgb evalPhong(const Vec3& localGen, float* directPdfW, float* reversePdfW) const;
     Rgb evalRoughConductor(const Vec3& localGen, float* directPdfW, float* reversePdfW) const;
     Rgb evalRoughDielectric(const Vec3& localGen, float* directPdfW, float* reversePdfW) const;
+    // Plastic, RoughPlastic, ThinDielectric (bsdf_plastic.cpp).
+    void setupPlastic();
+    Rgb evalPlastic(const Vec3& localGen, float* directPdfW, float* reversePdfW) const;
+    Rgb evalRoughPlastic(const Vec3& localGen, float* directPdfW, float* reversePdfW) const;
+    /// Probability of picking the specular lobe of a (rough) plastic seen from a
+    /// direction with |cos| = cosTheta (Mitsuba 3's weighting, see bsdf_plastic.cpp).
+    float plasticSpecularProb(float cosTheta) const;
+    /// Coating transmittance of a (rough) plastic for |cos| = cosTheta.
+    float plasticTransmittance(float cosTheta) const;
     /// Veach's adjoint factor for shading normals (1 for radiance transport).
     float shadingFactor(float cosShadingGen, float cosGeoGen) const;
     /// True if a dirGen with these cosines is on the allowed geometric side.
@@ -99,6 +130,7 @@ private:
                     uint32_t* sampledEvent) const;
 
     const Material* mat_ = nullptr;
+    SurfaceColors colors_;  ///< RGB parameters at this point (textures resolved)
     Frame frame_;        ///< shading frame (normal possibly flipped, see above)
     Vec3 localDirFix_;   ///< dirFix in frame_
     Vec3 geoNormal_;     ///< geometric normal, same side convention as frame_.n
@@ -114,6 +146,10 @@ private:
     // Fresnel reflectance of the smooth interface seen from dirFix.
     float etaFix_ = 1.0f, etaOther_ = 1.0f;
     float fresnelFix_ = 0.0f;
+    // Plastics: weight of the specular lobe in the selection (Mitsuba: s_mean / (d_mean +
+    // s_mean)), and the diffuse-base factor rho / (1 - Fint) per channel.
+    float specularWeight_ = 0.0f;
+    Rgb plasticBase_{0.0f};
 };
 
 }  // namespace ub

@@ -1,6 +1,6 @@
 // Light sampling and evaluation: SmallVCM's Illuminate / Emit / GetRadiance
 // (Georgiev 2012, "Implementing Vertex Connection and Merging", Sec. 5) for
-// area, point, directional, constant and image-based environment lights.
+// area, point, spot, directional, constant and image-based environment lights.
 //
 // Invariant the bidirectional estimators rely on: for every light and every
 // (point, direction) that illuminate() or emit() can produce, radianceAlong()
@@ -195,6 +195,27 @@ void Light::prepare() {
             if (!ub::isFinite(position))
                 throwLightError(*this, "point light position is not finite");
             break;
+        case LightType::Spot: {
+            if (!isFiniteNonNegative(intensity))
+                throwLightError(*this, "spot light intensity must be finite and non-negative");
+            if (!ub::isFinite(position)) throwLightError(*this, "spot light position is not finite");
+            float len = length(direction);
+            if (!std::isfinite(len) || !(len > 0))
+                throwLightError(*this, "spot light direction must be finite and non-zero");
+            direction = direction / len;
+            if (!(cutoffAngleDeg > 0.0f && cutoffAngleDeg <= 180.0f))
+                throwLightError(*this, "spot light cutoff_angle must be in (0, 180] degrees (got " +
+                                           std::to_string(cutoffAngleDeg) + ")");
+            if (!(beamWidthDeg >= 0.0f && beamWidthDeg <= cutoffAngleDeg))
+                throwLightError(*this, "spot light beam_width must be in [0, cutoff_angle] (got " +
+                                           std::to_string(beamWidthDeg) + ")");
+            cutoffRad = cutoffAngleDeg * (kPi / 180.0f);
+            const float beamRad = beamWidthDeg * (kPi / 180.0f);
+            cosCutoff = std::cos(cutoffRad);
+            cosBeamWidth = std::cos(beamRad);
+            invTransitionRad = cutoffRad > beamRad ? 1.0f / (cutoffRad - beamRad) : 0.0f;
+            break;
+        }
         case LightType::Directional: {
             if (!isFiniteNonNegative(radiance))
                 throwLightError(*this,
@@ -241,6 +262,33 @@ void Light::prepare() {
     prepared = true;
 }
 
+// ---- spot ------------------------------------------------------------------------
+
+float Light::spotFalloff(float cosTheta) const {
+    // Mitsuba 3 spot.cpp: 0 outside the cutoff cone, 1 inside the beam, in between linear
+    // in the angle from the cutoff.
+    if (!(cosTheta > cosCutoff)) return 0.0f;
+    if (cosTheta >= cosBeamWidth || invTransitionRad == 0.0f) return 1.0f;
+    const float theta = std::acos(std::min(1.0f, cosTheta));
+    return std::min(1.0f, std::max(0.0f, (cutoffRad - theta) * invTransitionRad));
+}
+
+float Light::spotPowerPerIntensity() const {
+    // int_0^b sin + int_b^c (c - t)/(c - b) sin dt = 1 - (sin c - sin b) / (c - b).
+    const double c = double(cutoffAngleDeg) * kPi / 180.0, b = double(beamWidthDeg) * kPi / 180.0;
+    const double inner = c > b ? 1.0 - (std::sin(c) - std::sin(b)) / (c - b) : 1.0 - std::cos(c);
+    return float(2.0 * kPi * inner);
+}
+
+namespace {
+
+/// Solid-angle pdf of emit()'s uniform cone sampling for a spot light.
+float spotConePdfW(const Light& l) {
+    return 1.0f / (2.0f * kPi * (1.0f - l.cosCutoff));
+}
+
+}  // namespace
+
 // ---- illuminate ------------------------------------------------------------------
 
 Rgb Light::illuminate(const SceneSphere& sphere, const Vec3& receivingPos, const Vec2& rnd,
@@ -281,6 +329,21 @@ Rgb Light::illuminate(const SceneSphere& sphere, const Vec3& receivingPos, const
             if (emissionPdfW) *emissionPdfW = uniformSpherePdfW();
             if (cosAtLight) *cosAtLight = 1.0f;
             return intensity;
+        }
+        case LightType::Spot: {
+            Vec3 toLight = position - receivingPos;
+            float distSqr = lengthSqr(toLight);
+            if (!(distSqr > 0)) return Rgb(0);
+            float dist = std::sqrt(distSqr);
+            Vec3 dir = toLight / dist;
+            float falloff = spotFalloff(dot(direction, -dir));
+            if (!(falloff > 0)) return Rgb(0);
+            *dirToLight = dir;
+            *distance = dist;
+            *directPdfW = distSqr;  // as a point light: I(dir) / d^2
+            if (emissionPdfW) *emissionPdfW = spotConePdfW(*this);
+            if (cosAtLight) *cosAtLight = 1.0f;
+            return intensity * falloff;
         }
         case LightType::Directional:
             *dirToLight = -direction;
@@ -342,6 +405,19 @@ Rgb Light::emit(const SceneSphere& sphere, const Vec2& rndDir, const Vec2& rndPo
             if (directPdfA) *directPdfA = 1.0f;
             if (cosThetaLight) *cosThetaLight = 1.0f;
             return intensity;
+        case LightType::Spot: {
+            // Uniform in the cutoff cone: cos theta uniform in [cos c, 1].
+            const float cosTheta = 1.0f - rndDir.x * (1.0f - cosCutoff);
+            const float sinTheta = std::sqrt(std::max(0.0f, 1.0f - cosTheta * cosTheta));
+            const float phi = 2.0f * kPi * rndDir.y;
+            const Vec3 local(sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta);
+            *positionOut = position;
+            *directionOut = Frame(direction).toWorld(local);
+            *emissionPdfW = spotConePdfW(*this);
+            if (directPdfA) *directPdfA = 1.0f;
+            if (cosThetaLight) *cosThetaLight = 1.0f;
+            return intensity * spotFalloff(cosTheta);
+        }
         case LightType::Directional:
             // Parallel rays through the scene-sphere disk on the side the light comes from.
             *positionOut = sceneDiskPoint(sphere, -direction, rndPos);
@@ -384,6 +460,7 @@ Rgb Light::radianceAlong(const SceneSphere& sphere, const Vec3& rayDir, const Ve
             return radiance;
         }
         case LightType::Point:
+        case LightType::Spot:
         case LightType::Directional:
             return Rgb(0);  // delta lights cannot be hit
         case LightType::ConstantEnv:

@@ -62,6 +62,7 @@ enum class LightType : uint32_t {
     Directional = 2,  ///< `direction` (travel direction of light), irradiance `radiance`
     ConstantEnv = 3,  ///< constant environment radiance
     EnvMap = 4,       ///< lat-long environment map, importance sampled
+    Spot = 5,         ///< Mitsuba 3 `spot`: `intensity` [W/sr] at `position`, axis `direction`
 };
 
 struct Light {
@@ -72,6 +73,13 @@ struct Light {
     Vec3 position{0, 0, 0};  ///< Point
     Vec3 direction{0, 0, -1};///< Directional: direction light travels (unit)
     bool twoSided = false;   ///< Area: emits from both sides
+    // ---- Spot (Mitsuba 3's `spot`): intensity(theta) = intensity * falloff(theta) with
+    // theta the angle to `direction`: 1 inside beamWidthDeg, a linear ramp in theta down to
+    // 0 at cutoffAngleDeg, 0 beyond. Mitsuba's defaults: cutoff 20, beam width 3/4 cutoff.
+    float cutoffAngleDeg = 20.0f;  ///< Spot: half-angle of the lit cone, in (0, 180]
+    float beamWidthDeg = 15.0f;    ///< Spot: half-angle of full intensity, in [0, cutoff]
+    float cosCutoff = 0.0f, cosBeamWidth = 0.0f;  ///< Spot: set by prepare()
+    float cutoffRad = 0.0f, invTransitionRad = 0.0f;  ///< Spot: set by prepare() (0: no ramp)
 
     // ---- Area light geometry (world space) ----
     std::vector<Vec3> triangles;  ///< 3 vertices per triangle (emits on the side of (p1-p0)x(p2-p0))
@@ -95,11 +103,23 @@ struct Light {
     /// a missing or invalid env map, or a non-rotation envToWorld.
     void prepare();
 
-    bool isDelta() const { return type == LightType::Point || type == LightType::Directional; }
+    bool isDelta() const {
+        return type == LightType::Point || type == LightType::Directional ||
+               type == LightType::Spot;
+    }
+    /// A single emitting point in free space (point and spot lights): shadow rays to it need
+    /// no offset at the light end.
+    bool isDeltaPosition() const { return type == LightType::Point || type == LightType::Spot; }
     /// False for lights at infinity (directional, environment).
     bool isFinite() const {
-        return type == LightType::Area || type == LightType::Point;
+        return type == LightType::Area || type == LightType::Point || type == LightType::Spot;
     }
+    /// Spot: the falloff factor in [0, 1] for cos(theta) to the axis (Mitsuba 3's spot).
+    float spotFalloff(float cosTheta) const;
+    /// Spot: total emitted power per unit intensity, 2 pi [1 - (sin c - sin b) / (c - b)]
+    /// for cutoff c and beam width b in radians (2 pi (1 - cos c) when b = c): the
+    /// integral of the falloff over the sphere.
+    float spotPowerPerIntensity() const;
     bool isEnvironment() const {
         return type == LightType::ConstantEnv || type == LightType::EnvMap;
     }
@@ -110,7 +130,9 @@ struct Light {
                    Vec3* dirToLight, float* distance, float* directPdfW, float* emissionPdfW,
                    float* cosAtLight) const;
     /// Samples an emitted ray (light subpath start). Returns emitted radiance
-    /// (Area/Env), intensity (Point) or irradiance (Directional) of the sample.
+    /// (Area/Env), intensity (Point; Spot: times the falloff) or irradiance (Directional)
+    /// of the sample. Spot lights sample directions uniformly in the cutoff cone,
+    /// emissionPdfW = 1 / (2 pi (1 - cos cutoff)) (illuminate() reports the same).
     Rgb emit(const SceneSphere& sphere, const Vec2& rndDir, const Vec2& rndPos, Vec3* position,
              Vec3* direction, float* emissionPdfW, float* directPdfA, float* cosThetaLight) const;
     /// Radiance arriving along rayDir (unit, from the shading point towards the light)

@@ -2,6 +2,7 @@
 // The BSDF built from a material at a hit is in scene/bsdf.h.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 
@@ -16,6 +17,18 @@ enum class MaterialType : uint32_t {
     Dielectric = 3,      ///< smooth glass: Fresnel reflection + refraction, `ior`, tint `specular`
     RoughConductor = 4,  ///< GGX microfacet conductor: `eta`, `k` (RGB), roughness `alpha`, tint `specular`
     RoughDielectric = 5, ///< GGX microfacet dielectric (Walter et al. 2007): `ior`, `alpha`, tint `specular`
+    Plastic = 6,         ///< Mitsuba 3 `plastic`: smooth coating (`ior` = int/ext) over Lambert `diffuse`
+    RoughPlastic = 7,    ///< Mitsuba 3 `roughplastic`: GGX coating (`alpha`) over Lambert `diffuse`
+    ThinDielectric = 8,  ///< Mitsuba 3 `thindielectric`: delta reflection `specular` + straight
+                         ///< transmission `transmittance`; `ior` of the sheet
+};
+
+/// Textured RGB parameters of a material, in Scene::textures (-1: the constant is used).
+struct MaterialTextures {
+    int diffuse = -1;        ///< replaces Material::diffuse
+    int glossy = -1;         ///< replaces Material::glossy
+    int specular = -1;       ///< replaces Material::specular
+    int transmittance = -1;  ///< replaces Material::transmittance
 };
 
 struct Material {
@@ -31,7 +44,24 @@ struct Material {
     float alpha = 0.1f;             ///< GGX roughness (alpha = roughness^2 convention NOT used: alpha as given)
     /// Two-sided: if true (default for opaque materials), the back side of a surface
     /// behaves like the front. Dielectrics ignore it: their inside is defined by the normal.
+    /// ThinDielectric ignores it too: the sheet is the same from both sides.
     bool twoSided = true;
+    Rgb transmittance{1, 1, 1};     ///< ThinDielectric: tint of the transmitted light
+    /// Plastic, RoughPlastic: Mitsuba's `nonlinear` (base albedo inside the internal
+    /// scattering sum, darker and more saturated colours); false keeps texture colours.
+    bool nonlinear = false;
+    MaterialTextures textures;      ///< textured parameters (Scene::setupBsdf looks them up)
+
+    // ---- derived data, filled by prepareMaterial() (scene/bsdf.h) ----
+    /// Plastic: Fdr of the coating seen from inside (fit); RoughPlastic: Mitsuba 3's
+    /// discretised hemispherical reflectance of the rough coating seen from inside.
+    float internalReflectance = 0.0f;
+    /// RoughPlastic: transmittance of the rough coating from outside at
+    /// mu = k / (size - 1) (kernels/shared/ub_plastic.h).
+    std::array<float, 64> coatingTransmittance{};
+    /// `ior` and `alpha` that prepareMaterial() used (-1: not prepared). Bsdf::setup throws
+    /// std::logic_error for a plastic whose current ior/alpha differ from these.
+    float preparedIor = -1.0f, preparedAlpha = -1.0f;
 };
 
 }  // namespace ub

@@ -44,6 +44,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "scene/bsdf.h"
 
 namespace ub {
 
@@ -238,7 +239,14 @@ Scene::Scene() : impl_(std::make_unique<Impl>()) {
 Scene::~Scene() = default;
 
 int Scene::addMaterial(const Material& m) {
+    for (int t : {m.textures.diffuse, m.textures.glossy, m.textures.specular,
+                  m.textures.transmittance})
+        if (t >= int(textures.size()))
+            throw std::logic_error("Scene::addMaterial: material '" + m.name +
+                                   "' refers to texture " + std::to_string(t) +
+                                   ", which was not added");
     materials.push_back(m);
+    prepareMaterial(materials.back());  // plastic tables (scene/bsdf.h)
     return int(materials.size()) - 1;
 }
 

@@ -15,8 +15,12 @@
 #include "scene/medium.h"
 #include "scene/medium_stack.h"
 #include "scene/medium_trace.h"
+#include "scene/texture.h"
 
 namespace ub {
+
+class Bsdf;
+struct SurfaceColors;
 
 /// Triangle mesh in world space (loaders apply transforms before adding).
 struct TriangleMesh {
@@ -71,6 +75,8 @@ public:
     // ---- building ----
     int addMaterial(const Material& m);
     int addLight(Light l);  ///< calls l.prepare() if not yet done; returns its index
+    /// Validates t (Texture::validate) and returns its index for MaterialTextures.
+    int addTexture(const Texture& t);
     /// Adds a triangle mesh; returns the shape id. lightId links an area light (or -1).
     uint32_t addMesh(TriangleMesh mesh, int materialId, int lightId, const std::string& name);
     uint32_t addSphere(const Vec3& center, float radius, int materialId, int lightId,
@@ -139,12 +145,22 @@ public:
     /// Same towards infinity along dir (directional and environment lights).
     MediumShadow shadowTransmittanceToInfinity(const Vec3& a, const Vec3& geoNormalA,
                                                const MediumStack& stackA, const Vec3& dir) const;
+    /// Sets up the BSDF of the hit's material with its textures looked up at hit.uv
+    /// (scene_textures.cpp). Every integrator builds its BSDFs through this. Returns
+    /// Bsdf::setup's result; false (and an invalid Bsdf) if the hit has no material.
+    bool setupBsdf(Bsdf* bsdf, const Hit& hit, const Vec3& dirFix, bool fromLight) const;
+    /// The same from stored vertex data (e.g. a light vertex kept for later connections).
+    bool setupBsdf(Bsdf* bsdf, int materialId, const Vec2& uv, const Vec3& dirFix,
+                   const Vec3& geoNormal, const Vec3& shadingNormal, bool fromLight) const;
+    /// The material's RGB parameters at uv (textures looked up, constants otherwise).
+    SurfaceColors surfaceColors(const Material& m, const Vec2& uv) const;
 
     // ---- data ----
     Camera camera;
     RenderSettings settings;
     std::vector<Material> materials;
     std::vector<Light> lights;
+    std::vector<Texture> textures;  ///< referenced by Material::textures
     int backgroundLightId = -1;   ///< environment light hit by escaping rays, or -1
     SceneSphere sceneSphere;      ///< bounding sphere of the geometry (and camera)
     Bounds3 bounds;

@@ -20,6 +20,12 @@ const char* materialTypeName(MaterialType t) {
             return "rough_conductor";
         case MaterialType::RoughDielectric:
             return "rough_dielectric";
+        case MaterialType::Plastic:
+            return "plastic";
+        case MaterialType::RoughPlastic:
+            return "rough_plastic";
+        case MaterialType::ThinDielectric:
+            return "thin_dielectric";
     }
     return "unknown";
 }
@@ -36,6 +42,8 @@ const char* lightTypeName(LightType t) {
             return "constant";
         case LightType::EnvMap:
             return "envmap";
+        case LightType::Spot:
+            return "spot";
     }
     return "unknown";
 }
@@ -109,6 +117,11 @@ std::string describeScene(const Scene& scene) {
                 break;
             case LightType::Point:
                 os << ", intensity " << vec(l.intensity) << " at " << vec(l.position);
+                break;
+            case LightType::Spot:
+                os << ", intensity " << vec(l.intensity) << " at " << vec(l.position)
+                   << " towards " << vec(l.direction) << ", cutoff " << num(l.cutoffAngleDeg)
+                   << " deg, beam " << num(l.beamWidthDeg) << " deg";
                 break;
             case LightType::Directional:
                 os << ", irradiance " << vec(l.radiance) << " towards " << vec(l.direction);

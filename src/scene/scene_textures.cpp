@@ -1,0 +1,44 @@
+// Scene::setupBsdf and texture lookups: every integrator builds its BSDFs here, so
+// textured parameters (scene/texture.h) reach all of them in the same way.
+#include <string>
+
+#include "core/error.h"
+#include "scene/bsdf.h"
+#include "scene/scene.h"
+
+namespace ub {
+
+int Scene::addTexture(const Texture& t) {
+    t.validate();
+    textures.push_back(t);
+    return int(textures.size()) - 1;
+}
+
+SurfaceColors Scene::surfaceColors(const Material& m, const Vec2& uv) const {
+    SurfaceColors c = SurfaceColors::of(m);
+    auto lookup = [&](int index, Rgb* value) {
+        if (index >= 0) *value = textures[size_t(index)].eval(uv);
+    };
+    lookup(m.textures.diffuse, &c.diffuse);
+    lookup(m.textures.glossy, &c.glossy);
+    lookup(m.textures.specular, &c.specular);
+    lookup(m.textures.transmittance, &c.transmittance);
+    return c;
+}
+
+bool Scene::setupBsdf(Bsdf* bsdf, int materialId, const Vec2& uv, const Vec3& dirFix,
+                      const Vec3& geoNormal, const Vec3& shadingNormal, bool fromLight) const {
+    if (materialId < 0 || size_t(materialId) >= materials.size()) {
+        *bsdf = Bsdf();
+        return false;
+    }
+    const Material& m = materials[size_t(materialId)];
+    return bsdf->setup(m, surfaceColors(m, uv), dirFix, geoNormal, shadingNormal, fromLight);
+}
+
+bool Scene::setupBsdf(Bsdf* bsdf, const Hit& hit, const Vec3& dirFix, bool fromLight) const {
+    return setupBsdf(bsdf, hit.materialId, hit.uv, dirFix, hit.geoNormal, hit.shadingNormal,
+                     fromLight);
+}
+
+}  // namespace ub

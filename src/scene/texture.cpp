@@ -1,0 +1,103 @@
+// Texture lookups (conventions: texture.h).
+#include "scene/texture.h"
+
+#include <cmath>
+
+#include "core/error.h"
+
+namespace ub {
+
+namespace {
+
+/// x - floor(x), in [0, 1).
+float frac(float x) {
+    float f = x - std::floor(x);
+    return f < 1.0f ? f : 0.0f;  // x = -1e-9 rounds to 1.0f
+}
+
+int wrapIndex(int i, int n) {
+    int r = i % n;
+    return r < 0 ? r + n : r;
+}
+
+/// Bilinear lookup with repeat wrapping; u, v in [0, 1).
+Rgb bilinear(const Image& img, float u, float v) {
+    // Continuous pixel coordinates with centres at integer + 1/2.
+    const float px = u * float(img.width) - 0.5f, py = v * float(img.height) - 0.5f;
+    const float fx = std::floor(px), fy = std::floor(py);
+    const float wx = px - fx, wy = py - fy;
+    const int x0 = wrapIndex(int(fx), img.width), y0 = wrapIndex(int(fy), img.height);
+    const int x1 = wrapIndex(int(fx) + 1, img.width), y1 = wrapIndex(int(fy) + 1, img.height);
+    return (img.at(x0, y0) * (1.0f - wx) + img.at(x1, y0) * wx) * (1.0f - wy) +
+           (img.at(x0, y1) * (1.0f - wx) + img.at(x1, y1) * wx) * wy;
+}
+
+[[noreturn]] void throwTextureError(const Texture& t, const std::string& message) {
+    Diagnostic d;
+    d.where = "texture '" + t.name + "'";
+    d.message = message;
+    throw InputError(std::vector<Diagnostic>{d});
+}
+
+bool validColor(const Rgb& c) {
+    return isFinite(c) && minComponent(c) >= 0.0f;
+}
+
+}  // namespace
+
+UvTransform UvTransform::fromMatrix4(const Transform& t) {
+    UvTransform r;
+    for (int i = 0; i < 2; ++i) {
+        r.m[i][0] = t.m[i][0];
+        r.m[i][1] = t.m[i][1];
+        r.m[i][2] = t.m[i][3];
+    }
+    return r;
+}
+
+Rgb Texture::eval(const Vec2& uvSurface) const {
+    if (type == TextureType::Constant) return color0;
+    const Vec2 uv = toUv.apply(uvSurface);
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return Rgb(0.0f);
+    const float u = frac(uv.x), v = frac(uv.y);
+    if (type == TextureType::Checkerboard) return (u > 0.5f) == (v > 0.5f) ? color0 : color1;
+    return bilinear(*image, u, v);
+}
+
+Rgb Texture::mean() const {
+    switch (type) {
+        case TextureType::Constant:
+            return color0;
+        case TextureType::Checkerboard:
+            return (color0 + color1) * 0.5f;
+        case TextureType::Bitmap:
+            return image ? image->mean() : Rgb(0.0f);
+    }
+    return Rgb(0.0f);
+}
+
+void Texture::validate() const {
+    for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 3; ++j)
+            if (!std::isfinite(toUv.m[i][j])) throwTextureError(*this, "to_uv is not finite");
+    switch (type) {
+        case TextureType::Constant:
+            if (!validColor(color0)) throwTextureError(*this, "colour must be finite and >= 0");
+            break;
+        case TextureType::Checkerboard:
+            if (!validColor(color0) || !validColor(color1))
+                throwTextureError(*this, "checkerboard colours must be finite and >= 0");
+            break;
+        case TextureType::Bitmap:
+            if (!image || image->width <= 0 || image->height <= 0)
+                throwTextureError(*this, "bitmap has no pixels");
+            for (const Rgb& p : image->pixels)
+                if (!validColor(p))
+                    throwTextureError(*this, "bitmap has a negative or non-finite pixel");
+            break;
+        default:
+            throwTextureError(*this, "unknown texture type");
+    }
+}
+
+}  // namespace ub
