@@ -191,11 +191,11 @@ TEST(Bsdf, PlasticChiSquare) {
         };
         auto pdf = [&](const Vec3& d) { return double(bsdf.pdf(tf.toWorld(d))); };
         const bool sharp = c.m->sharp;
-        auto res = ub::test::chi2TestSphere(sample, pdf, 200000, sharp ? 100 : 40,
-                                            sharp ? 200 : 80, sharp ? 4 : 10);
+        auto res = ub::test::chi2TestSphere(sample, pdf, 200000, sharp ? 100 : 40, sharp ? 200 : 80,
+                                            sharp ? 4 : 10);
         EXPECT_TRUE(res.message.empty()) << c.label() << ": " << res.message;
-        EXPECT_GT(res.pValue, alpha) << c.label() << ": chi2 = " << res.statistic
-                                     << ", dof = " << res.dof;
+        EXPECT_GT(res.pValue, alpha)
+            << c.label() << ": chi2 = " << res.statistic << ", dof = " << res.dof;
     }
 }
 
@@ -472,7 +472,7 @@ TEST(Bsdf, ThinDielectricInterreflectionSum) {
         for (int k = 0; k < 1000; ++k) {
             transmit += inside * (1 - r);  // leaves through the far side
             inside *= r;
-            reflect += inside * (1 - r);   // back through the near side
+            reflect += inside * (1 - r);  // back through the near side
             inside *= r;
         }
         EXPECT_NEAR(ub_thin_dielectric_reflectance(r), reflect, 1e-6) << r;

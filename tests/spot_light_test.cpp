@@ -59,11 +59,14 @@ TEST(SpotLight, EmitChiSquare) {
         auto sample = [&]() {
             Vec3 pos, dir;
             float emPdfW, pdfA, cosL;
-            l.emit(sceneSphere(), rng.uniform2(), rng.uniform2(), &pos, &dir, &emPdfW, &pdfA, &cosL);
+            l.emit(sceneSphere(), rng.uniform2(), rng.uniform2(), &pos, &dir, &emPdfW, &pdfA,
+                   &cosL);
             if (!(emPdfW > 0)) return Vec3(0.0f);
             return Vec3(dot(dir, f.n), dot(dir, f.s), dot(dir, f.t));
         };
-        auto pdf = [&](const Vec3& d) { return d.x > std::cos(cutoff * kPi / 180) ? conePdf : 0.0; };
+        auto pdf = [&](const Vec3& d) {
+            return d.x > std::cos(cutoff * kPi / 180) ? conePdf : 0.0;
+        };
         auto r = ub::test::chi2TestSphere(sample, pdf, 200000, 40, 80, 16);
         EXPECT_TRUE(r.message.empty()) << r.message;
         EXPECT_GT(r.pValue, ub::test::sidak(0.01, 2))
@@ -130,8 +133,11 @@ TEST(SpotLight, FalloffProfile) {
 // (100k cells: relative error < 1e-6) and (2) against the Monte Carlo estimate
 // E[emit() * cos / emissionPdfW] from 100k samples, within 4 standard errors.
 TEST(SpotLight, EmittedPowerMatchesAnalyticIntegral) {
-    for (auto cb : {std::pair<float, float>{30.0f, 20.0f}, {20.0f, 15.0f}, {60.0f, 0.0f},
-                    {45.0f, 45.0f}, {150.0f, 90.0f}}) {
+    for (auto cb : {std::pair<float, float>{30.0f, 20.0f},
+                    {20.0f, 15.0f},
+                    {60.0f, 0.0f},
+                    {45.0f, 45.0f},
+                    {150.0f, 90.0f}}) {
         const Light l = spot(cb.first, cb.second);
         const double analytic = l.spotPowerPerIntensity();
         const int n = 100000;
@@ -184,8 +190,8 @@ TEST(SpotLight, IlluminateIrradiance) {
         EXPECT_NEAR(dist, d, 1e-5f);
     }
     float pdfA = 1, emPdfW = 1;
-    EXPECT_TRUE(isBlack(
-        l.radianceAlong(sceneSphere(), -kAxis, l.position, Vec3(0.0f), &pdfA, &emPdfW)));
+    EXPECT_TRUE(
+        isBlack(l.radianceAlong(sceneSphere(), -kAxis, l.position, Vec3(0.0f), &pdfA, &emPdfW)));
     EXPECT_EQ(pdfA, 0.0f);
     EXPECT_TRUE(l.isDelta() && l.isDeltaPosition() && l.isFinite());
 }

@@ -79,7 +79,7 @@ TEST(Texture, CheckerboardMatchesMitsubaPattern) {
     EXPECT_TRUE(sameRgb(t.eval({0.75f, 0.75f}), kC0));
     EXPECT_TRUE(sameRgb(t.eval({0.75f, 0.25f}), kC1));
     EXPECT_TRUE(sameRgb(t.eval({0.25f, 0.75f}), kC1));
-    EXPECT_TRUE(sameRgb(t.eval({0.5f, 0.0f}), kC0));   // 0.5 is not > 0.5
+    EXPECT_TRUE(sameRgb(t.eval({0.5f, 0.0f}), kC0));    // 0.5 is not > 0.5
     EXPECT_TRUE(sameRgb(t.eval({1.25f, 3.25f}), kC0));  // period 1
     EXPECT_TRUE(sameRgb(t.eval({-0.25f, 0.25f}), kC1));
     EXPECT_TRUE(sameRgb(t.eval({-0.25f, -0.25f}), kC0));
@@ -189,7 +189,14 @@ TEST(Texture, PngReadErrors) {
     std::fwrite(sig, 1, 8, fp);
     std::fputs("garbage after the signature", fp);
     std::fclose(fp);
-    EXPECT_THROW(readPng(path), InputError);
+    try {
+        readPng(path);
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("corrupt or unsupported PNG image (libpng: "),
+                  std::string::npos)
+            << e.what();
+    }
     std::filesystem::remove(path);
 }
 

@@ -98,6 +98,18 @@ float srgbToLinear(float c) {
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
+namespace {
+
+/// libpng error handler: keeps the message for the InputError and returns to setjmp
+/// (libpng's default handler would also print to stderr).
+void pngError(png_structp png, png_const_charp message) {
+    if (auto* m = static_cast<std::string*>(png_get_error_ptr(png))) *m = message;
+    png_longjmp(png, 1);
+}
+void pngWarning(png_structp, png_const_charp) {}
+
+}  // namespace
+
 Image readPng(const std::string& path, bool linearize) {
     if (!std::filesystem::is_regular_file(path)) throw InputError(path, "image file does not exist");
     FILE* fp = std::fopen(path.c_str(), "rb");
@@ -107,7 +119,9 @@ Image readPng(const std::string& path, bool linearize) {
         std::fclose(fp);
         throw InputError(path, "not a PNG file (bad signature)");
     }
-    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    std::string pngMessage;
+    png_structp png =
+        png_create_read_struct(PNG_LIBPNG_VER_STRING, &pngMessage, pngError, pngWarning);
     png_infop info = png ? png_create_info_struct(png) : nullptr;
     // Declared before setjmp: libpng longjmps here on a corrupt file.
     std::vector<unsigned char> data;
@@ -116,7 +130,8 @@ Image readPng(const std::string& path, bool linearize) {
     if (!png || !info || setjmp(png_jmpbuf(png))) {
         png_destroy_read_struct(&png, &info, nullptr);
         std::fclose(fp);
-        throw InputError(path, "corrupt or unsupported PNG image");
+        throw InputError(path, "corrupt or unsupported PNG image" +
+                                   (pngMessage.empty() ? "" : " (libpng: " + pngMessage + ")"));
     }
     png_init_io(png, fp);
     png_set_sig_bytes(png, 8);

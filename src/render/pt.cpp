@@ -124,9 +124,7 @@ Rgb PathTracer::tracePixel(int x, int y, int iteration) const {
         if (pathLength >= maxLength || hit.materialId < 0) break;
 
         Bsdf bsdf;
-        if (!bsdf.setup(scene_.materials[size_t(hit.materialId)], -ray.dir, hit.geoNormal,
-                        hit.shadingNormal, /*fromLight=*/false))
-            break;
+        if (!scene_.setupBsdf(&bsdf, hit, -ray.dir, /*fromLight=*/false)) break;
         const float contProb = std::min(1.0f, bsdf.continuationProb());
 
         // ---- Next-event estimation: a path of length pathLength + 1 ----
@@ -158,7 +156,7 @@ Rgb PathTracer::tracePixel(int x, int y, int iteration) const {
                             // sit on surfaces we must not hit; point lights need no offset).
                             Vec3 lightPos = hit.pos + dirToLight * distance;
                             Vec3 lightOffsetDir =
-                                light.type == LightType::Point ? Vec3(0.0f) : -dirToLight;
+                                light.isDeltaPosition() ? Vec3(0.0f) : -dirToLight;
                             blocked =
                                 scene_.occluded(hit.pos, hit.geoNormal, lightPos, lightOffsetDir);
                         } else {

@@ -193,7 +193,8 @@ void Bsdf::setupPlastic() {
     } else {
         reflectance = 1.0f - plasticTransmittance(cosFix);
     }
-    contProb_ = maxComponent(colors_.specular * reflectance + colors_.diffuse * (1.0f - reflectance));
+    contProb_ =
+        maxComponent(colors_.specular * reflectance + colors_.diffuse * (1.0f - reflectance));
 }
 
 float Bsdf::plasticTransmittance(float cosTheta) const {
@@ -233,12 +234,12 @@ Rgb Bsdf::evalRoughPlastic(const Vec3& gen, float* directPdfW, float* reversePdf
     const float probSpecFix = plasticSpecularProb(fix.z), probSpecGen = plasticSpecularProb(gen.z);
     // Visible-normal density times the reflection Jacobian (Walter eq. 14), mixed with the
     // cosine lobe by the selection probabilities.
-    *directPdfW =
-        probSpecFix * ub_ggx_visible_pdf(fix.z, cosFixH, h.z, alpha) * ub_jacobian_reflect(cosGenH) +
-        (1.0f - probSpecFix) * ub_lambert_pdf(gen.z);
-    *reversePdfW =
-        probSpecGen * ub_ggx_visible_pdf(gen.z, cosGenH, h.z, alpha) * ub_jacobian_reflect(cosFixH) +
-        (1.0f - probSpecGen) * ub_lambert_pdf(fix.z);
+    *directPdfW = probSpecFix * ub_ggx_visible_pdf(fix.z, cosFixH, h.z, alpha) *
+                      ub_jacobian_reflect(cosGenH) +
+                  (1.0f - probSpecFix) * ub_lambert_pdf(gen.z);
+    *reversePdfW = probSpecGen * ub_ggx_visible_pdf(gen.z, cosGenH, h.z, alpha) *
+                       ub_jacobian_reflect(cosFixH) +
+                   (1.0f - probSpecGen) * ub_lambert_pdf(fix.z);
     const Rgb glossy = colors_.specular * (fresnel * d * g / (4.0f * fix.z * gen.z));
     const float transmit = plasticTransmittance(fix.z) * plasticTransmittance(gen.z);
     return glossy + plasticBase_ * (transmit * kInvPi / (eta * eta));

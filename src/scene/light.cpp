@@ -198,7 +198,8 @@ void Light::prepare() {
         case LightType::Spot: {
             if (!isFiniteNonNegative(intensity))
                 throwLightError(*this, "spot light intensity must be finite and non-negative");
-            if (!ub::isFinite(position)) throwLightError(*this, "spot light position is not finite");
+            if (!ub::isFinite(position))
+                throwLightError(*this, "spot light position is not finite");
             float len = length(direction);
             if (!std::isfinite(len) || !(len > 0))
                 throwLightError(*this, "spot light direction must be finite and non-zero");

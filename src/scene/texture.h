@@ -36,7 +36,8 @@ enum class TextureType : uint32_t {
 struct UvTransform {
     float m[2][3] = {{1, 0, 0}, {0, 1, 0}};
     Vec2 apply(const Vec2& uv) const {
-        return {m[0][0] * uv.x + m[0][1] * uv.y + m[0][2], m[1][0] * uv.x + m[1][1] * uv.y + m[1][2]};
+        return {m[0][0] * uv.x + m[0][1] * uv.y + m[0][2],
+                m[1][0] * uv.x + m[1][1] * uv.y + m[1][2]};
     }
     /// Mitsuba's reduction of a 4x4 transform to a 2D one: rows and columns 0 and 1 and
     /// the translation column 3 (the z row and column are dropped).
@@ -51,10 +52,10 @@ struct UvTransform {
 
 struct Texture {
     TextureType type = TextureType::Constant;
-    std::string name;           ///< for messages (e.g. the file of a bitmap)
-    Rgb color0{0.4f, 0.4f, 0.4f};  ///< Constant value; Checkerboard colour at uv' = (0, 0)
-    Rgb color1{0.2f, 0.2f, 0.2f};  ///< Checkerboard's other colour
-    UvTransform toUv;           ///< Checkerboard, Bitmap
+    std::string name;                    ///< for messages (e.g. the file of a bitmap)
+    Rgb color0{0.4f, 0.4f, 0.4f};        ///< Constant value; Checkerboard colour at uv' = (0, 0)
+    Rgb color1{0.2f, 0.2f, 0.2f};        ///< Checkerboard's other colour
+    UvTransform toUv;                    ///< Checkerboard, Bitmap
     std::shared_ptr<const Image> image;  ///< Bitmap: linear RGB, row 0 at v' = 0
 
     /// Value at the surface uv (before toUv). Non-finite uv gives black.
