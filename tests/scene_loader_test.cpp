@@ -414,17 +414,18 @@ TEST(JsonLoaderErrors, MissingRequiredKey) {
 TEST(JsonLoaderErrors, UnknownTypesListValidTypes) {
     auto d = errorsOf(sceneWith(R"json("white": {"type": "difuse"})json",
                                 R"json({"type": "cone", "material": "white"})json",
-                                R"json({"type": "spot"})json"));
+                                R"json({"type": "laser"})json"));
     ASSERT_EQ(d.size(), 3u);
     EXPECT_EQ(d[0].where, "/materials/white/type");
     EXPECT_EQ(d[0].message,
               "unknown material type 'difuse' (did you mean 'diffuse'?); valid types: "
-              "diffuse, phong, mirror, dielectric, rough_conductor, rough_dielectric");
+              "diffuse, phong, mirror, dielectric, rough_conductor, rough_dielectric, plastic, "
+              "rough_plastic, thin_dielectric");
     EXPECT_EQ(d[1].message,
               "unknown shape type 'cone' (did you mean 'cube'?); valid types: obj, ply, "
               "rectangle, cube, sphere");
     EXPECT_EQ(d[2].message,
-              "unknown light type 'spot'; valid types: point, directional, "
+              "unknown light type 'laser'; valid types: point, spot, directional, "
               "constant, envmap (area lights are shapes with an \"emission\")");
 }
 

@@ -32,7 +32,7 @@ struct LightVertex {
     float dVC;               ///< MIS partial [TR (32)/(34)]
     float dVM;               ///< MIS partial [TR (33)/(35)]
     uint32_t flags;          ///< reserved (0); e.g. medium vertices in UPBP
-    uint32_t pad0, pad1;     ///< explicit padding to 96 bytes (16-byte multiple)
+    Vec2 uv;                 ///< surface uv: Scene::setupBsdf looks the textures up here
 };
 
 // Layout check: the struct is read as raw memory by device code later.
@@ -45,5 +45,6 @@ static_assert(offsetof(LightVertex, dirFix) == 32, "LightVertex layout changed")
 static_assert(offsetof(LightVertex, geoNormal) == 48, "LightVertex layout changed");
 static_assert(offsetof(LightVertex, shadingNormal) == 64, "LightVertex layout changed");
 static_assert(offsetof(LightVertex, dVM) == 80, "LightVertex layout changed");
+static_assert(offsetof(LightVertex, uv) == 88, "LightVertex layout changed");
 
 }  // namespace ub

@@ -53,9 +53,7 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration) const {
         if (state.pathLength >= maxLength || hit.materialId < 0) break;
 
         Bsdf bsdf;
-        if (!bsdf.setup(scene_.materials[size_t(hit.materialId)], -state.ray.dir, hit.geoNormal,
-                        hit.shadingNormal, /*fromLight=*/false))
-            break;
+        if (!scene_.setupBsdf(&bsdf, hit, -state.ray.dir, /*fromLight=*/false)) break;
         // Complete the partials at this vertex [TR (31)-(36)].
         state.mis = ub_mis_at_hit(mis_, state.mis, hit.dist, bsdf.cosThetaFix(), 1);
 
@@ -129,7 +127,7 @@ Rgb VertexCM::directIllumination(Rng& rng, const SubPath& state, const Hit& hit,
     if (light.isFinite()) {
         const Vec3 lightPos = hit.pos + dirToLight * distance;
         // Area-light points sit on geometry: offset them back along the segment.
-        const Vec3 lightOffset = light.type == LightType::Point ? Vec3(0.0f) : -dirToLight;
+        const Vec3 lightOffset = light.isDeltaPosition() ? Vec3(0.0f) : -dirToLight;
         blocked = scene_.occluded(hit.pos, hit.geoNormal, lightPos, lightOffset);
     } else {
         blocked = scene_.occludedToInfinity(hit.pos, hit.geoNormal, dirToLight);
@@ -153,8 +151,8 @@ Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const
     cameraRevPdfW *= cameraCont;
 
     Bsdf lightBsdf;
-    if (!lightBsdf.setup(scene_.materials[lv.materialId], lv.dirFix, lv.geoNormal, lv.shadingNormal,
-                         /*fromLight=*/true))
+    if (!scene_.setupBsdf(&lightBsdf, int(lv.materialId), lv.uv, lv.dirFix, lv.geoNormal,
+                          lv.shadingNormal, /*fromLight=*/true))
         return Rgb(0.0f);
     float cosLight = 0.0f, lightDirPdfW = 0.0f, lightRevPdfW = 0.0f;
     Rgb fLight = lightBsdf.evaluate(-dir, &cosLight, &lightDirPdfW, &lightRevPdfW);

@@ -60,9 +60,7 @@ void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuf
             if (!scene_.intersect(state.ray, &hit)) break;
             if (hit.materialId < 0) break;  // pure emitter: absorbs
             Bsdf bsdf;
-            if (!bsdf.setup(scene_.materials[size_t(hit.materialId)], -state.ray.dir, hit.geoNormal,
-                            hit.shadingNormal, /*fromLight=*/true))
-                break;
+            if (!scene_.setupBsdf(&bsdf, hit, -state.ray.dir, /*fromLight=*/true)) break;
             // Complete the MIS partials at this vertex [TR (31)-(36)]; the first segment of a
             // light at infinity is in planar measure already [TR Sec. 5.1].
             state.mis = ub_mis_at_hit(mis_, state.mis, hit.dist, bsdf.cosThetaFix(),
@@ -82,6 +80,7 @@ void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuf
                 v.dVCM = state.mis.dVCM;
                 v.dVC = state.mis.dVC;
                 v.dVM = state.mis.dVM;
+                v.uv = hit.uv;
                 vertices.push_back(v);
             }
             // Light tracing: connect to the camera (a path of pathLength + 1 segments).

@@ -21,7 +21,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kLightTypes = {"point", "directional", "constant", "envmap"};
+const std::vector<std::string> kLightTypes = {"point", "spot", "directional", "constant",
+                                              "envmap"};
 
 /// nlohmann messages start with "[json.exception.parse_error.101] parse error at line 3,
 /// column 14: "; we print our own position, so keep only what follows.
@@ -169,6 +170,40 @@ void readLight(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
         light.type = LightType::Point;
         light.position = r.getVec3(v, ptr, "position", Presence::Required, Vec3(0.0f));
         light.intensity = r.getRgb(v, ptr, "intensity", Presence::Required, nonNeg, Rgb(0.0f));
+    } else if (type == "spot") {
+        keys.insert(keys.end(),
+                    {"position", "direction", "target", "intensity", "cutoff_angle", "beam_width"});
+        r.checkKeys(v, ptr, keys, "spot light");
+        light.type = LightType::Spot;
+        light.position = r.getVec3(v, ptr, "position", Presence::Required, Vec3(0.0f));
+        light.intensity = r.getRgb(v, ptr, "intensity", Presence::Required, nonNeg, Rgb(0.0f));
+        const bool hasDirection = v.contains("direction"), hasTarget = v.contains("target");
+        if (hasDirection == hasTarget) {
+            r.error(hasTarget ? jsonPointerChild(ptr, "target") : ptr,
+                    "a spot light needs exactly one of \"direction\" (the axis of its cone) or "
+                    "\"target\" (a point on the axis)");
+        } else if (hasDirection) {
+            light.direction =
+                r.getDirection(v, ptr, "direction", Presence::Required, Vec3(0, 0, -1));
+        } else {
+            const Vec3 target = r.getVec3(v, ptr, "target", Presence::Required, Vec3(0.0f));
+            if (lengthSqr(target - light.position) > 0.0f)
+                light.direction = normalize(target - light.position);
+            else
+                r.error(jsonPointerChild(ptr, "target"),
+                        "the target equals the position: the spot light has no direction");
+        }
+        light.cutoffAngleDeg = r.getNumber(v, ptr, "cutoff_angle", Presence::Optional,
+                                           NumberRange::leftOpen(0.0, 180.0), 20.0f);
+        // Mitsuba's default: 3/4 of the cutoff angle.
+        light.beamWidthDeg =
+            r.getNumber(v, ptr, "beam_width", Presence::Optional, NumberRange::closed(0.0, 180.0),
+                        0.75f * light.cutoffAngleDeg);
+        if (light.beamWidthDeg > light.cutoffAngleDeg)
+            r.error(jsonPointerChild(ptr, "beam_width"),
+                    "beam_width " + formatNumber(light.beamWidthDeg) + " exceeds cutoff_angle " +
+                        formatNumber(light.cutoffAngleDeg) +
+                        " (expected a number in [0, cutoff_angle] degrees)");
     } else if (type == "directional") {
         keys.insert(keys.end(), {"direction", "irradiance"});
         r.checkKeys(v, ptr, keys, "directional light");
@@ -217,8 +252,9 @@ void readLight(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
     if (v.contains("name")) light.name = r.getString(v, ptr, "name", Presence::Optional);
     if (r.errorCount() != before) return;
 
-    bool black =
-        light.type == LightType::Point ? isBlack(light.intensity) : isBlack(light.radiance);
+    bool black = light.type == LightType::Point || light.type == LightType::Spot
+                     ? isBlack(light.intensity)
+                     : isBlack(light.radiance);
     if (black) r.warning(ptr, "this light is black: it emits nothing");
     if (light.isEnvironment()) {
         if (parts.backgroundLight >= 0) {
@@ -288,6 +324,15 @@ std::unique_ptr<Scene> buildScene(JsonSceneParts& parts, const std::string& file
     scene->camera.setup(c.position, c.target, c.up, c.fovYDeg, c.width, c.height, c.lensRadius,
                         c.focusDistance);
     scene->settings = parts.settings;
+    // Textures first: materials refer to them by index (parts' indices are the scene's).
+    try {
+        for (const Texture& t : parts.textures) scene->addTexture(t);
+    } catch (const InputError& e) {
+        std::vector<Diagnostic> d = e.diagnostics();
+        for (auto& x : d)
+            if (x.file.empty()) x.file = fileName;
+        throw InputError(std::move(d));
+    }
     std::vector<int> materialIds;
     for (const Material& m : parts.materials) materialIds.push_back(scene->addMaterial(m));
     std::vector<int> lightIds;

@@ -23,7 +23,28 @@ const MetalPreset kMetals[] = {
 };
 
 const std::vector<std::string> kMaterialTypes = {
-    "diffuse", "phong", "mirror", "dielectric", "rough_conductor", "rough_dielectric"};
+    "diffuse",          "phong",   "mirror",        "dielectric",     "rough_conductor",
+    "rough_dielectric", "plastic", "rough_plastic", "thin_dielectric"};
+
+/// Mitsuba 3's default IORs: polypropylene (plastics), BK7 glass (thin_dielectric), air.
+constexpr float kPolypropyleneIor = 1.49f, kBk7Ior = 1.5046f, kAirIor = 1.000277f;
+
+/// Per-channel maximum of a texture's values (for energy checks of sums of colours).
+Rgb textureMax(const Texture& t) {
+    switch (t.type) {
+        case TextureType::Constant:
+            return t.color0;
+        case TextureType::Checkerboard:
+            return vmax(t.color0, t.color1);
+        case TextureType::Bitmap: {
+            Rgb m(0.0f);
+            if (t.image)
+                for (const Rgb& p : t.image->pixels) m = vmax(m, p);
+            return m;
+        }
+    }
+    return Rgb(0.0f);
+}
 
 std::vector<std::string> metalNames() {
     std::vector<std::string> names;
@@ -36,7 +57,12 @@ const NumberRange kReflectance = NumberRange::closed(0.0, 1.0);
 
 const char* kChannel[3] = {"red", "green", "blue"};
 
-void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material& mat) {
+void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material& mat,
+                  JsonSceneParts& parts) {
+    // A colour that may be a texture: fills the constant and the texture index.
+    auto colour = [&](const std::string& key, const Rgb& fallback, Rgb* value, int* texture) {
+        *texture = readJsonTexturedRgb(r, m, ptr, key, kReflectance, fallback, parts, value);
+    };
     if (!r.isObject(m, ptr, "a material object with a \"type\" key")) return;
     const Json* typeJson = r.member(m, ptr, "type", Presence::Required,
                                     "a material type: one of " + joinNames(kMaterialTypes));
@@ -50,23 +76,28 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         mat.type = MaterialType::Diffuse;
         keys.insert(keys.end(), {"reflectance", "two_sided"});
         r.checkKeys(m, ptr, keys, "diffuse material");
-        mat.diffuse = r.getRgb(m, ptr, "reflectance", Presence::Optional, kReflectance, Rgb(0.5f));
+        colour("reflectance", Rgb(0.5f), &mat.diffuse, &mat.textures.diffuse);
     } else if (type == "phong") {
         mat.type = MaterialType::Phong;
         keys.insert(keys.end(),
                     {"diffuse_reflectance", "glossy_reflectance", "exponent", "two_sided"});
         r.checkKeys(m, ptr, keys, "phong material");
-        mat.diffuse =
-            r.getRgb(m, ptr, "diffuse_reflectance", Presence::Optional, kReflectance, Rgb(0.0f));
-        mat.glossy =
-            r.getRgb(m, ptr, "glossy_reflectance", Presence::Optional, kReflectance, Rgb(0.0f));
+        colour("diffuse_reflectance", Rgb(0.0f), &mat.diffuse, &mat.textures.diffuse);
+        colour("glossy_reflectance", Rgb(0.0f), &mat.glossy, &mat.textures.glossy);
+        // Textured colours are checked with their per-channel maxima.
+        const Rgb maxDiffuse = mat.textures.diffuse >= 0
+                                   ? textureMax(parts.textures[size_t(mat.textures.diffuse)])
+                                   : mat.diffuse;
+        const Rgb maxGlossy = mat.textures.glossy >= 0
+                                  ? textureMax(parts.textures[size_t(mat.textures.glossy)])
+                                  : mat.glossy;
         mat.exponent =
             r.getNumber(m, ptr, "exponent", Presence::Required, NumberRange::positive(), 1.0f);
         // The modified Phong lobe is normalized ((n+2)/(2 pi) cos^n, Lafortune & Willems
         // 1994), so its albedo is at most glossy_reflectance; the sum with the Lambertian
         // part must stay <= 1 per channel to conserve energy.
         for (int c = 0; c < 3; ++c) {
-            float sum = mat.diffuse[c] + mat.glossy[c];
+            float sum = maxDiffuse[c] + maxGlossy[c];
             if (sum > 1.0f) {
                 r.error(ptr, "diffuse_reflectance + glossy_reflectance = " + formatNumber(sum) +
                                  " > 1 in the " + kChannel[c] +
@@ -79,7 +110,7 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         mat.type = MaterialType::Mirror;
         keys.insert(keys.end(), {"reflectance", "two_sided"});
         r.checkKeys(m, ptr, keys, "mirror material");
-        mat.specular = r.getRgb(m, ptr, "reflectance", Presence::Optional, kReflectance, Rgb(1.0f));
+        colour("reflectance", Rgb(1.0f), &mat.specular, &mat.textures.specular);
     } else if (type == "dielectric" || type == "rough_dielectric") {
         bool rough = type == "rough_dielectric";
         mat.type = rough ? MaterialType::RoughDielectric : MaterialType::Dielectric;
@@ -87,7 +118,7 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         if (rough) keys.push_back("alpha");
         r.checkKeys(m, ptr, keys, type + " material");
         mat.ior = r.getNumber(m, ptr, "ior", Presence::Required, NumberRange::positive(), 1.5f);
-        mat.specular = r.getRgb(m, ptr, "tint", Presence::Optional, kReflectance, Rgb(1.0f));
+        colour("tint", Rgb(1.0f), &mat.specular, &mat.textures.specular);
         if (rough)
             mat.alpha = r.getNumber(m, ptr, "alpha", Presence::Required,
                                     NumberRange::leftOpen(0.0, 1.0), 0.1f);
@@ -123,13 +154,50 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         }
         mat.alpha =
             r.getNumber(m, ptr, "alpha", Presence::Required, NumberRange::leftOpen(0.0, 1.0), 0.1f);
-        mat.specular = r.getRgb(m, ptr, "tint", Presence::Optional, kReflectance, Rgb(1.0f));
+        colour("tint", Rgb(1.0f), &mat.specular, &mat.textures.specular);
+    } else if (type == "plastic" || type == "rough_plastic") {
+        const bool rough = type == "rough_plastic";
+        mat.type = rough ? MaterialType::RoughPlastic : MaterialType::Plastic;
+        keys.insert(keys.end(), {"diffuse_reflectance", "specular_reflectance", "int_ior",
+                                 "ext_ior", "nonlinear", "two_sided"});
+        if (rough) keys.push_back("alpha");
+        r.checkKeys(m, ptr, keys, type + " material");
+        colour("diffuse_reflectance", Rgb(0.5f), &mat.diffuse, &mat.textures.diffuse);
+        colour("specular_reflectance", Rgb(1.0f), &mat.specular, &mat.textures.specular);
+        const float intIor = r.getNumber(m, ptr, "int_ior", Presence::Optional,
+                                         NumberRange::positive(), kPolypropyleneIor);
+        const float extIor =
+            r.getNumber(m, ptr, "ext_ior", Presence::Optional, NumberRange::positive(), kAirIor);
+        mat.ior = intIor / extIor;
+        if (rough && intIor == extIor)
+            r.error(jsonPointerChild(ptr, "int_ior"),
+                    "int_ior and ext_ior are equal (" + formatNumber(intIor) +
+                        "): a rough_plastic needs a coating that differs from the outside");
+        mat.nonlinear = r.getBool(m, ptr, "nonlinear", false);
+        if (rough)
+            mat.alpha = r.getNumber(m, ptr, "alpha", Presence::Optional,
+                                    NumberRange::leftOpen(0.0, 1.0), 0.1f);
+    } else if (type == "thin_dielectric") {
+        mat.type = MaterialType::ThinDielectric;
+        keys.insert(keys.end(),
+                    {"int_ior", "ext_ior", "specular_reflectance", "specular_transmittance"});
+        r.checkKeys(m, ptr, keys, "thin_dielectric material");
+        const float intIor =
+            r.getNumber(m, ptr, "int_ior", Presence::Optional, NumberRange::positive(), kBk7Ior);
+        const float extIor =
+            r.getNumber(m, ptr, "ext_ior", Presence::Optional, NumberRange::positive(), kAirIor);
+        mat.ior = intIor / extIor;
+        colour("specular_reflectance", Rgb(1.0f), &mat.specular, &mat.textures.specular);
+        colour("specular_transmittance", Rgb(1.0f), &mat.transmittance,
+               &mat.textures.transmittance);
+        mat.twoSided = false;  // a sheet: both sides alike whatever the flag
     } else {
         r.error(typePtr, "unknown material type '" + type + "'" + didYouMean(type, kMaterialTypes) +
                              "; valid types: " + joinNames(kMaterialTypes));
         return;
     }
-    if (mat.type != MaterialType::Dielectric && mat.type != MaterialType::RoughDielectric)
+    if (mat.type != MaterialType::Dielectric && mat.type != MaterialType::RoughDielectric &&
+        mat.type != MaterialType::ThinDielectric)
         mat.twoSided = r.getBool(m, ptr, "two_sided", true);
 }
 
@@ -146,7 +214,7 @@ void readJsonMaterials(JsonReader& r, const Json& materials, JsonSceneParts& par
         }
         Material mat;
         mat.name = item.key();
-        readMaterial(r, item.value(), itemPtr, mat);
+        readMaterial(r, item.value(), itemPtr, mat, parts);
         parts.materialIds[mat.name] = int(parts.materials.size());
         parts.materialNames.push_back(mat.name);
         parts.materials.push_back(mat);

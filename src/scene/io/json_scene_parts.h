@@ -5,6 +5,7 @@
 #pragma once
 
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,8 @@ struct JsonSceneParts {
     JsonCameraDesc camera;
     RenderSettings settings;
     std::vector<Material> materials;
+    std::vector<Texture> textures;           ///< Material::textures index these (and Scene's)
+    std::map<std::string, std::shared_ptr<const Image>> bitmapCache;  ///< by path (+ "|raw")
     std::map<std::string, int> materialIds;  ///< by name
     std::vector<std::string> materialNames;  ///< in file order, for messages
     std::vector<JsonShapeDesc> shapes;
@@ -70,6 +73,12 @@ void readJsonMedia(JsonReader& r, const Json& media, JsonSceneParts& parts);
 /// error) on an unknown name or a wrong type; *id = -1 for vacuum.
 bool readJsonMediumRef(JsonReader& r, const Json& v, const std::string& ptr,
                        const JsonSceneParts& parts, int* id);
+/// Reads obj[key] (optional) as an RGB colour in `range` or a texture object
+/// (json_textures.cpp). Returns the index of the new texture in parts.textures, or -1 for a
+/// plain colour, which goes to *value (fallback when absent or wrong; a texture's mean).
+int readJsonTexturedRgb(JsonReader& r, const Json& obj, const std::string& objPtr,
+                        const std::string& key, const NumberRange& range, const Rgb& fallback,
+                        JsonSceneParts& parts, Rgb* value);
 /// Reads "/shapes" (an array), creating area lights for emissive shapes.
 void readJsonShapes(JsonReader& r, const Json& shapes, JsonSceneParts& parts);
 /// Reads a "transform" value: {"scale", "rotate", "translate"} or {"matrix"}.
