@@ -60,7 +60,7 @@ TEST(MeshIo, ObjTriangleWithNormalsAndUvs) {
     ASSERT_EQ(m.uvs.size(), 3u);
     EXPECT_FLOAT_EQ(m.positions[m.indices[1]].x, 2.0f);
     EXPECT_FLOAT_EQ(m.uvs[m.indices[1]].x, 1.0f);
-    EXPECT_FLOAT_EQ(m.uvs[m.indices[2]].y, 0.0f);  // file t = 1, flipped to v = 1 - t
+    EXPECT_FLOAT_EQ(m.uvs[m.indices[2]].y, 1.0f);
     EXPECT_FLOAT_EQ(m.normals[m.indices[0]].z, 1.0f);
     EXPECT_FLOAT_EQ(meshArea(m), 2.0f);
 }
@@ -116,9 +116,9 @@ TEST(MeshIo, PlyAsciiQuadWithNormalsAndUvs) {
     ASSERT_EQ(m.uvs.size(), m.positions.size());
     for (size_t i = 0; i < m.positions.size(); ++i) {
         EXPECT_FLOAT_EQ(m.normals[i].z, 1.0f);
-        // The file's (s, t) equals (x, y); loaded uv = (s, 1 - t) (mesh_io.h).
+        // uv (s, t) equals (x, y) in this file.
         EXPECT_FLOAT_EQ(m.uvs[i].x, m.positions[i].x);
-        EXPECT_FLOAT_EQ(m.uvs[i].y, 1.0f - m.positions[i].y);
+        EXPECT_FLOAT_EQ(m.uvs[i].y, m.positions[i].y);
     }
     for (size_t t = 0; t < 2; ++t) {
         const uint32_t* i = &m.indices[3 * t];

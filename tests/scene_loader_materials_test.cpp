@@ -12,6 +12,7 @@
 #include "core/image.h"
 #include "scene/bsdf.h"
 #include "scene/io/json_loader.h"
+#include "scene/scene.h"
 
 using namespace ub;
 namespace fs = std::filesystem;
@@ -315,4 +316,33 @@ TEST(SceneFormatDoc, MaterialTextureAndLightExamplesLoad) {
             "],\n\"shapes\": [{\"type\": \"rectangle\", \"material\": \"wood\"}]}",
         "doc.json", dir.path.string());
     EXPECT_EQ(scene->textures.size(), 2u);
+}
+
+// OBJ texture coordinates are flipped (v = 1 - t) as Mitsuba 3 does by default, PLY ones are
+// kept: a ray down onto the OBJ triangle's vertex with vt (0, 1) sees uv (0, 0).
+TEST(JsonLoader, ObjTextureCoordinatesAreFlippedPlyAreNot) {
+    const std::string dataDir = std::string(UNIBEAM_TEST_DATA_DIR);
+    auto scene = loadJsonSceneFromString(
+        sceneWith(R"json("w": {"type": "diffuse"})json",
+                  R"json({"type": "obj", "file": "meshes/triangle.obj", "material": "w"},
+                         {"type": "ply", "file": "meshes/square.ply", "material": "w",
+                          "transform": {"translate": [5, 0, 0]}})json",
+                  kPoint),
+        "scene.json", dataDir);
+    auto uvAt = [&](const Vec3& p) {
+        Ray ray;
+        ray.org = p + Vec3(0, 0, 1);
+        ray.dir = Vec3(0, 0, -1);
+        Hit hit;
+        EXPECT_TRUE(scene->intersect(ray, &hit));
+        return hit.uv;
+    };
+    // triangle.obj: (0,0,0) vt (0,0), (2,0,0) vt (1,0), (0,2,0) vt (0,1).
+    Vec2 uv = uvAt(Vec3(0.02f, 1.9f, 0.0f));  // near the vertex with vt (0, 1)
+    EXPECT_NEAR(uv.x, 0.01f, 1e-4f);
+    EXPECT_NEAR(uv.y, 1.0f - 0.95f, 1e-4f);
+    // square.ply: the file's (s, t) equals (x, y).
+    uv = uvAt(Vec3(5.25f, 0.75f, 0.0f));
+    EXPECT_NEAR(uv.x, 0.25f, 1e-4f);
+    EXPECT_NEAR(uv.y, 0.75f, 1e-4f);
 }

@@ -278,7 +278,7 @@ bool loadObj(const std::string& path, const std::string& text, Reporter& rep, Tr
                 }
                 if (hasUvs) {
                     const float* t = &attrib.texcoords[2 * size_t(key.vt)];
-                    m.uvs.push_back(Vec2(t[0], 1.0f - t[1]));  // see mesh_io.h
+                    m.uvs.push_back(Vec2(t[0], t[1]));
                 }
             }
             m.indices.push_back(it->second);
@@ -342,7 +342,7 @@ bool loadPly(const std::string& path, Reporter& rep, TriangleMesh* out) {
             }
             if (hasUvs) {
                 const aiVector3D& t = mesh->mTextureCoords[0][v];
-                m.uvs.push_back(Vec2(t.x, 1.0f - t.y));  // see mesh_io.h
+                m.uvs.push_back(Vec2(t.x, t.y));
             }
         }
         for (unsigned f = 0; f < mesh->mNumFaces; ++f) {

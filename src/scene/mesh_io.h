@@ -2,10 +2,6 @@
 // validated: non-finite positions, out-of-range indices and meshes without
 // any non-degenerate triangle are errors; degenerate (zero-area) triangles are
 // dropped with a warning that says how many.
-//
-// Texture coordinates: v is flipped at load (uv = (s, 1 - t) for the file's (s, t)), as
-// Mitsuba 3's OBJ and PLY loaders do, because textures look up row 0 (the top of the
-// image) at v = 0 (scene/texture.h) while OBJ/PLY put t = 0 at the bottom of the image.
 #pragma once
 
 #include <string>

@@ -13,8 +13,10 @@
 //    interpolation between the four nearest pixel centres, wrap mode "repeat" (uv' is
 //    taken modulo 1 first). PNG files are sRGB-decoded at load (each texel, before
 //    interpolation, as Mitsuba does for `raw = false`); EXR files are used as stored.
-//    Mesh loaders follow Mitsuba's convention for OBJ/PLY texture coordinates (v' = 1 - v
-//    of the file's v, so the file's v = 0 is the bottom row of the image).
+//    Scene loaders follow Mitsuba's convention for mesh texture coordinates: OBJ files get
+//    v = 1 - t (the file's t = 0 is the bottom row of the image; Mitsuba's
+//    `flip_tex_coords`, default true for OBJ), PLY files are used as stored (default false).
+//    mesh_io itself returns the file's values.
 #pragma once
 
 #include <cstdint>

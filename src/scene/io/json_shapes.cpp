@@ -283,6 +283,11 @@ void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
                 } else {
                     size_t before = r.errorCount();
                     shape.mesh = loadMeshFile(path, r.diagnostics(), ptr);
+                    // OBJ texture coordinates put t = 0 at the bottom of the image, textures
+                    // put row 0 at v = 0: flip v as Mitsuba 3's OBJ reader does by default
+                    // (its PLY reader does not, nor do we).
+                    if (type == "obj")
+                        for (Vec2& uv : shape.mesh.uvs) uv.y = 1.0f - uv.y;
                     if (r.errorCount() != before)
                         r.error(filePtr, "mesh file '" + file +
                                              "' could not be loaded (see the "
