@@ -97,7 +97,7 @@ Rgb VolPathTracer::tracePixel(int x, int y, int iteration) const {
         MediumShadow sh;
         if (light.isFinite()) {
             Vec3 lightPos = pos + dirToLight * distance;
-            Vec3 lightOffsetDir = light.type == LightType::Point ? Vec3(0.0f) : -dirToLight;
+            Vec3 lightOffsetDir = light.isDeltaPosition() ? Vec3(0.0f) : -dirToLight;
             sh = scene_.shadowTransmittance(pos, geoNormal, shadowStack, lightPos, lightOffsetDir);
         } else {
             sh = scene_.shadowTransmittanceToInfinity(pos, geoNormal, shadowStack, dirToLight);
@@ -216,9 +216,7 @@ Rgb VolPathTracer::tracePixel(int x, int y, int iteration) const {
 
         Bsdf bsdf;
         const Vec3 dirFix = -ray.dir;
-        if (!bsdf.setup(scene_.materials[size_t(hit.materialId)], dirFix, hit.geoNormal,
-                        hit.shadingNormal, /*fromLight=*/false))
-            break;
+        if (!scene_.setupBsdf(&bsdf, hit, dirFix, /*fromLight=*/false)) break;
         const float contProb = std::min(1.0f, bsdf.continuationProb());
         if (!bsdf.isDelta() && lightCount > 0 && pathLength + 1 >= minLength) {
             nextEvent(
