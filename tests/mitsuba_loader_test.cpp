@@ -285,3 +285,28 @@ TEST(MitsubaSpectra, ConstantReflectanceIsWhiteAndEmissionIsLinear) {
     Rgb b = spectrumToLinearSrgb({360, 830}, {1.0, 1.0}, true);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(2 * a[c], b[c], 1e-5f);
 }
+
+TEST(MitsubaXml, MediaOnShapesBecomeBoundaries) {
+    auto s = load(scene(std::string(kLight) + R"(<medium id="fog" type="homogeneous">
+  <rgb name="sigma_t" value="1, 2, 3"/><rgb name="albedo" value="0.5"/><float name="scale" value="2"/>
+  <phase type="hg"><float name="g" value="0.3"/></phase></medium>
+<shape type="sphere"><bsdf type="null"/><ref id="fog" name="interior"/></shape>
+<shape type="cube"><bsdf type="dielectric"/><ref id="fog" name="interior"/></shape>
+)"));
+    ASSERT_EQ(s->media.size(), 1u);  // one medium, shared by reference
+    const Medium& m = s->media[0];
+    EXPECT_NEAR(m.sigmaS.z, 0.5f * 3 * 2, 1e-5f);
+    EXPECT_NEAR(m.sigmaA.y, 0.5f * 2 * 2, 1e-5f);
+    EXPECT_FLOAT_EQ(m.g, 0.3f);
+    EXPECT_TRUE(s->shapes[0].isMediumBoundary);
+    EXPECT_TRUE(s->shapes[0].imaginary);  // null BSDF: an index-matched boundary
+    EXPECT_FALSE(s->shapes[1].imaginary);
+    EXPECT_EQ(s->shapes[1].interiorMediumId, 0);
+
+    std::string e = errorsOf(scene(std::string(kLight) +
+                                   "<medium id=\"f\" type=\"homogeneous\"/>\n"
+                                   "<shape type=\"sphere\"><bsdf type=\"null\"/>\n"
+                                   "  <ref id=\"f\" name=\"exterior\"/></shape>\n"));
+    EXPECT_TRUE(contains(e, "scene.xml:11:3: error: <shape type=\"sphere\">: exterior media are "
+                            "not supported")) << e;
+}

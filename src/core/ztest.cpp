@@ -43,13 +43,19 @@ ZTestResult zTest(const Image& image, const Image* imageVariance, const Image& r
                 const double v = image.at(x, y)[c], ref = reference.at(x, y)[c];
                 double varRef = referenceVariance.at(x, y)[c];
                 double varImg = imageVariance ? double(imageVariance->at(x, y)[c]) : varRef;
-                if (!std::isfinite(v) || !std::isfinite(ref) || !std::isfinite(varRef) ||
-                    !std::isfinite(varImg) || varRef < 0 || varImg < 0) {
+                const char* bad = !std::isfinite(v)        ? "image"
+                                  : !std::isfinite(ref)    ? "reference"
+                                  : !std::isfinite(varRef) ? "reference variance"
+                                  : !std::isfinite(varImg) ? "image variance"
+                                                           : nullptr;
+                if (bad) {
                     std::ostringstream os;
-                    os << "non-finite value or negative variance at pixel (" << x << ", " << y
+                    os << "non-finite value in the " << bad << " at pixel (" << x << ", " << y
                        << "), channel " << c;
                     fail(os.str());
                 }
+                // A variance computed as m2 - m1^2 (Mitsuba's references) can round to a
+                // slightly negative value; the floor below covers it.
                 varRef = std::max(varRef, o.varianceFloor);
                 varImg = std::max(varImg, o.varianceFloor);
                 double var = varImg / o.samples;

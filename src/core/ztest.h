@@ -57,8 +57,8 @@ double zTestPValue(double z);
 
 /// Runs the test. imageVariance may be null: the reference variance then stands for the
 /// image's per-sample variance too (Mitsuba's assumption). Throws InputError (file "")
-/// when sizes differ, a value is non-finite or negative where a variance is expected, or
-/// options are out of range.
+/// when sizes differ, a value is non-finite, or options are out of range. Negative
+/// variances (round-off of m2 - m1^2) are raised to the floor like tiny ones.
 ZTestResult zTest(const Image& image, const Image* imageVariance, const Image& reference,
                   const Image& referenceVariance, const ZTestOptions& options);
 

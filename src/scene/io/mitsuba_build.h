@@ -51,6 +51,8 @@ public:
     /// The nested object or reference attached as `name` (or, when name is empty, the
     /// only child with tag `tag`); marks it used. nullptr if absent.
     const XmlObject* child(const XmlObject& o, const std::string& tag, const std::string& name);
+    /// Where the last child() found its object attached (the nested tag or the <ref>).
+    const XmlPos& lastChildPos() const { return lastChildPos_; }
     /// All children with the given tag (marked used).
     std::vector<const XmlObject*> children(const XmlObject& o, const std::string& tag);
 
@@ -66,6 +68,7 @@ public:
 private:
     Diagnostics& diags_;
     size_t errors_ = 0;
+    XmlPos lastChildPos_;
 };
 
 /// Options of loadMitsubaScene.
@@ -79,6 +82,8 @@ struct MitsubaBuild {
     const XmlScene& xml;
     Scene& scene;
     std::map<const XmlObject*, int> materialIds;  ///< bsdf object -> material id
+    std::map<const XmlObject*, int> textureIds;   ///< texture object -> texture id
+    std::map<const XmlObject*, int> mediumIds;    ///< medium object -> Scene::media index
     /// Media (volscene's Scene::media is not in main yet): objects seen, for messages.
     bool cameraSet = false;
 

@@ -45,6 +45,7 @@ private:
     void readShape(const XmlObject& o);
     void readEmitter(const XmlObject& o);
     int defaultMaterial();
+    int mediumId(const XmlObject& medium);
 
     MitsubaBuild& b_;
     XmlReader& r_;
@@ -236,6 +237,17 @@ void Builder::readSensor(const XmlObject& o) {
     b_.cameraSet = true;
 }
 
+int Builder::mediumId(const XmlObject& med) {
+    auto it = b_.mediumIds.find(&med);
+    if (it != b_.mediumIds.end()) return it->second;
+    Medium m;
+    int id = -1;
+    if (buildMitsubaMedium(b_, med, &m))
+        id = b_.scene.addMedium(m, med.id.empty() ? med.type : med.id);
+    b_.mediumIds[&med] = id;
+    return id;
+}
+
 int Builder::defaultMaterial() {
     if (defaultMaterial_ < 0) {
         Material m;  // Mitsuba's default: one-sided diffuse, reflectance 0.5
@@ -340,21 +352,27 @@ void Builder::readShape(const XmlObject& o) {
             }
         }
     }
-    for (const char* side : {"interior", "exterior"})
-        if (const XmlObject* med = r_.child(o, "medium", side)) {
-            Medium medium;
-            if (buildMitsubaMedium(b_, *med, &medium))
-                r_.error(med->pos, o.label() + ": participating media on shapes (" + side + " " +
-                                       med->label() + ") are not supported yet");
-        }
+    int interiorId = -1;
+    const XmlObject* interior = r_.child(o, "medium", "interior");
+    if (interior) interiorId = mediumId(*interior);
+    if (const XmlObject* ext = r_.child(o, "medium", "exterior")) {
+        const XmlPos refPos = r_.lastChildPos();
+        mediumId(*ext);
+        r_.error(refPos, o.label() + ": exterior media are not supported: unibeam derives the "
+                                       "medium outside a shape from the boundaries around it "
+                                       "(docs/mitsuba.md, medium tracking)");
+    }
     r_.checkUnused(o);
     if (r_.errorCount() != before) return;
-    if (materialId == -1 && !em) {
+    if (materialId == -1 && !em && !interior) {
         r_.warning(o.pos, o.label() + " '" + name + "' has a null BSDF and no medium: it is "
                                                     "invisible and is left out");
         return;
     }
-    if (materialId == -1) materialId = defaultMaterial();  // null emitter: black surface
+    if (materialId == -1 && em) materialId = defaultMaterial();  // null emitter: black surface
+    const bool imaginary = materialId == -1;  // null BSDF + medium: an index-matched boundary
+    if (imaginary && em)
+        r_.error(em->pos, o.label() + ": a shape with a null BSDF and a medium cannot emit");
     if (em) {
         try {
             lightId = b_.scene.addLight(std::move(light));
@@ -363,10 +381,10 @@ void Builder::readShape(const XmlObject& o) {
             return;
         }
     }
-    if (isSphere)
-        b_.scene.addSphere(center, radius, materialId, lightId, name);
-    else
-        b_.scene.addMesh(std::move(mesh), materialId, lightId, name);
+    const uint32_t shapeId =
+        isSphere ? b_.scene.addSphere(center, radius, materialId, lightId, name)
+                 : b_.scene.addMesh(std::move(mesh), materialId, lightId, name);
+    if (interior) b_.scene.setMediumBoundary(shapeId, interiorId, 0, imaginary);
 }
 
 void Builder::readEmitter(const XmlObject& o) {
@@ -441,7 +459,7 @@ std::unique_ptr<Scene> buildFromXml(const XmlScene& xml, Diagnostics& diags,
     auto scene = std::make_unique<Scene>();
     scene->sourceFile = xml.file;
     XmlReader reader(diags);
-    MitsubaBuild b{reader, xml, *scene, {}, false};
+    MitsubaBuild b{reader, xml, *scene, {}, {}, {}, false};
     Builder(b).build();
     diags.throwIfErrors();
     if (warnings) *warnings = diags.warnings();

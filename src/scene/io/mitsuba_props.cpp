@@ -207,6 +207,7 @@ const XmlObject* XmlReader::child(const XmlObject& o, const std::string& tag,
     }
     if (!found) return nullptr;
     found->used = true;
+    lastChildPos_ = found->pos;
     return found->object.get();
 }
 
