@@ -660,7 +660,7 @@ TEST(SceneLoader, UnsupportedExtensionListsSupportedOnes) {
     } catch (const InputError& e) {
         EXPECT_STREQ(e.what(),
                      "scene.yaml: error: unsupported scene file extension '.yaml' (supported: "
-                     ".json, .xml)");
+                     ".json, .xml, .obj)");
     }
 }
 

@@ -5,10 +5,11 @@
 
 #include "scene/io/json_loader.h"
 #include "scene/io/mitsuba_loader.h"
+#include "scene/io/smallupbp_loader.h"
 
 namespace ub {
 
-std::vector<std::string> supportedSceneExtensions() { return {".json", ".xml"}; }
+std::vector<std::string> supportedSceneExtensions() { return {".json", ".xml", ".obj"}; }
 
 std::unique_ptr<Scene> loadScene(const std::string& path, std::vector<Diagnostic>* warnings) {
     return loadScene(path, {}, warnings);
@@ -25,6 +26,20 @@ std::unique_ptr<Scene> loadScene(const std::string& path,
             throw InputError(path, "scene parameters (-D " + defines.begin()->first +
                                        "=...) apply only to Mitsuba .xml scenes");
         return loadJsonScene(path, warnings);
+    }
+    if (ext == ".obj") {
+        if (!defines.empty())
+            throw InputError(path, "scene parameters (-D " + defines.begin()->first +
+                                       "=...) apply only to Mitsuba .xml scenes");
+        // A SmallUPBP scene: X.obj with X.obj.aux beside it (scene/io/smallupbp_loader.h).
+        if (std::filesystem::is_regular_file(path + ".aux"))
+            return loadSmallUpbpScene(path, warnings);
+        throw InputError(path,
+                         "an .obj scene is read in SmallUPBP's format, which needs the file '" +
+                             std::filesystem::path(path).filename().string() +
+                             ".aux' beside it (camera, media and lights; see docs/smallupbp.md), "
+                             "and it is missing; to render a plain mesh, reference it from a "
+                             ".json scene");
     }
 
     std::string list;

@@ -1,6 +1,7 @@
 // Entry point for reading a scene file of any supported format, chosen by the
-// file extension: .json (native, docs/scene-format.md) and .xml (Mitsuba 3
-// subset, docs/mitsuba.md). Later: SmallUPBP .obj + .obj.aux.
+// file extension: .json (native, docs/scene-format.md), .xml (Mitsuba 3
+// subset, docs/mitsuba.md) and .obj with a sibling .obj.aux (SmallUPBP,
+// docs/smallupbp.md).
 #pragma once
 
 #include <map>

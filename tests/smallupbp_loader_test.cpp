@@ -1,0 +1,457 @@
+// SmallUPBP scenes (.obj + .mtl + .obj.aux): the three paper/gpuupbp scenes in
+// shared/scenes/smallupbp load with the counts and camera of their files and render
+// finite images with vpt; every class of bad input gives its message with
+// file:line:column; the environment-map frame reproduces SmallUPBP's lookup.
+#include "scene/io/smallupbp_loader.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "core/image.h"
+#include "render/integrator.h"
+#include "scene/io/scene_loader.h"
+
+namespace fs = std::filesystem;
+using namespace ub;
+
+namespace {
+
+const std::string kSharedScenes = std::string(UNIBEAM_SHARED_DIR) + "/scenes/smallupbp";
+const std::string kUnpacked = UNIBEAM_SMALLUPBP_DIR;  // bunny, mirrorballs (tests/CMakeLists.txt)
+
+bool contains(const std::string& s, const std::string& part) {
+    return s.find(part) != std::string::npos;
+}
+
+std::string allMessages(const std::vector<Diagnostic>& d) {
+    std::string s;
+    for (const auto& x : d) s += x.format() + "\n";
+    return s;
+}
+
+/// A scratch folder with a small valid scene t.obj / t.mtl / t.obj.aux that tests edit.
+class TinyScene {
+  public:
+    explicit TinyScene(const std::string& name)
+        : dir_(fs::temp_directory_path() / ("unibeam_upbp_" + name)) {
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+        mtl =
+            "newmtl white\nKd 0.5 0.5 0.5\nnewmtl glass\nKd 0 0 0\nnewmtl lamp\nKd 0 0 0\n"
+            "Ke 2 2 2\n";
+        // A floor quad, a closed tetrahedron of glass, and a lamp quad facing down.
+        obj =
+            "mtllib t.mtl\n"
+            "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+            "v -0.2 -0.2 0.1\nv 0.2 -0.2 0.1\nv 0 0.2 0.1\nv 0 0 0.5\n"
+            "v -0.3 -0.3 1\nv 0.3 -0.3 1\nv 0.3 0.3 1\nv -0.3 0.3 1\n"
+            "usemtl white\nf 1 2 3 4\n"
+            "usemtl glass\nf 5 7 6\nf 5 6 8\nf 6 7 8\nf 7 5 8\n"
+            "usemtl lamp\nf 9 12 11 10\n";
+        aux =
+            "TM_ROW0 1 0 0\nTM_ROW1 0 1 0\nTM_ROW2 0 0 1\nTM_ROW3 0 0 3\nCAMERA_FOV 0.9\n"
+            "medium inside\nabsorption 0.1 0.1 0.1\nscattering 0.5 0.5 0.5\ng 0.3\n"
+            "material glass\nior 1.5\nmirror 1 1 1\nmediumId inside\npriority 2\n";
+    }
+    ~TinyScene() { fs::remove_all(dir_); }
+
+    std::string objPath() const { return (dir_ / "t.obj").string(); }
+    std::string auxPath() const { return objPath() + ".aux"; }
+    std::string mtlPath() const { return (dir_ / "t.mtl").string(); }
+
+    void write() const {
+        std::ofstream(objPath()) << obj;
+        std::ofstream(mtlPath()) << mtl;
+        std::ofstream(auxPath()) << aux;
+    }
+    /// Loads and returns the error text ("" if it loaded); warnings into *w.
+    std::string errors(std::vector<Diagnostic>* w = nullptr) const {
+        write();
+        try {
+            loadScene(objPath(), w);
+        } catch (const InputError& e) {
+            return e.what();
+        }
+        return "";
+    }
+
+    std::string obj, mtl, aux;
+
+  private:
+    fs::path dir_;
+};
+
+void expectCameraFromAux(const Scene& s, const Vec3& row1, const Vec3& row2, const Vec3& row3,
+                         float fovXRad) {
+    const Camera& c = s.camera;
+    EXPECT_NEAR(c.position().x, row3.x, 1e-3f);
+    EXPECT_NEAR(c.position().y, row3.y, 1e-3f);
+    EXPECT_NEAR(c.position().z, row3.z, 1e-3f);
+    const Vec3 fwd = normalize(-row2);
+    EXPECT_NEAR(dot(c.forward(), fwd), 1.0f, 1e-5f);
+    // The image's up vector is TM_ROW1 made orthogonal to the viewing direction.
+    const Vec3 up = normalize(row1 - fwd * dot(row1, fwd));
+    EXPECT_NEAR(dot(c.up(), up), 1.0f, 1e-4f);
+    EXPECT_EQ(c.width(), 256);
+    EXPECT_EQ(c.height(), 256);
+    // Square image: the vertical field of view equals the horizontal CAMERA_FOV.
+    EXPECT_NEAR(c.fovYDeg(), fovXRad * 180.0f / float(M_PI), 1e-3f);
+}
+
+/// Renders `iterations` of vpt at 32x32 and checks every pixel is finite and >= 0;
+/// returns the mean luminance.
+float renderFinite(Scene& scene, int iterations) {
+    Camera small;
+    const Camera& c = scene.camera;
+    small.setup(c.position(), c.position() + c.forward(), c.up(), c.fovYDeg(), 32, 32);
+    scene.camera = small;
+    RenderOptions opt;
+    opt.algorithm = "vpt";
+    opt.maxPathLength = 10;
+    opt.seed = 7;
+    auto integrator = makeIntegrator(scene, opt);
+    Image img(32, 32);
+    double sum = 0.0;
+    int bad = 0;
+    for (int it = 0; it < iterations; ++it) {
+        integrator->renderIteration(it, img);
+        for (const Rgb& p : img.pixels) {
+            if (!isFinite(p) || minComponent(p) < 0.0f) ++bad;
+            sum += luminance(p);
+        }
+    }
+    EXPECT_EQ(bad, 0) << "non-finite or negative pixels";
+    return float(sum / (double(iterations) * 32 * 32));
+}
+
+int countBoundaries(const Scene& s, bool imaginary) {
+    int n = 0;
+    for (const ShapeInfo& sh : s.shapes) n += sh.isMediumBoundary && sh.imaginary == imaginary;
+    return n;
+}
+
+const ShapeInfo* shapeNamed(const Scene& s, const std::string& name) {
+    for (const ShapeInfo& sh : s.shapes)
+        if (sh.name == name) return &sh;
+    return nullptr;
+}
+
+}  // namespace
+
+// ---- the three scenes -----------------------------------------------------------
+
+TEST(SmallUpbpScenes, CandleLoadsAsWritten) {
+    const std::string path = kSharedScenes + "/candle/candle.obj";
+    ASSERT_TRUE(fs::is_regular_file(path)) << path;
+    std::vector<Diagnostic> w;
+    auto scene = loadScene(path, &w);
+    // candle.mtl: 6 materials, all used by one usemtl group each.
+    EXPECT_EQ(scene->materials.size(), 6u);
+    EXPECT_EQ(scene->shapes.size(), 6u);
+    EXPECT_EQ(scene->media.size(), 1u);   // M_svicka
+    EXPECT_EQ(scene->lights.size(), 1u);  // Svetlo (Ke 100 in the .aux)
+    EXPECT_EQ(scene->globalMediumId, -1);
+    EXPECT_EQ(countBoundaries(*scene, false), 1);  // svicka, priority 1
+    const ShapeInfo* candle = shapeNamed(*scene, "svicka");
+    ASSERT_NE(candle, nullptr);
+    EXPECT_EQ(candle->mediumPriority, 1);
+    EXPECT_EQ(scene->media[size_t(candle->interiorMediumId)].sigmaS.x, 2.0f);
+    // wire_088144225: Kd + Ks 0.35 with Ns 32 -> Phong.
+    bool phong = false;
+    for (const Material& m : scene->materials)
+        if (m.name == "wire_088144225") {
+            phong = m.type == MaterialType::Phong && m.exponent == 32.0f && m.glossy.x == 0.35f;
+        }
+    EXPECT_TRUE(phong);
+    expectCameraFromAux(*scene, Vec3(0.5f, 0.0f, 0.8660f), Vec3(-0.8660f, 0.0f, 0.5f),
+                        Vec3(-84.8188f, 22.9605f, 31.0322f), 0.7854f);
+    // The .aux block of Pozadi uses Ka/Kd/Ks, which SmallUPBP reads as Ke: warned.
+    const std::string msgs = allMessages(w);
+    EXPECT_TRUE(contains(msgs,
+                         "candle.obj.aux:35:1: warning: 'Kd' in an .aux file is read as "
+                         "'Ke' (emission)"))
+        << msgs;
+    EXPECT_GT(renderFinite(*scene, 2), 0.0f);
+}
+
+TEST(SmallUpbpScenes, MirrorballsLoadsAsWritten) {
+    const std::string path = kUnpacked + "/mirrorballs/mirrorballs.obj";
+    ASSERT_TRUE(fs::is_regular_file(path)) << path << " (unpacked by the build)";
+    std::vector<Diagnostic> w;
+    auto scene = loadScene(path, &w);
+    EXPECT_EQ(scene->materials.size(), 9u);
+    // 17 'g' groups use 9 materials; SmallUPBP groups faces by material, and the medium
+    // boundary matGlass is split into its 3 closed pieces (a ball and two lamp glasses).
+    EXPECT_EQ(scene->shapes.size(), 11u);
+    EXPECT_EQ(scene->media.size(), 4u);
+    EXPECT_EQ(scene->lights.size(), 1u);           // matLight, Ke 80000
+    EXPECT_EQ(countBoundaries(*scene, false), 5);  // matGlass (3 pieces), matBall, matBall2
+    EXPECT_EQ(countBoundaries(*scene, true), 1);   // matGlobal
+    EXPECT_NE(shapeNamed(*scene, "matGlass (piece 3 of 3)"), nullptr);
+    const ShapeInfo* global = shapeNamed(*scene, "matGlobal");
+    ASSERT_NE(global, nullptr);
+    EXPECT_EQ(global->mediumPriority, 1);
+    // medBall's 'scaterring' is its scattering coefficient.
+    EXPECT_EQ(scene->mediumNames[0], "medBall");
+    EXPECT_EQ(scene->media[0].sigmaS.y, 0.1f);
+    EXPECT_TRUE(contains(allMessages(w),
+                         "mirrorballs.obj.aux:16:1: warning: 'scaterring' read "
+                         "as 'scattering'"))
+        << allMessages(w);
+    expectCameraFromAux(*scene, Vec3(0.0f, 0.0f, 1.0f), Vec3(-0.0117f, 0.9999f, 0.0f),
+                        Vec3(22.4941f, 1496.1625f, 279.8196f), 0.6911f);
+    EXPECT_GT(renderFinite(*scene, 2), 0.0f);
+}
+
+TEST(SmallUpbpScenes, BunnyLoadsAsWritten) {
+    const std::string path = kUnpacked + "/bunny/bunny.obj";
+    ASSERT_TRUE(fs::is_regular_file(path)) << path << " (unpacked by the build)";
+    std::vector<Diagnostic> w;
+    auto scene = loadScene(path, &w);
+    EXPECT_EQ(scene->materials.size(), 9u);
+    EXPECT_EQ(scene->shapes.size(), 5u);  // matBall2, matChrome, matGlass, matLight, matGlobal
+    EXPECT_EQ(scene->media.size(), 4u);
+    EXPECT_EQ(scene->lights.size(), 1u);
+    EXPECT_EQ(countBoundaries(*scene, false), 2);  // the bunny (matBall2), matGlass
+    EXPECT_EQ(countBoundaries(*scene, true), 1);
+    // The Stanford bunny's base has holes: closed with a warning at its material block.
+    EXPECT_TRUE(contains(allMessages(w),
+                         "bunny.obj.aux:61:1: warning: material 'matBall2': "
+                         "its mesh has"))
+        << allMessages(w);
+    expectCameraFromAux(*scene, Vec3(0.0f, 0.0f, 1.0f), Vec3(0.0f, 1.0f, 0.0f),
+                        Vec3(209.99f, 1496.1625f, 300.0f), 0.2f);
+    // Its only light sits in a chrome shade behind a glass: all light arrives through
+    // specular refraction (the scene shows what UPBP's photon estimators add), so a few
+    // vpt samples are black; only finiteness is checked.
+    renderFinite(*scene, 2);
+}
+
+// ---- the tiny scene and its mapping ----------------------------------------------
+
+TEST(SmallUpbpLoader, TinySceneMapsMaterialsMediaAndLights) {
+    TinyScene t("tiny");
+    t.write();
+    std::vector<Diagnostic> w;
+    auto s = loadScene(t.objPath(), &w);
+    EXPECT_TRUE(w.empty()) << allMessages(w);
+    ASSERT_EQ(s->materials.size(), 3u);
+    EXPECT_EQ(s->materials[0].type, MaterialType::Diffuse);
+    EXPECT_EQ(s->materials[1].type, MaterialType::Dielectric);
+    EXPECT_EQ(s->materials[1].ior, 1.5f);
+    ASSERT_EQ(s->shapes.size(), 3u);
+    EXPECT_EQ(s->shapes[0].triangleCount, 2u);  // the quad, fanned
+    EXPECT_TRUE(s->shapes[1].isMediumBoundary);
+    EXPECT_EQ(s->shapes[1].mediumPriority, 2);
+    ASSERT_EQ(s->lights.size(), 1u);
+    EXPECT_EQ(s->lights[0].type, LightType::Area);
+    EXPECT_EQ(s->lights[0].radiance.x, 2.0f);
+    ASSERT_EQ(s->media.size(), 1u);
+    EXPECT_EQ(s->media[0].g, 0.3f);
+    EXPECT_GT(renderFinite(*s, 2), 0.0f);
+}
+
+TEST(SmallUpbpLoader, MediumEmissionIsSourceTermPerLength) {
+    // SmallUPBP adds emission * distance; unibeam's source is sigma_a * Le.
+    TinyScene t("emission");
+    t.aux +=
+        "medium glow\nabsorption 0.5 0.25 1\nemission 1 1 1\nscattering 0 0 0\n"
+        "globalMediumId glow\n";
+    t.write();
+    auto s = loadScene(t.objPath());
+    ASSERT_EQ(s->media.size(), 2u);
+    EXPECT_EQ(s->globalMediumId, 1);
+    EXPECT_FLOAT_EQ(s->media[1].Le.x * s->media[1].sigmaA.x, 1.0f);
+    EXPECT_FLOAT_EQ(s->media[1].Le.y * s->media[1].sigmaA.y, 1.0f);
+    EXPECT_FLOAT_EQ(s->media[1].Le.z * s->media[1].sigmaA.z, 1.0f);
+}
+
+TEST(SmallUpbpLoader, AuxLightsMapToPointDirectionalConstant) {
+    TinyScene t("lights");
+    t.aux +=
+        "light_point 0 0 2 5 6 7\nlight_directional 0 0 -2 1 1 1\n"
+        "light_background_constant 0.1 0.2 0.3\n";
+    t.write();
+    auto s = loadScene(t.objPath());
+    ASSERT_EQ(s->lights.size(), 4u);
+    EXPECT_EQ(s->lights[1].type, LightType::Point);
+    EXPECT_EQ(s->lights[1].intensity.z, 7.0f);
+    EXPECT_EQ(s->lights[2].type, LightType::Directional);
+    EXPECT_NEAR(s->lights[2].direction.z, -1.0f, 1e-6f);  // direction light travels
+    EXPECT_EQ(s->lights[3].type, LightType::ConstantEnv);
+    EXPECT_EQ(s->backgroundLightId, 3);
+}
+
+// SmallUPBP's EnvMap::Dir2LatLong (z up): u = 1/2 - atan2(y, x) / 2pi, v = acos(z) / pi,
+// column u of the rotated map = file column u - rotate. Our envmap light, built from the
+// .aux line, must return the same pixel for directions inside that pixel (away from its
+// edges: SmallUPBP filters bilinearly, unibeam does not).
+TEST(SmallUpbpLoader, EnvironmentMapLookupMatchesSmallUpbp) {
+    TinyScene t("envmap");
+    const int W = 16, H = 8;
+    Image map(W, H);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) map.at(x, y) = Rgb(float(x + 1), float(y + 1), 1.0f);
+    writeExr((fs::path(t.objPath()).parent_path() / "room.exr").string(), map);
+    t.aux += "light_background_em 2 0.25 room.exr\n";
+    t.write();
+    auto s = loadScene(t.objPath());
+    ASSERT_GE(s->backgroundLightId, 0);
+    const Light& env = s->lights[size_t(s->backgroundLightId)];
+    const int rot = int(0.25f * W);
+    int checked = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            // SmallUPBP looks up the direction d (towards the environment) at
+            // (u, v) = ((x + 0.1) / W, (y + 0.5) / H) of the rotated map, which shows file
+            // column (x - rot) mod W there.
+            const float u = (float(x) + 0.1f) / W, v = (float(y) + 0.5f) / H;
+            // Inverting Dir2LatLong: atan2(dy, dx) = pi (1 - 2u), acos(dz) = pi v.
+            const float theta = float(M_PI) * v;
+            const float alpha = float(M_PI) * (1.0f - 2.0f * u);
+            const Vec3 d(std::sin(theta) * std::cos(alpha), std::sin(theta) * std::sin(alpha),
+                         std::cos(theta));
+            float pdfA = 0, pdfE = 0;
+            const Rgb got =
+                env.radianceAlong(s->sceneSphere, d, Vec3(0.0f), Vec3(0.0f), &pdfA, &pdfE);
+            const int fileX = ((x - rot) % W + W) % W;
+            EXPECT_FLOAT_EQ(got.x, 2.0f * float(fileX + 1)) << "x " << x << " y " << y;
+            EXPECT_FLOAT_EQ(got.y, 2.0f * float(y + 1)) << "x " << x << " y " << y;
+            ++checked;
+        }
+    EXPECT_EQ(checked, W * H);
+}
+
+// ---- bad input: every message names file:line:column ------------------------------
+
+TEST(SmallUpbpLoader, PlainObjWithoutAuxSaysWhatIsExpected) {
+    TinyScene t("noaux");
+    t.write();
+    fs::remove(t.auxPath());
+    try {
+        loadScene(t.objPath());
+        FAIL() << "expected an InputError";
+    } catch (const InputError& e) {
+        EXPECT_TRUE(contains(e.what(),
+                             "t.obj: error: an .obj scene is read in SmallUPBP's "
+                             "format, which needs the file 't.obj.aux' beside it"))
+            << e.what();
+    }
+}
+
+TEST(SmallUpbpLoader, MissingKeywordValueNamesLine) {
+    TinyScene t("missingvalue");
+    t.aux += "material white\nior\npriority 3\n";
+    const std::string e = t.errors();
+    EXPECT_TRUE(contains(e,
+                         "t.obj.aux:16:1: error: missing value: 'ior' expects 1 number "
+                         "(index of refraction), found 0 before 'priority' on line 17"))
+        << e;
+}
+
+TEST(SmallUpbpLoader, NonNumericValueNamesColumn) {
+    TinyScene t("nonnumeric");
+    t.aux += "medium fog\nabsorption 0.1 abc 0.3\n";
+    const std::string e = t.errors();
+    EXPECT_TRUE(contains(e,
+                         "t.obj.aux:16:16: error: 'abc' is not a number: 'absorption' "
+                         "expects 3 numbers (r g b)"))
+        << e;
+}
+
+TEST(SmallUpbpLoader, UnknownMediumReferenceListsDefinedOnes) {
+    TinyScene t("unknownmedium");
+    t.aux += "material white\nmediumId insid\npriority 1\n";
+    const std::string e = t.errors();
+    EXPECT_TRUE(contains(e,
+                         "t.obj.aux:16:10: error: unknown medium 'insid' (did you mean "
+                         "'inside'?) (defined: inside)"))
+        << e;
+}
+
+TEST(SmallUpbpLoader, UnknownKeywordIsAnError) {
+    TinyScene t("unknownkeyword");
+    t.aux += "material white\nroughness 0.3\n";
+    const std::string e = t.errors();
+    EXPECT_TRUE(contains(e,
+                         "t.obj.aux:16:1: error: unknown keyword 'roughness' (SmallUPBP's "
+                         ".aux keywords:"))
+        << e;
+}
+
+TEST(SmallUpbpLoader, UnknownCameraOptionIsAnError) {
+    TinyScene t("cameraoption");
+    t.aux += "CAMERA_ZOOM 2\n";
+    const std::string e = t.errors();
+    EXPECT_TRUE(contains(e, "t.obj.aux:15:1: error: unknown keyword 'CAMERA_ZOOM'")) << e;
+}
+
+TEST(SmallUpbpLoader, MissingMtlNamesMtllibLine) {
+    TinyScene t("missingmtl");
+    t.obj.replace(0, 12, "mtllib nothere.mtl");
+    const std::string e = t.errors();
+    EXPECT_TRUE(contains(e, "t.obj:1:8: error: material library 'nothere.mtl' not found")) << e;
+}
+
+TEST(SmallUpbpLoader, MisspellingIsAcceptedWithWarning) {
+    TinyScene t("misspelling");
+    t.aux += "medium fog\nscaterring 0.2 0.2 0.2\n";
+    std::vector<Diagnostic> w;
+    EXPECT_EQ(t.errors(&w), "");
+    EXPECT_TRUE(contains(allMessages(w),
+                         "t.obj.aux:16:1: warning: 'scaterring' read as "
+                         "'scattering' (SmallUPBP recognises .aux keywords by "
+                         "their first letters)"))
+        << allMessages(w);
+}
+
+TEST(SmallUpbpLoader, MissingCameraRowAndFovAreErrors) {
+    TinyScene t("camera");
+    t.aux.replace(t.aux.find("TM_ROW2"), 14, "");
+    t.aux.replace(t.aux.find("CAMERA_FOV 0.9"), 14, "");
+    const std::string e = t.errors();
+    EXPECT_TRUE(contains(e, "t.obj.aux: error: missing 'TM_ROW2'")) << e;
+    EXPECT_TRUE(contains(e, "t.obj.aux: error: missing 'CAMERA_FOV'")) << e;
+}
+
+TEST(SmallUpbpLoader, UnknownMaterialInAuxListsMtlMaterials) {
+    TinyScene t("unknownmaterial");
+    t.aux += "material glas\nior 1.2\n";
+    const std::string e = t.errors();
+    EXPECT_TRUE(contains(e,
+                         "t.obj.aux:15:10: error: unknown material 'glas' (did you mean "
+                         "'glass'?) (materials come from the .mtl file; it defines: white, "
+                         "glass, lamp)"))
+        << e;
+}
+
+TEST(SmallUpbpLoader, BadObjAndMtlStatementsNameTheirLines) {
+    TinyScene t("badobj");
+    t.obj += "usemtl white\nf 1 2 99\nvx 1 2 3\nv 1 two 3\n";
+    t.mtl += "Kd 0.1 0.2\nnewmtl x\nbumpiness 3\n";
+    const std::string e = t.errors();
+    EXPECT_TRUE(contains(e,
+                         "t.obj:24:7: error: vertex index 99 out of range (the file has 13 "
+                         "vertices)"))
+        << e;
+    EXPECT_TRUE(contains(e, "t.obj:26:5: error: 'two' is not a finite number")) << e;
+    EXPECT_TRUE(contains(e,
+                         "t.mtl:8:1: error: missing value: 'Kd' expects 3 numbers (r g b), "
+                         "found 2 before 'newmtl' on line 9"))
+        << e;
+    EXPECT_TRUE(contains(e, "t.mtl:10:1: error: unknown .mtl statement 'bumpiness'")) << e;
+}
+
+TEST(SmallUpbpLoader, MediumWithoutPriorityIsAnError) {
+    TinyScene t("nopriority");
+    t.aux += "material white\nmediumId inside\n";
+    const std::string e = t.errors();
+    EXPECT_TRUE(contains(e,
+                         "t.obj.aux:15:1: error: material 'white' has a mediumId but no "
+                         "priority"))
+        << e;
+}
