@@ -286,6 +286,22 @@ TEST(SmallUpbpLoader, AuxLightsMapToPointDirectionalConstant) {
     EXPECT_EQ(s->backgroundLightId, 3);
 }
 
+// SmallUPBP's -r WxH keeps the horizontal CAMERA_FOV; so does unibeam's --resolution
+// for these scenes (Camera::resized with RenderSettings::keepHorizontalFov).
+TEST(SmallUpbpLoader, ResolutionKeepsHorizontalFov) {
+    TinyScene t("resize");
+    t.write();
+    auto s = loadScene(t.objPath());
+    ASSERT_TRUE(s->settings.keepHorizontalFov);
+    const Camera c = s->camera.resized(400, 800, s->settings.keepHorizontalFov);
+    // Horizontal half angle from the image plane: tan = (width / 2) / imagePlaneDist.
+    const float tanHalfX = 0.5f * float(c.width()) / c.imagePlaneDist();
+    EXPECT_NEAR(tanHalfX, std::tan(0.5f * 0.9f), 1e-5f);  // CAMERA_FOV 0.9
+    // The default keeps the vertical angle instead.
+    const Camera v = s->camera.resized(400, 800);
+    EXPECT_NEAR(v.fovYDeg(), s->camera.fovYDeg(), 1e-5f);
+}
+
 // SmallUPBP's EnvMap::Dir2LatLong (z up): u = 1/2 - atan2(y, x) / 2pi, v = acos(z) / pi,
 // column u of the rotated map = file column u - rotate. Our envmap light, built from the
 // .aux line, must return the same pixel for directions inside that pixel (away from its

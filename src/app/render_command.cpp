@@ -100,13 +100,8 @@ int runRender(const RenderArgs& args) {
 
     // ---- scene and options ----
     std::unique_ptr<Scene> scene = loadSceneFile(args.scene, args.defines);
-    if (width > 0) {
-        const Camera& c = scene->camera;
-        Camera resized;
-        resized.setup(c.position(), c.position() + c.forward(), c.up(), c.fovYDeg(), width, height,
-                      c.lensRadius(), c.focusDistance());
-        scene->camera = resized;
-    }
+    if (width > 0)
+        scene->camera = scene->camera.resized(width, height, scene->settings.keepHorizontalFov);
     RenderOptions options;
     options.algorithm = args.algorithm;
     options.maxPathLength = args.maxLength ? *args.maxLength : scene->settings.maxPathLength;

@@ -1,5 +1,7 @@
 #include "scene/camera.h"
 
+#include <cmath>
+
 #include "core/sampling.h"
 
 namespace ub {
@@ -17,6 +19,19 @@ void Camera::setup(const Vec3& position, const Vec3& target, const Vec3& up, flo
     focusDistance_ = focusDistance;
     float tanHalf = std::tan(0.5f * fovYDeg * kPi / 180.0f);
     imagePlaneDist_ = float(height) / (2.0f * tanHalf);
+}
+
+Camera Camera::resized(int width, int height, bool keepHorizontalFov) const {
+    float fovY = fovYDeg_;
+    if (keepHorizontalFov && width_ > 0 && height_ > 0) {
+        // tan(fovX / 2) = tan(fovY / 2) * width / height, kept across the two sizes.
+        const float tanHalfX =
+            std::tan(0.5f * fovYDeg_ * kPi / 180.0f) * float(width_) / float(height_);
+        fovY = 2.0f * std::atan(tanHalfX * float(height) / float(width)) * 180.0f / kPi;
+    }
+    Camera c;
+    c.setup(position_, position_ + forward_, up_, fovY, width, height, lensRadius_, focusDistance_);
+    return c;
 }
 
 Ray Camera::generateRay(const Vec2& raster, const Vec2& lensU) const {

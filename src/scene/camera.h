@@ -26,6 +26,10 @@ public:
     void setup(const Vec3& position, const Vec3& target, const Vec3& up, float fovYDeg, int width,
                int height, float lensRadius = 0.0f, float focusDistance = 1.0f);
 
+    /// The same camera with a width x height image: the vertical field of view is kept,
+    /// or the horizontal one if keepHorizontalFov.
+    Camera resized(int width, int height, bool keepHorizontalFov = false) const;
+
     /// Primary ray through raster position `raster` (e.g. pixel + jitter); lensU in [0,1)^2
     /// picks the lens point (ignored for a pinhole).
     Ray generateRay(const Vec2& raster, const Vec2& lensU = Vec2(0.5f, 0.5f)) const;

@@ -49,6 +49,9 @@ struct RenderSettings {
     int maxPathLength = 10;    ///< max number of path segments (SmallVCM semantics)
     int minPathLength = 0;     ///< paths with fewer segments do not contribute
     uint64_t seed = 1;
+    /// --resolution keeps the horizontal field of view instead of the vertical one
+    /// (SmallUPBP scenes: its -r keeps CAMERA_FOV, a horizontal angle).
+    bool keepHorizontalFov = false;
 };
 
 struct ShapeInfo {

@@ -301,8 +301,9 @@ std::unique_ptr<Scene> loadSmallUpbpScene(const std::string& objPath,
     auto scene = std::make_unique<Scene>();
     scene->sourceFile = objPath;
     scene->camera = buildCamera(aux, ctx);
-    scene->settings.maxPathLength = 10;  // SmallUPBP's default -l
-    scene->settings.seed = 1234;         // SmallUPBP's default -seed
+    scene->settings.maxPathLength = 10;        // SmallUPBP's default -l
+    scene->settings.seed = 1234;               // SmallUPBP's default -seed
+    scene->settings.keepHorizontalFov = true;  // SmallUPBP's -r keeps CAMERA_FOV
 
     // Materials, in .mtl order.
     int maxBoundaryPriority = -1;
