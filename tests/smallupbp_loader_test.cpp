@@ -14,6 +14,7 @@
 #include "core/image.h"
 #include "render/integrator.h"
 #include "scene/io/scene_loader.h"
+#include "scene/io/smallupbp_boundary.h"
 
 namespace fs = std::filesystem;
 using namespace ub;
@@ -470,4 +471,73 @@ TEST(SmallUpbpLoader, MediumWithoutPriorityIsAnError) {
                          "t.obj.aux:15:1: error: material 'white' has a mediumId but no "
                          "priority"))
         << e;
+}
+
+// ---- medium boundaries: pieces, holes, cavities (scene/io/smallupbp_boundary.h) ----
+
+namespace {
+
+/// Axis-aligned cube [lo, hi]^3 as 12 triangles, faces outwards (or inwards).
+void addCube(TriangleMesh* m, float lo, float hi, bool inwards, bool skipTop = false) {
+    const uint32_t base = uint32_t(m->positions.size());
+    for (int i = 0; i < 8; ++i)
+        m->positions.push_back(Vec3(i & 1 ? hi : lo, i & 2 ? hi : lo, i & 4 ? hi : lo));
+    // Quads as (a, b, c, d) counter-clockwise seen from outside.
+    const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                  {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (int q = 0; q < 6; ++q) {
+        if (skipTop && q == 1) continue;  // the z = hi face
+        const uint32_t* f = quads[q];
+        uint32_t t[2][3] = {{f[0], f[1], f[2]}, {f[0], f[2], f[3]}};
+        for (auto& tri : t) {
+            if (inwards) std::swap(tri[1], tri[2]);
+            for (uint32_t v : tri) m->indices.push_back(base + v);
+        }
+    }
+}
+
+double signedVolume(const TriangleMesh& m) {
+    double v = 0.0;
+    for (size_t t = 0; t < m.triangleCount(); ++t)
+        v += double(dot(m.positions[m.indices[3 * t]], cross(m.positions[m.indices[3 * t + 1]],
+                                                             m.positions[m.indices[3 * t + 2]]))) /
+             6.0;
+    return v;
+}
+
+}  // namespace
+
+TEST(SmallUpbpBoundary, SeparateObjectsBecomeSeparatePieces) {
+    TriangleMesh m;
+    addCube(&m, 0.0f, 1.0f, false);
+    addCube(&m, 5.0f, 6.0f, false);
+    BoundarySplit s = splitMediumBoundary(m);
+    ASSERT_EQ(s.pieces.size(), 2u);
+    EXPECT_EQ(s.holes, 0u);
+    EXPECT_EQ(s.pieces[0].triangleCount(), 12u);
+    EXPECT_NEAR(signedVolume(s.pieces[1]), 1.0, 1e-5);
+}
+
+TEST(SmallUpbpBoundary, HoleIsClosedWithOutwardFan) {
+    TriangleMesh m;
+    addCube(&m, 0.0f, 1.0f, false, /*skipTop=*/true);
+    BoundarySplit s = splitMediumBoundary(m);
+    ASSERT_EQ(s.pieces.size(), 1u);
+    EXPECT_EQ(s.holes, 1u);
+    EXPECT_EQ(s.holeEdges, 4u);
+    // 10 cube triangles + a fan of 4 around the centre of the missing face; the volume
+    // is the cube's again (the fan is flat and faces outwards).
+    EXPECT_EQ(s.pieces[0].triangleCount(), 14u);
+    EXPECT_NEAR(signedVolume(s.pieces[0]), 1.0, 1e-5);
+}
+
+TEST(SmallUpbpBoundary, CavityStaysWithItsShell) {
+    // A hollow box: outer wall outwards, inner wall inwards (negative volume).
+    TriangleMesh m;
+    addCube(&m, 0.0f, 3.0f, false);
+    addCube(&m, 1.0f, 2.0f, true);
+    BoundarySplit s = splitMediumBoundary(m);
+    ASSERT_EQ(s.pieces.size(), 1u);
+    EXPECT_EQ(s.cavities, 1u);
+    EXPECT_NEAR(signedVolume(s.pieces[0]), 27.0 - 1.0, 1e-4);
 }
