@@ -148,6 +148,96 @@ TEST(MisBruteForce, MergePartialIsConnectionPartialOverEta) {
     }
 }
 
+// ---- Medium vertices (vlt, vbpt) ----------------------------------------------------
+//
+// Random paths whose vertices are medium vertices with probability 0.4 (cosines 1, equal
+// phase pdfs in both directions, never specular) and whose segments carry random
+// free-flight pdfs: a medium end gets a scatter density times pass probabilities in
+// [0.02, 3] (per unit length), a surface end a pass probability in [0.02, 1], or exactly 1
+// (vacuum) for a third of the surface-to-surface segments. The two directions of a segment
+// get independent values, so every factor must sit in the right place. Configurations:
+// bpt (power, balance) -- vbpt's techniques; merging in media is UPBP's, not tested here.
+// Tolerance 1e-4 as above (the extra factors are of the same magnitude).
+namespace {
+
+void addMedia(Rng& rng, MisPath* p, float mediumProb) {
+    const int k = p->k();
+    for (int i = 1; i < k; ++i) {
+        MisVertex& x = p->v[i];
+        if (rng.uniform() >= mediumProb) continue;
+        x.medium = true;
+        x.specular = false;
+        x.cosIn = x.cosOut = 1.0f;
+        x.pdfFwdW = x.pdfRevW = uniformIn(rng, 0.02f, 4.0f);  // HG: its own adjoint
+        x.cont = uniformIn(rng, 0.3f, 1.0f);
+    }
+    p->distFwd.assign(size_t(k + 1), 1.0f);
+    p->distRev.assign(size_t(k + 1), 1.0f);
+    auto inMedium = [&](int i) { return i >= 1 && i <= k - 1 && p->v[i].medium; };
+    for (int i = 1; i <= k; ++i) {
+        const bool endMedium = inMedium(i), startMedium = inMedium(i - 1);
+        const bool vacuum = !endMedium && !startMedium && rng.uniform() < 0.33f;
+        if (vacuum) continue;
+        p->distFwd[size_t(i)] =
+            endMedium ? uniformIn(rng, 0.02f, 3.0f) : uniformIn(rng, 0.02f, 1.0f);
+        p->distRev[size_t(i)] =
+            startMedium ? uniformIn(rng, 0.02f, 3.0f) : uniformIn(rng, 0.02f, 1.0f);
+    }
+}
+
+std::vector<NamedConfig> bptConfigs() {
+    std::vector<NamedConfig> out;
+    for (const NamedConfig& nc : configs())
+        if (!nc.cfg.useVM) out.push_back(nc);
+    return out;
+}
+
+}  // namespace
+
+TEST(MisBruteForce, MediumVerticesRecursiveWeightsEqualExplicitPdfWeights) {
+    Rng rng(45, 7);
+    int compared = 0, mediumVertices = 0;
+    for (const NamedConfig& nc : bptConfigs()) {
+        for (int n = 0; n < 4000; ++n) {
+            int k = 2 + int(rng.uniform() * 7);
+            MisLightKind kind = kKinds[n % 4];
+            MisPath p = randomPath(rng, k, kind, 0.2f);
+            addMedia(rng, &p, 0.4f);
+            for (int i = 1; i < k; ++i) mediumVertices += p.v[i].medium;
+            auto ref = bruteForceWeights(p, nc.cfg);
+            auto rec = recursiveWeights(p, nc.cfg);
+            ASSERT_EQ(ref.size(), rec.size());
+            double sum = 0;
+            for (size_t t = 0; t < ref.size(); ++t) {
+                ASSERT_NEAR(rec[t].weight, ref[t].weight, 1e-4)
+                    << nc.name << " k=" << k << " light kind " << int(kind) << " technique "
+                    << ref[t].name() << " (path " << n << ")";
+                sum += rec[t].weight;
+                ++compared;
+            }
+            if (!rec.empty()) ASSERT_NEAR(sum, 1.0, 1e-4) << nc.name << " k=" << k;
+        }
+    }
+    EXPECT_GT(compared, 30000);
+    EXPECT_GT(mediumVertices, 10000);
+}
+
+// Without media the media-aware updates reduce to the surface ones exactly.
+TEST(MisBruteForce, MediaUpdatesWithUnitDistancePdfsAreTheSurfaceUpdates) {
+    Rng rng(46, 7);
+    ub_mis_constants c = ub_mis_make_constants(0.05f, 1000.0f, 1, 1, UB_MIS_POWER);
+    for (int n = 0; n < 1000; ++n) {
+        ub_mis_partials p = {uniformIn(rng, 0.1f, 5.0f), uniformIn(rng, 0.1f, 5.0f),
+                             uniformIn(rng, 0.1f, 5.0f)};
+        float d = uniformIn(rng, 0.1f, 3.0f), cosFix = uniformIn(rng, 0.1f, 1.0f);
+        ub_mis_partials a = ub_mis_at_hit(c, p, d, cosFix, n % 2);
+        ub_mis_partials b = ub_mis_at_hit_media(c, p, d, cosFix, n % 2, 1.0f, 1.0f);
+        ASSERT_FLOAT_EQ(a.dVCM, b.dVCM);
+        ASSERT_FLOAT_EQ(a.dVC, b.dVC);
+        ASSERT_FLOAT_EQ(a.dVM, b.dVM);
+    }
+}
+
 // Hand-checked special cases of the technique sets.
 TEST(MisBruteForce, TechniqueSetsFollowSmallVcm) {
     MisPath p;

@@ -31,6 +31,28 @@
  * Mis(x) is x^beta: beta = 2 (power heuristic) or 1 (balance heuristic),
  * applied to every ratio factor, including eta and the pdfs (TR Sec. 3).
  *
+ * MEDIA (vlt, vbpt). A vertex may lie in a participating medium. Following
+ * Veach's path-space formulation extended to media (Pauly et al. 2000,
+ * "Metropolis Light Transport for Participating Media"; Krivanek et al. 2014,
+ * UPBP, Sec. 4), every area pdf of a vertex becomes a volume pdf there, and
+ * every vertex pdf gains the distance-sampling pdf of the segment that led to
+ * it (shared/notes/mis.md Sec. 1):
+ *   p(x_i) = p_W(x_{i-1}) * D_i * T_i / d_i^2,
+ * with D_i = |cos| at a surface vertex and 1 at a medium vertex, and T_i the
+ * free-flight pdf of the segment chain from x_{i-1} (scene/medium_trace.h):
+ * the scatter density pdfScatter (per unit length) of stopping at x_i times
+ * the pass probabilities of the segments before it if x_i is a medium vertex,
+ * the product of the pass probabilities if x_i is a surface vertex (1 through
+ * vacuum). The reverse pdf of the same segment (sampled from x_i towards
+ * x_{i-1}) has its own T. With both, the recursion keeps its form: the hit
+ * update divides all partials by the forward T and multiplies dVC and dVM by
+ * the reverse T (ub_mis_at_hit_media); weights that take area pdfs of a new
+ * edge (connection, light tracing) take them with the T of that edge, and NEE
+ * takes the T of the shadow chain (ub_mis_weight_nee_media). At a medium
+ * vertex the "BSDF" is sigma_s * phase (sigma_s is carried by the free-flight
+ * throughput), its cosines are 1, its pdfs are the phase pdf times the
+ * vertex's continuation probability, and it is never specular.
+ *
  * Conventions: solid-angle pdfs end in W, area pdfs in A. Every BSDF pdf passed
  * here already includes the Russian-roulette continuation probability of the
  * vertex where the sampling would happen. "dir" pdfs sample the direction in
@@ -116,10 +138,30 @@ UB_INLINE ub_mis_partials ub_mis_init_camera(ub_mis_constants c, float cameraPdf
 /* ---- Updates ------------------------------------------------------------------------ */
 
 /* After tracing a segment of length `dist` to a new vertex with |cos| `cosFix` between
- * the segment and the surface normal: converts the solid-angle pdf of the last
- * direction to area measure, completing [TR (31)-(33)] or [TR (34)-(36)].
- * applyDistSqr is 0 only on the first segment of a light at infinity, whose
- * emission pdf is already in a planar measure [TR Sec. 5.1]. */
+ * the segment and the surface normal (1 at a medium vertex): converts the solid-angle pdf
+ * of the last direction to area (volume) measure, completing [TR (31)-(33)] or
+ * [TR (34)-(36)]. applyDistSqr is 0 only on the first segment of a light at infinity,
+ * whose emission pdf is already in a planar measure [TR Sec. 5.1].
+ * Media: distPdfFwd is the free-flight pdf with which the subpath being traced reached the
+ * new vertex over this segment (scatter density times pass probabilities for a medium
+ * vertex, pass probability for a surface vertex), distPdfRev the pdf of the same segment
+ * sampled the other way, from the new vertex back to the previous one (stopping there if
+ * it is a medium vertex). The forward pdf completes p(x_i) in dVCM = 1/p(x_i) and in the
+ * ratio p(x_{i-1} from x_i) / p(x_i) that dVC and dVM carry; the reverse pdf belongs to
+ * that ratio's numerator (shared/notes/mis.md Sec. 1, a_i and b_{i-1}). */
+UB_INLINE ub_mis_partials ub_mis_at_hit_media(ub_mis_constants c, ub_mis_partials p, float dist,
+                                              float cosFix, int applyDistSqr, float distPdfFwd,
+                                              float distPdfRev) {
+    if (applyDistSqr) p.dVCM *= ub_mis(c, dist * dist);
+    float invFwd = 1.0f / ub_mis(c, cosFix * distPdfFwd);
+    float revOverFwd = ub_mis(c, distPdfRev) * invFwd;
+    p.dVCM *= invFwd;
+    p.dVC *= revOverFwd;
+    p.dVM *= revOverFwd;
+    return p;
+}
+
+/* The same without media (both distance pdfs 1). */
 UB_INLINE ub_mis_partials ub_mis_at_hit(ub_mis_constants c, ub_mis_partials p, float dist,
                                         float cosFix, int applyDistSqr) {
     if (applyDistSqr) p.dVCM *= ub_mis(c, dist * dist);
@@ -158,7 +200,9 @@ UB_INLINE ub_mis_partials ub_mis_scatter(ub_mis_constants c, ub_mis_partials p, 
  * cameraDirPdfA: camera BSDF at z sampling y, in area measure at y;
  * lightRevPdfW: light BSDF at y sampling its previous vertex given the direction to z;
  * lightDirPdfA: light BSDF at y sampling z, in area measure at z;
- * cameraRevPdfW: camera BSDF at z sampling its previous vertex given the direction to y. */
+ * cameraRevPdfW: camera BSDF at z sampling its previous vertex given the direction to y.
+ * Media: both area pdfs include the free-flight pdf of the connecting chain in their
+ * direction (stopping at the end vertex if it lies in a medium, passing otherwise). */
 UB_INLINE float ub_mis_weight_connect(ub_mis_constants c, ub_mis_partials l, ub_mis_partials e,
                                       float cameraDirPdfA, float lightRevPdfW, float lightDirPdfA,
                                       float cameraRevPdfW) {
@@ -175,17 +219,31 @@ UB_INLINE float ub_mis_weight_connect(ub_mis_constants c, ub_mis_partials l, ub_
  * bsdfDirPdfW: camera BSDF sampling the light direction (0 for delta lights);
  * bsdfRevPdfW: camera BSDF sampling its previous vertex given the light direction;
  * lightPickProb, directPdfW (illuminate's solid-angle pdf, without pick probability),
- * emissionPdfW (without pick probability), cosToLight at z, cosAtLight at the light. */
+ * emissionPdfW (without pick probability), cosToLight at z, cosAtLight at the light.
+ * Media: passProb = probability that free-flight sampling from z passes the whole shadow
+ * chain (what BSDF sampling needs to reach the light), distPdfToZ = free-flight pdf of the
+ * light subpath stopping at z over that chain (scatter density times passes if z is a
+ * medium vertex, passProb if z is on a surface). Both are 1 without media. */
+UB_INLINE float ub_mis_weight_nee_media(ub_mis_constants c, ub_mis_partials e, float bsdfDirPdfW,
+                                        float bsdfRevPdfW, float lightPickProb, float directPdfW,
+                                        float emissionPdfW, float cosToLight, float cosAtLight,
+                                        float passProb, float distPdfToZ) {
+    /* Partial light subpath weight [TR (44)]: hitting the light by BSDF sampling */
+    float wLight = ub_mis(c, bsdfDirPdfW * passProb / (lightPickProb * directPdfW));
+    /* Partial camera subpath weight [TR (45)]: the light emitted towards z; the pick
+     * probability cancels in the ratio emissionPdfW / directPdfW */
+    float wCamera =
+        ub_mis(c, emissionPdfW * cosToLight * distPdfToZ / (directPdfW * cosAtLight)) *
+        (c.vmWeightFactor + e.dVCM + e.dVC * ub_mis(c, bsdfRevPdfW));
+    return 1.0f / (wLight + 1.0f + wCamera); /* [TR (37)] */
+}
+
+/* The same without media. */
 UB_INLINE float ub_mis_weight_nee(ub_mis_constants c, ub_mis_partials e, float bsdfDirPdfW,
                                   float bsdfRevPdfW, float lightPickProb, float directPdfW,
                                   float emissionPdfW, float cosToLight, float cosAtLight) {
-    /* Partial light subpath weight [TR (44)]: hitting the light by BSDF sampling */
-    float wLight = ub_mis(c, bsdfDirPdfW / (lightPickProb * directPdfW));
-    /* Partial camera subpath weight [TR (45)]: the light emitted towards z; the pick
-     * probability cancels in the ratio emissionPdfW / directPdfW */
-    float wCamera = ub_mis(c, emissionPdfW * cosToLight / (directPdfW * cosAtLight)) *
-                    (c.vmWeightFactor + e.dVCM + e.dVC * ub_mis(c, bsdfRevPdfW));
-    return 1.0f / (wLight + 1.0f + wCamera); /* [TR (37)] */
+    return ub_mis_weight_nee_media(c, e, bsdfDirPdfW, bsdfRevPdfW, lightPickProb, directPdfW,
+                                   emissionPdfW, cosToLight, cosAtLight, 1.0f, 1.0f);
 }
 
 /* A camera subpath (partials e, after ub_mis_at_hit) hits an emitter, with pdfs of
@@ -199,7 +257,8 @@ UB_INLINE float ub_mis_weight_hit_light(ub_mis_constants c, ub_mis_partials e, f
 }
 
 /* Light tracing: light vertex y (partials l) connected to the camera.
- * cameraPdfA: pdf of the camera sampling y, area measure (p_cam,W |cos_y| / d^2);
+ * cameraPdfA: pdf of the camera sampling y, area measure (p_cam,W |cos_y| / d^2), times the
+ * free-flight pdf of the camera ray reaching y (media; |cos_y| = 1 at a medium vertex);
  * bsdfRevPdfW: light BSDF at y sampling its previous vertex given the camera direction. */
 UB_INLINE float ub_mis_weight_light_trace(ub_mis_constants c, ub_mis_partials l, float cameraPdfA,
                                           float bsdfRevPdfW) {

@@ -31,6 +31,8 @@ const IntegratorEntry kIntegrators[] = {
     {"bpm", makeVertexCM, false},      // bidirectional photon mapping (render/vcm.h)
     {"vcm", makeVertexCM, false},      // vertex connection and merging (render/vcm.h)
     {"vpt", makeVolPathTracer, true},  // volumetric path tracing, NEE + MIS (render/vpt.h)
+    {"vlt", makeVertexCM, true},       // volumetric light tracing (render/vcm.h, media)
+    {"vbpt", makeVertexCM, true},      // volumetric bidirectional path tracing (render/vcm.h)
 };
 
 }  // namespace

@@ -9,6 +9,13 @@
 //
 // dVCM, dVC, dVM are the MIS partials of the light subpath after the hit
 // update at this vertex (kernels/shared/ub_mis.h, tech. rep. (31)-(36)).
+//
+// Medium vertices (vlt, vbpt): flags has kLightVertexInMedium, materialId holds
+// the medium's index into Scene::media (mediumId()), geoNormal, shadingNormal
+// and uv are zero, and the scattering function is sigma_s times the
+// medium's Henyey-Greenstein phase function (sigma_s is already part of the
+// throughput: free-flight sampling weight T sigma_s / pdf, scene/medium.h).
+// continuationProb is then the medium's roulette probability at the vertex.
 #pragma once
 
 #include <cstddef>
@@ -23,7 +30,7 @@ struct LightVertex {
     Vec3 position;           ///< world-space hit point
     uint32_t pathLength;     ///< segments from the light source to this vertex (>= 1)
     Vec3 throughput;         ///< Le cos / p_emit * prod f cos / p, before this vertex's BSDF
-    uint32_t materialId;     ///< index into Scene::materials
+    uint32_t materialId;     ///< index into Scene::materials (medium vertex: Scene::media)
     Vec3 dirFix;             ///< unit direction to the previous vertex (towards the light)
     float continuationProb;  ///< Bsdf::continuationProb() of the light BSDF here
     Vec3 geoNormal;          ///< geometric normal as stored on the surface
@@ -31,8 +38,13 @@ struct LightVertex {
     Vec3 shadingNormal;      ///< shading normal as stored on the surface
     float dVC;               ///< MIS partial [TR (32)/(34)]
     float dVM;               ///< MIS partial [TR (33)/(35)]
-    uint32_t flags;          ///< reserved (0); e.g. medium vertices in UPBP
+    uint32_t flags;          ///< kLightVertex* bits
     Vec2 uv;                 ///< surface uv: Scene::setupBsdf looks the textures up here
+
+    bool inMedium() const { return (flags & kLightVertexInMedium) != 0; }
+    /// Medium of a medium vertex (index into Scene::media).
+    int mediumId() const { return int(materialId); }
+    static constexpr uint32_t kLightVertexInMedium = 1u;  ///< a medium (not surface) vertex
 };
 
 // Layout check: the struct is read as raw memory by device code later.
@@ -45,6 +57,7 @@ static_assert(offsetof(LightVertex, dirFix) == 32, "LightVertex layout changed")
 static_assert(offsetof(LightVertex, geoNormal) == 48, "LightVertex layout changed");
 static_assert(offsetof(LightVertex, shadingNormal) == 64, "LightVertex layout changed");
 static_assert(offsetof(LightVertex, dVM) == 80, "LightVertex layout changed");
+static_assert(offsetof(LightVertex, flags) == 84, "LightVertex layout changed");
 static_assert(offsetof(LightVertex, uv) == 88, "LightVertex layout changed");
 
 }  // namespace ub

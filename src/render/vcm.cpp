@@ -10,19 +10,42 @@
 
 #include "core/error.h"
 #include "core/rng.h"
+#include "render/medium_walk.h"
+#include "render/vertex_scatter.h"
 
 namespace ub {
 
 namespace {
 
 VertexCM::Algorithm parseAlgorithm(const std::string& name) {
-    if (name == "lt") return VertexCM::Algorithm::LightTrace;
-    if (name == "bpt") return VertexCM::Algorithm::Bpt;
+    if (name == "lt" || name == "vlt") return VertexCM::Algorithm::LightTrace;
+    if (name == "bpt" || name == "vbpt") return VertexCM::Algorithm::Bpt;
     if (name == "ppm") return VertexCM::Algorithm::Ppm;
     if (name == "bpm") return VertexCM::Algorithm::Bpm;
     if (name == "vcm") return VertexCM::Algorithm::Vcm;
-    throw InputError("",
-                     "VertexCM: unknown algorithm '" + name + "' (valid: lt, bpt, ppm, bpm, vcm)");
+    throw InputError("", "VertexCM: unknown algorithm '" + name +
+                             "' (valid: lt, bpt, ppm, bpm, vcm, vlt, vbpt)");
+}
+
+/// The media where subpaths of `light` start: at a point just off its emitting side (area
+/// lights: the first triangle's centroid, or the sphere), its position (point, spot), the
+/// global medium (lights at infinity). One stack per light: a light whose emitting surface
+/// crosses a medium boundary is not supported (its subpaths would start in the medium of
+/// that one point).
+MediumStack lightStartStack(const Scene& scene, const Light& light) {
+    MediumStack stack;
+    stack.reset(scene.globalMediumId);
+    const float eps = 1e-4f * std::max(scene.sceneSphere.radius, 1e-3f);
+    if (light.isDeltaPosition()) return scene.mediumStackAt(light.position);
+    if (light.type != LightType::Area) return stack;
+    if (!light.triangles.empty()) {
+        const Vec3& a = light.triangles[0];
+        const Vec3& b = light.triangles[1];
+        const Vec3& c = light.triangles[2];
+        const Vec3 n = normalize(cross(b - a, c - a));
+        return scene.mediumStackAt((a + b + c) / 3.0f + n * eps);
+    }
+    return scene.mediumStackAt(light.position + Vec3(light.sphereRadius + eps, 0.0f, 0.0f));
 }
 
 }  // namespace
@@ -62,6 +85,31 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
         if (!(options.alpha > 0.0f && options.alpha <= 1.0f))
             throw InputError(scene.sourceFile, "radius reduction alpha must be in (0, 1], got " +
                                                    std::to_string(options.alpha));
+    }
+    const bool volumetric = options.algorithm == "vlt" || options.algorithm == "vbpt";
+    useMedia_ = volumetric && scene.hasMedia();
+    if (useMedia_) {
+        for (size_t m = 0; m < scene.media.size(); ++m)
+            if (lightTraceOnly_ && scene.media[m].hasEmission())
+                throw InputError(scene.sourceFile,
+                                 "medium '" + scene.mediumNames[m] +
+                                     "' emits light, which light tracing (vlt) cannot render "
+                                     "(only camera subpaths find medium emission): use vbpt or "
+                                     "vpt");
+        for (const Light& light : scene.lights)
+            if (!light.isFinite() && scene.globalMediumId >= 0)
+                throw InputError(scene.sourceFile,
+                                 "light '" + light.name +
+                                     "' is at infinity but the scene has a "
+                                     "global medium ('" +
+                                     scene.mediumNames[size_t(scene.globalMediumId)] +
+                                     "'), through which its light would have to travel an "
+                                     "infinite distance; '" +
+                                     options.algorithm +
+                                     "' cannot start light subpaths there: bound the medium "
+                                     "with a closed boundary shape, or use vpt");
+        for (const Light& light : scene.lights)
+            lightStacks_.push_back(lightStartStack(scene, light));
     }
     baseRadius_ = options.radius * (options.radiusIsRelative ? scene.sceneSphere.radius : 1.0f);
     lightPickProb_ = scene.lights.empty() ? 0.0f : 1.0f / float(scene.lights.size());
@@ -127,18 +175,81 @@ void VertexCM::renderIteration(int iteration, Image& out) {
     splats_.resolve(out);
 }
 
-bool VertexCM::sampleScattering(Rng& rng, const Bsdf& bsdf, const Hit& hit, SubPath& state) const {
+bool VertexCM::traceToVertex(Rng& rng, SubPath& state, PathVertex* v, bool* escaped) const {
+    *escaped = false;
+    if (!useMedia_) {
+        v->inMedium = false;
+        if (!scene_.intersect(state.ray, &v->hit)) {
+            *escaped = true;
+            return false;
+        }
+        v->pos = v->hit.pos;
+        v->dist = v->hit.dist;
+        return true;
+    }
+    // Media: the chain to the next real surface, then free-flight sampling along it.
+    const MediumStack stackAtStart = state.stack;
+    MediumTrace trace;
+    scene_.traceMedia(state.ray, &state.stack, &trace, &v->hit);
+    if (trace.overflow) return false;
+    const ChainVertex cv =
+        sampleChainVertex(scene_, trace, state.ray.dir, state.rayFromMedium, rng);
+    state.throughput *= cv.weight;
+    v->distPdfFwd = cv.distPdfFwd;
+    v->distPdfRev = cv.distPdfRev;
+    v->mediumEmission = cv.emission;
+    if (isBlack(state.throughput) || !isFinite(state.throughput)) return false;
+    v->dist = cv.distance;
+    if (cv.scattered) {
+        v->inMedium = true;
+        v->pos = cv.pos;
+        v->mediumId = cv.mediumId;
+        // The media at the vertex: those of its segment.
+        state.stack = stackAtStart;
+        scene_.replayCrossings(trace, cv.segment, &state.stack);
+        return true;
+    }
+    v->inMedium = false;
+    if (!trace.hitSurface) {
+        *escaped = true;
+        return false;
+    }
+    v->pos = v->hit.pos;
+    return true;
+}
+
+bool VertexCM::setupScatter(const PathVertex& v, const SubPath& state, bool fromLight,
+                            VertexScatter* scatter) const {
+    if (v.inMedium) {
+        const Medium& medium = scene_.media[size_t(v.mediumId)];
+        scatter->setupMedium(medium.g, -state.ray.dir,
+                             mediumContinuationProb(mediumCoefficientsAt(medium, v.pos)));
+        return true;
+    }
+    if (v.hit.materialId < 0) return false;
+    return scatter->setupSurface(scene_, v.hit, -state.ray.dir, fromLight);
+}
+
+bool VertexCM::stackTowards(const PathVertex& v, const SubPath& state, const Vec3& dir,
+                            MediumStack* out) const {
+    *out = state.stack;
+    if (v.inMedium) return true;
+    return scene_.crossSurface(v.hit, -state.ray.dir, dir, out);
+}
+
+bool VertexCM::sampleScattering(Rng& rng, const VertexScatter& scatter, const PathVertex& v,
+                                SubPath& state) const {
     Vec3 dirGen;
     float dirPdfW = 0.0f, cosThetaOut = 0.0f;
     uint32_t event = kEventNone;
-    Rgb f = bsdf.sample(rng.uniform3(), &dirGen, &dirPdfW, &cosThetaOut, &event);
+    Rgb f = scatter.sample(rng.uniform3(), &dirGen, &dirPdfW, &cosThetaOut, &event);
     if (isBlack(f) || !(dirPdfW > 0.0f)) return false;
     const bool specular = (event & kEventSpecular) != 0;
     // For a delta lobe the reverse pdf equals the forward one; otherwise evaluate it.
-    float revPdfW = specular ? dirPdfW : bsdf.pdf(dirGen, /*reverse=*/true);
+    float revPdfW = specular ? dirPdfW : scatter.pdf(dirGen, /*reverse=*/true);
 
     // Russian roulette (SmallVCM): continue with probability q; q is part of both pdfs.
-    const float contProb = vcmContinuationProb(bsdf);
+    const float contProb = scatter.continuationProb();
     if (!(contProb > 0.0f)) return false;
     if (contProb < 1.0f && rng.uniform() >= contProb) return false;
     dirPdfW *= contProb;
@@ -149,7 +260,17 @@ bool VertexCM::sampleScattering(Rng& rng, const Bsdf& bsdf, const Hit& hit, SubP
     state.specularPath = state.specularPath && specular;
     state.throughput *= f * (cosThetaOut / dirPdfW);
     if (isBlack(state.throughput) || !isFinite(state.throughput)) return false;
-    state.ray = scene_.spawnRay(hit, dirGen);
+    if (v.inMedium) {
+        state.ray.org = v.pos;
+        state.ray.dir = dirGen;
+        state.ray.tMin = 0.0f;
+        state.ray.tMax = kInf;
+    } else {
+        if (useMedia_ && !scene_.crossSurface(v.hit, -state.ray.dir, dirGen, &state.stack))
+            return false;
+        state.ray = scene_.spawnRay(v.hit, dirGen);
+    }
+    state.rayFromMedium = v.inMedium;
     return true;
 }
 

@@ -23,10 +23,29 @@
 // Zwicker 2011; TR Sec. 4), r_1 = RenderOptions::radius, times the scene
 // bounding-sphere radius if radiusIsRelative.
 //
+// Media (`vlt`, `vbpt`: light tracing and bidirectional path tracing with
+// participating media; Lafortune & Willems 1996, "Rendering Participating Media
+// with Bidirectional Path Tracing"; MIS as in Krivanek et al. 2014, UPBP, for the
+// connection techniques): when the algorithm is vlt or vbpt and the scene has
+// media, both subpaths trace segment chains through imaginary and skipped
+// boundaries (Scene::traceMedia) and sample free-flight distances along them
+// (render/medium_walk.h), so they also scatter at medium vertices with the HG
+// phase function (render/vertex_scatter.h). Medium vertices are stored as light
+// vertices (LightVertex::kLightVertexInMedium), connected to the camera, to camera
+// vertices and to lights like surface vertices, with the transmittance of the
+// connecting chain (Scene::shadowTransmittance, through imaginary boundaries).
+// Every MIS pdf includes the free-flight pdfs of its segment in its direction
+// (kernels/shared/ub_mis.h, MEDIA). Emission of a medium (sigma_a Le) is added by
+// the camera subpath of vbpt at its medium vertices with the collision estimator
+// and weight 1 (no other technique samples it, as in `vpt`); vlt rejects scenes
+// with emitting media. Lights at infinity cannot start subpaths inside a global
+// medium (the medium would have to extend to infinity): vlt and vbpt reject such
+// scenes. Without media vlt and vbpt are lt and bpt.
+//
 // Conventions shared with `pt` (render/pt.h): path length counts segments, a
 // light seen directly has length 1; surfaces that emit and have a material keep
 // scattering; Russian roulette with Bsdf::continuationProb(). Light tracing
-// needs a pinhole camera: lt, bpt and vcm reject thin-lens cameras.
+// needs a pinhole camera: lt, bpt, vcm, vlt and vbpt reject thin-lens cameras.
 #pragma once
 
 #include <memory>
@@ -38,21 +57,28 @@
 #include "render/integrator.h"
 #include "render/light_vertex.h"
 #include "scene/bsdf.h"
+#include "scene/medium_stack.h"
 
 namespace ub {
 
 class Rng;
+class VertexScatter;
+struct ChainVertex;
 
 class VertexCM : public Integrator {
   public:
     enum class Algorithm { LightTrace, Bpt, Ppm, Bpm, Vcm };
 
-    /// Reads options.algorithm (lt, bpt, ppm, bpm, vcm). Throws InputError for another
-    /// name, a thin-lens camera with lt/bpt/vcm, or a bad radius/alpha.
+    /// Reads options.algorithm (lt, bpt, ppm, bpm, vcm, vlt, vbpt). Throws InputError for
+    /// another name, a thin-lens camera with lt/bpt/vcm/vlt/vbpt, a bad radius/alpha, or a
+    /// media set-up vlt/vbpt cannot render (see above).
     VertexCM(const Scene& scene, const RenderOptions& options);
     void renderIteration(int iteration, Image& out) override;
 
     Algorithm algorithm() const { return algorithm_; }
+    /// True if subpaths are traced through participating media (vlt/vbpt on a scene with
+    /// media).
+    bool tracesMedia() const { return useMedia_; }
     /// Merging radius used by iteration `iteration` (0-based).
     float radiusAt(int iteration) const;
     /// Light vertices stored by the last iteration (for tests).
@@ -65,34 +91,67 @@ class VertexCM : public Integrator {
         Rgb throughput{1, 1, 1};
         int pathLength = 1;  ///< segments, including the one being traced
         bool isFiniteLight = true;
-        bool specularPath = true;  ///< every scattering so far was specular (camera side)
-        ub_mis_partials mis{};     ///< dVCM, dVC, dVM
+        bool specularPath = true;    ///< every scattering so far was specular (camera side)
+        bool rayFromMedium = false;  ///< the ray starts at a medium vertex
+        ub_mis_partials mis{};       ///< dVCM, dVC, dVM
+        MediumStack stack;           ///< media at the ray origin, for its direction (media only)
     };
+
+    /// The vertex a traced segment (chain) ends at.
+    struct PathVertex {
+        bool inMedium = false;  ///< medium vertex at pos; else the surface hit
+        Hit hit;                ///< surface vertex (hit.pos = pos)
+        Vec3 pos;
+        int mediumId = -1;
+        float dist = 0.0f;  ///< from the previous vertex
+        /// Free-flight pdfs of the segment in the tracing and the reverse direction (1 without
+        /// media; render/medium_walk.h).
+        float distPdfFwd = 1.0f, distPdfRev = 1.0f;
+        Rgb mediumEmission{0.0f};  ///< collision estimate of medium emission (camera side)
+        Vec3 geoNormal() const { return inMedium ? Vec3(0.0f) : hit.geoNormal; }
+    };
+
+    // Shared (vcm.cpp): traces state.ray to the next vertex (surface hit or, with media, a
+    // medium vertex), updating throughput and medium stack. False if the ray escaped (then
+    // *v holds the distance pdfs of the escape) or the path must end (black throughput).
+    bool traceToVertex(Rng& rng, SubPath& state, PathVertex* v, bool* escaped) const;
+    /// Sets up the scattering function at v (dirFix = -state.ray.dir); false if degenerate.
+    bool setupScatter(const PathVertex& v, const SubPath& state, bool fromLight,
+                      VertexScatter* scatter) const;
+    /// The medium stack for leaving vertex v along dir (surface: crossing it if dir goes
+    /// to the other side). False on stack overflow.
+    bool stackTowards(const PathVertex& v, const SubPath& state, const Vec3& dir,
+                      MediumStack* out) const;
 
     // Light pass (vcm_light.cpp): traces light subpaths [begin, end) of an iteration.
     void traceLightPaths(int iteration, size_t begin, size_t end, SplatBuffer::Chunk& splats,
                          std::vector<LightVertex>& vertices, std::vector<uint32_t>& pathEnds) const;
     bool startLightPath(Rng& rng, SubPath& state) const;
-    void connectToCamera(const SubPath& state, const Hit& hit, const Bsdf& bsdf,
+    void connectToCamera(const SubPath& state, const PathVertex& v, const VertexScatter& scatter,
                          SplatBuffer::Chunk& splats) const;
 
     // Camera pass (vcm_camera.cpp).
     Rgb traceCameraPath(int x, int y, int iteration) const;
     Rgb lightHitRadiance(const Light& light, const SubPath& state, const Vec3& rayDir,
                          const Vec3& hitPos, const Vec3& hitNormal) const;
-    Rgb directIllumination(Rng& rng, const SubPath& state, const Hit& hit, const Bsdf& bsdf) const;
-    Rgb connectVertices(const LightVertex& lv, const SubPath& state, const Hit& hit,
-                        const Bsdf& bsdf) const;
+    Rgb directIllumination(Rng& rng, const SubPath& state, const PathVertex& v,
+                           const VertexScatter& scatter) const;
+    Rgb connectVertices(const LightVertex& lv, const SubPath& state, const PathVertex& v,
+                        const VertexScatter& scatter) const;
     Rgb mergeVertices(const SubPath& state, const Hit& hit, const Bsdf& bsdf) const;
 
     // Shared: samples the next direction (Russian roulette, MIS update [TR (34)-(36)],
-    // [TR (53)-(55)]). Returns false if the subpath ends.
-    bool sampleScattering(Rng& rng, const Bsdf& bsdf, const Hit& hit, SubPath& state) const;
+    // [TR (53)-(55)]), updates the medium stack and spawns the ray. Returns false if the
+    // subpath ends.
+    bool sampleScattering(Rng& rng, const VertexScatter& scatter, const PathVertex& v,
+                          SubPath& state) const;
 
     const Scene& scene_;
     RenderOptions options_;
     Algorithm algorithm_;
     bool useVC_ = false, useVM_ = false, lightTraceOnly_ = false, ppm_ = false;
+    bool useMedia_ = false;                 ///< vlt/vbpt on a scene with media
+    std::vector<MediumStack> lightStacks_;  ///< media where each light's subpaths start
     float baseRadius_ = 0;
     float lightPickProb_ = 0;
 

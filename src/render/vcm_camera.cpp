@@ -6,6 +6,7 @@
 
 #include "core/rng.h"
 #include "render/vcm.h"
+#include "render/vertex_scatter.h"
 
 namespace ub {
 
@@ -28,39 +29,55 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration) const {
     const float cameraPdfW = camera.isPinhole() ? camera.pdfW(state.ray.dir) : 1.0f;
     state.mis = ub_mis_init_camera(mis_, cameraPdfW);
 
+    state.rayFromMedium = false;
+    if (useMedia_) state.stack = scene_.cameraMediumStack;
+
     Rgb color(0.0f);
     for (;; ++state.pathLength) {
-        Hit hit;
-        if (!scene_.intersect(state.ray, &hit)) {
-            // Environment: no distance or cosine conversion for lights at infinity [TR 5.1].
-            if (scene_.backgroundLightId >= 0 && state.pathLength >= minLength)
+        PathVertex v;
+        bool escaped = false;
+        const Rgb throughputBefore = state.throughput;
+        if (!traceToVertex(rng, state, &v, &escaped)) {
+            // Environment: no distance or cosine conversion for lights at infinity [TR 5.1];
+            // with media, the free-flight pdfs of the escaping chain (ub_mis.h, MEDIA).
+            if (escaped && scene_.backgroundLightId >= 0 && state.pathLength >= minLength) {
+                SubPath atLight = state;
+                atLight.mis =
+                    ub_mis_at_hit_media(mis_, state.mis, 0.0f, 1.0f, 0, v.distPdfFwd, v.distPdfRev);
                 color += state.throughput *
-                         lightHitRadiance(scene_.lights[size_t(scene_.backgroundLightId)], state,
+                         lightHitRadiance(scene_.lights[size_t(scene_.backgroundLightId)], atLight,
                                           state.ray.dir, state.ray.org, Vec3(0.0f));
+            }
             break;
         }
+        // Medium emission (sigma_a Le) at a medium vertex: collision estimator, weight 1 (no
+        // light subpath starts in a medium). Not for vlt (rejected in the constructor).
+        if (v.inMedium && !lightTraceOnly_ && state.pathLength >= minLength)
+            color += throughputBefore * v.mediumEmission;
         // Emitter hit: the light endpoint's cosine is the geometric one, as in emission.
-        if (hit.lightId >= 0 && state.pathLength >= minLength) {
+        if (!v.inMedium && v.hit.lightId >= 0 && state.pathLength >= minLength) {
             SubPath atLight = state;
-            atLight.mis = ub_mis_at_hit(mis_, state.mis, hit.dist,
-                                        std::fabs(dot(hit.geoNormal, state.ray.dir)), 1);
+            atLight.mis = ub_mis_at_hit_media(mis_, state.mis, v.dist,
+                                              std::fabs(dot(v.hit.geoNormal, state.ray.dir)), 1,
+                                              v.distPdfFwd, v.distPdfRev);
             color +=
-                state.throughput * lightHitRadiance(scene_.lights[size_t(hit.lightId)], atLight,
-                                                    state.ray.dir, hit.pos, hit.geoNormal);
+                state.throughput * lightHitRadiance(scene_.lights[size_t(v.hit.lightId)], atLight,
+                                                    state.ray.dir, v.hit.pos, v.hit.geoNormal);
         }
         // Light tracing uses the camera pass only for directly visible emitters.
         if (lightTraceOnly_) break;
-        if (state.pathLength >= maxLength || hit.materialId < 0) break;
+        if (state.pathLength >= maxLength) break;
 
-        Bsdf bsdf;
-        if (!scene_.setupBsdf(&bsdf, hit, -state.ray.dir, /*fromLight=*/false)) break;
-        // Complete the partials at this vertex [TR (31)-(36)].
-        state.mis = ub_mis_at_hit(mis_, state.mis, hit.dist, bsdf.cosThetaFix(), 1);
+        VertexScatter scatter;  // BSDF, or phase function at a medium vertex
+        if (!setupScatter(v, state, /*fromLight=*/false, &scatter)) break;
+        // Complete the partials at this vertex [TR (31)-(36)] (ub_mis.h, MEDIA).
+        state.mis = ub_mis_at_hit_media(mis_, state.mis, v.dist, scatter.cosThetaFix(), 1,
+                                        v.distPdfFwd, v.distPdfRev);
 
-        if (!bsdf.isDelta() && useVC_) {
+        if (!scatter.isDelta() && useVC_) {
             // Next-event estimation: a path of pathLength + 1 segments.
             if (state.pathLength + 1 >= minLength)
-                color += state.throughput * directIllumination(rng, state, hit, bsdf);
+                color += state.throughput * directIllumination(rng, state, v, scatter);
             // Connections to the vertices of the light subpath with the same index.
             const uint32_t first = pixelIndex == 0 ? 0 : pathEnds_[pixelIndex - 1];
             for (uint32_t i = first; i < pathEnds_[pixelIndex]; ++i) {
@@ -68,14 +85,14 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration) const {
                 const int length = int(lv.pathLength) + 1 + state.pathLength;
                 if (length < minLength) continue;
                 if (length > maxLength) break;  // vertices are stored in path order
-                color += state.throughput * lv.throughput * connectVertices(lv, state, hit, bsdf);
+                color += state.throughput * lv.throughput * connectVertices(lv, state, v, scatter);
             }
         }
-        if (!bsdf.isDelta() && useVM_) {
-            color += state.throughput * mergeVertices(state, hit, bsdf);
+        if (!scatter.isDelta() && useVM_) {
+            color += state.throughput * mergeVertices(state, v.hit, scatter.bsdf());
             if (ppm_) break;  // PPM merges at the first non-specular camera vertex only
         }
-        if (!sampleScattering(rng, bsdf, hit, state)) break;
+        if (!sampleScattering(rng, scatter, v, state)) break;
     }
     return color;
 }
@@ -97,8 +114,8 @@ Rgb VertexCM::lightHitRadiance(const Light& light, const SubPath& state, const V
     return le * ub_mis_weight_hit_light(mis_, state.mis, directPdfA, emissionPdfW);
 }
 
-Rgb VertexCM::directIllumination(Rng& rng, const SubPath& state, const Hit& hit,
-                                 const Bsdf& bsdf) const {
+Rgb VertexCM::directIllumination(Rng& rng, const SubPath& state, const PathVertex& v,
+                                 const VertexScatter& scatter) const {
     const int lightCount = int(scene_.lights.size());
     if (lightCount == 0) return Rgb(0.0f);
     const int lightId = std::min(int(rng.uniform() * float(lightCount)), lightCount - 1);
@@ -106,71 +123,105 @@ Rgb VertexCM::directIllumination(Rng& rng, const SubPath& state, const Hit& hit,
     const Vec2 rnd = rng.uniform2();
     Vec3 dirToLight;
     float distance = 0.0f, directPdfW = 0.0f, emissionPdfW = 0.0f, cosAtLight = 0.0f;
-    Rgb le = light.illuminate(scene_.sceneSphere, hit.pos, rnd, &dirToLight, &distance, &directPdfW,
+    Rgb le = light.illuminate(scene_.sceneSphere, v.pos, rnd, &dirToLight, &distance, &directPdfW,
                               &emissionPdfW, &cosAtLight);
     if (isBlack(le) || !(directPdfW > 0.0f)) return Rgb(0.0f);
 
     float cosToLight = 0.0f, bsdfDirPdfW = 0.0f, bsdfRevPdfW = 0.0f;
-    Rgb f = bsdf.evaluate(dirToLight, &cosToLight, &bsdfDirPdfW, &bsdfRevPdfW);
+    Rgb f = scatter.evaluate(dirToLight, &cosToLight, &bsdfDirPdfW, &bsdfRevPdfW);
     if (isBlack(f)) return Rgb(0.0f);
-    const float contProb = vcmContinuationProb(bsdf);
+    const float contProb = scatter.continuationProb();
     // BSDF sampling cannot hit a delta light.
     bsdfDirPdfW *= light.isDelta() ? 0.0f : contProb;
     bsdfRevPdfW *= contProb;
-    // Weight of [TR (44), (45)].
-    const float weight =
-        ub_mis_weight_nee(mis_, state.mis, bsdfDirPdfW, bsdfRevPdfW, lightPickProb_, directPdfW,
-                          emissionPdfW, cosToLight, cosAtLight);
-    const Rgb contrib = le * f * (weight * cosToLight / (lightPickProb_ * directPdfW));
-    if (isBlack(contrib)) return Rgb(0.0f);
-    bool blocked;
-    if (light.isFinite()) {
-        const Vec3 lightPos = hit.pos + dirToLight * distance;
-        // Area-light points sit on geometry: offset them back along the segment.
-        const Vec3 lightOffset = light.isDeltaPosition() ? Vec3(0.0f) : -dirToLight;
-        blocked = scene_.occluded(hit.pos, hit.geoNormal, lightPos, lightOffset);
-    } else {
-        blocked = scene_.occludedToInfinity(hit.pos, hit.geoNormal, dirToLight);
+
+    const Vec3 lightPos = v.pos + dirToLight * distance;
+    // Area-light points sit on geometry: offset them back along the segment.
+    const Vec3 lightOffset = light.isDeltaPosition() ? Vec3(0.0f) : -dirToLight;
+    if (!useMedia_) {
+        // Weight of [TR (44), (45)].
+        const float weight =
+            ub_mis_weight_nee(mis_, state.mis, bsdfDirPdfW, bsdfRevPdfW, lightPickProb_, directPdfW,
+                              emissionPdfW, cosToLight, cosAtLight);
+        const Rgb contrib = le * f * (weight * cosToLight / (lightPickProb_ * directPdfW));
+        if (isBlack(contrib)) return Rgb(0.0f);
+        const bool blocked = light.isFinite()
+                                 ? scene_.occluded(v.pos, v.hit.geoNormal, lightPos, lightOffset)
+                                 : scene_.occludedToInfinity(v.pos, v.hit.geoNormal, dirToLight);
+        return blocked ? Rgb(0.0f) : contrib;
     }
-    return blocked ? Rgb(0.0f) : contrib;
+    // Media: transmittance of the shadow chain, the probability that BSDF/phase sampling
+    // passes it, and the pdf of the light subpath stopping at v (ub_mis.h, MEDIA).
+    MediumStack stack;
+    if (!stackTowards(v, state, dirToLight, &stack)) return Rgb(0.0f);
+    const MediumShadow sh =
+        light.isFinite()
+            ? scene_.shadowTransmittance(v.pos, v.geoNormal(), stack, lightPos, lightOffset)
+            : scene_.shadowTransmittanceToInfinity(v.pos, v.geoNormal(), stack, dirToLight);
+    if (sh.blocked || isBlack(sh.transmittance)) return Rgb(0.0f);
+    const float weight = ub_mis_weight_nee_media(
+        mis_, state.mis, bsdfDirPdfW, bsdfRevPdfW, lightPickProb_, directPdfW, emissionPdfW,
+        cosToLight, cosAtLight, sh.probPass, v.inMedium ? sh.pdfScatterRevL : sh.probPass);
+    return le * f * sh.transmittance * (weight * cosToLight / (lightPickProb_ * directPdfW));
 }
 
-Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const Hit& hit,
-                              const Bsdf& bsdf) const {
-    Vec3 dir = lv.position - hit.pos;
+Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const PathVertex& v,
+                              const VertexScatter& scatter) const {
+    Vec3 dir = lv.position - v.pos;
     const float distSqr = lengthSqr(dir);
     if (!(distSqr > 0.0f)) return Rgb(0.0f);
     const float distance = std::sqrt(distSqr);
     dir /= distance;
 
     float cosCamera = 0.0f, cameraDirPdfW = 0.0f, cameraRevPdfW = 0.0f;
-    Rgb fCamera = bsdf.evaluate(dir, &cosCamera, &cameraDirPdfW, &cameraRevPdfW);
+    Rgb fCamera = scatter.evaluate(dir, &cosCamera, &cameraDirPdfW, &cameraRevPdfW);
     if (isBlack(fCamera)) return Rgb(0.0f);
-    const float cameraCont = vcmContinuationProb(bsdf);
+    const float cameraCont = scatter.continuationProb();
     cameraDirPdfW *= cameraCont;
     cameraRevPdfW *= cameraCont;
 
-    Bsdf lightBsdf;
-    if (!scene_.setupBsdf(&lightBsdf, int(lv.materialId), lv.uv, lv.dirFix, lv.geoNormal,
-                          lv.shadingNormal, /*fromLight=*/true))
+    // The light vertex's scattering function: its BSDF, or its medium's phase function.
+    VertexScatter lightScatter;
+    if (lv.inMedium())
+        lightScatter.setupMedium(scene_.media[size_t(lv.mediumId())].g, lv.dirFix,
+                                 lv.continuationProb);
+    else if (!lightScatter.setupSurface(scene_, int(lv.materialId), lv.uv, lv.dirFix, lv.geoNormal,
+                                        lv.shadingNormal, /*fromLight=*/true))
         return Rgb(0.0f);
     float cosLight = 0.0f, lightDirPdfW = 0.0f, lightRevPdfW = 0.0f;
-    Rgb fLight = lightBsdf.evaluate(-dir, &cosLight, &lightDirPdfW, &lightRevPdfW);
+    Rgb fLight = lightScatter.evaluate(-dir, &cosLight, &lightDirPdfW, &lightRevPdfW);
     if (isBlack(fLight)) return Rgb(0.0f);
     lightDirPdfW *= lv.continuationProb;
     lightRevPdfW *= lv.continuationProb;
 
+    // Visibility; with media the transmittance of the connecting chain (walked from the
+    // camera vertex through imaginary boundaries) and its free-flight pdfs in both
+    // directions, stopping at the end vertex if that lies in a medium (ub_mis.h, MEDIA).
+    Rgb transmittance(1.0f);
+    float distPdfToLight = 1.0f, distPdfToCamera = 1.0f;
+    if (useMedia_) {
+        MediumStack stack;
+        if (!stackTowards(v, state, dir, &stack)) return Rgb(0.0f);
+        const MediumShadow sh =
+            scene_.shadowTransmittance(v.pos, v.geoNormal(), stack, lv.position, lv.geoNormal);
+        if (sh.blocked || isBlack(sh.transmittance)) return Rgb(0.0f);
+        transmittance = sh.transmittance;
+        distPdfToLight = lv.inMedium() ? sh.pdfScatterFwdL : sh.probPass;
+        distPdfToCamera = v.inMedium ? sh.pdfScatterRevL : sh.probPass;
+    }
+
     const float geometry = cosLight * cosCamera / distSqr;
-    // Pdfs of sampling each end from the other, in area measure.
-    const float cameraDirPdfA = cameraDirPdfW * cosLight / distSqr;
-    const float lightDirPdfA = lightDirPdfW * cosCamera / distSqr;
+    // Pdfs of sampling each end from the other, in area (volume) measure.
+    const float cameraDirPdfA = cameraDirPdfW * cosLight * distPdfToLight / distSqr;
+    const float lightDirPdfA = lightDirPdfW * cosCamera * distPdfToCamera / distSqr;
     ub_mis_partials lightMis = {lv.dVCM, lv.dVC, lv.dVM};
     // Weight of [TR (40), (41)].
     const float weight = ub_mis_weight_connect(mis_, lightMis, state.mis, cameraDirPdfA,
                                                lightRevPdfW, lightDirPdfA, cameraRevPdfW);
-    const Rgb contrib = fCamera * fLight * (weight * geometry);
+    const Rgb contrib = fCamera * fLight * transmittance * (weight * geometry);
     if (isBlack(contrib)) return Rgb(0.0f);
-    if (scene_.occluded(hit.pos, hit.geoNormal, lv.position, lv.geoNormal)) return Rgb(0.0f);
+    if (!useMedia_ && scene_.occluded(v.pos, v.hit.geoNormal, lv.position, lv.geoNormal))
+        return Rgb(0.0f);
     return contrib;
 }
 

@@ -5,6 +5,7 @@
 
 #include "core/rng.h"
 #include "render/vcm.h"
+#include "render/vertex_scatter.h"
 
 namespace ub {
 
@@ -42,6 +43,8 @@ bool VertexCM::startLightPath(Rng& rng, SubPath& state) const {
     start.pos = origin;
     start.geoNormal = light.type == LightType::Area ? direction : Vec3(0.0f);
     state.ray = scene_.spawnRay(start, direction);
+    state.rayFromMedium = false;  // x_0 lies on the light, never a medium vertex
+    if (useMedia_) state.stack = lightStacks_[size_t(lightId)];
     return true;
 }
 
@@ -56,77 +59,97 @@ void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuf
         SubPath state;
         bool alive = startLightPath(rng, state);
         for (; alive; ++state.pathLength) {
-            Hit hit;
-            if (!scene_.intersect(state.ray, &hit)) break;
-            if (hit.materialId < 0) break;  // pure emitter: absorbs
-            Bsdf bsdf;
-            if (!scene_.setupBsdf(&bsdf, hit, -state.ray.dir, /*fromLight=*/true)) break;
-            // Complete the MIS partials at this vertex [TR (31)-(36)]; the first segment of a
-            // light at infinity is in planar measure already [TR Sec. 5.1].
-            state.mis = ub_mis_at_hit(mis_, state.mis, hit.dist, bsdf.cosThetaFix(),
-                                      state.pathLength > 1 || state.isFiniteLight);
+            PathVertex v;
+            bool escaped = false;
+            if (!traceToVertex(rng, state, &v, &escaped)) break;
+            VertexScatter scatter;  // BSDF, or phase function at a medium vertex
+            if (!setupScatter(v, state, /*fromLight=*/true, &scatter)) break;  // pure emitter
+            // Complete the MIS partials at this vertex [TR (31)-(36)], with the free-flight
+            // pdfs of the segment (ub_mis.h, MEDIA); the first segment of a light at infinity
+            // is in planar measure already [TR Sec. 5.1].
+            state.mis = ub_mis_at_hit_media(mis_, state.mis, v.dist, scatter.cosThetaFix(),
+                                            state.pathLength > 1 || state.isFiniteLight,
+                                            v.distPdfFwd, v.distPdfRev);
 
             // Store the vertex unless the BSDF is purely specular (no connection or merging).
-            if (!bsdf.isDelta() && (useVC_ || useVM_)) {
-                LightVertex v{};
-                v.position = hit.pos;
-                v.pathLength = uint32_t(state.pathLength);
-                v.throughput = state.throughput;
-                v.materialId = uint32_t(hit.materialId);
-                v.dirFix = -state.ray.dir;
-                v.continuationProb = vcmContinuationProb(bsdf);
-                v.geoNormal = hit.geoNormal;
-                v.shadingNormal = hit.shadingNormal;
-                v.dVCM = state.mis.dVCM;
-                v.dVC = state.mis.dVC;
-                v.dVM = state.mis.dVM;
-                v.uv = hit.uv;
-                vertices.push_back(v);
+            if (!scatter.isDelta() && (useVC_ || useVM_)) {
+                LightVertex lv{};
+                lv.position = v.pos;
+                lv.pathLength = uint32_t(state.pathLength);
+                lv.throughput = state.throughput;
+                lv.dirFix = -state.ray.dir;
+                lv.continuationProb = scatter.continuationProb();
+                lv.dVCM = state.mis.dVCM;
+                lv.dVC = state.mis.dVC;
+                lv.dVM = state.mis.dVM;
+                if (v.inMedium) {
+                    lv.flags = LightVertex::kLightVertexInMedium;
+                    lv.materialId = uint32_t(v.mediumId);
+                } else {
+                    lv.materialId = uint32_t(v.hit.materialId);
+                    lv.geoNormal = v.hit.geoNormal;
+                    lv.shadingNormal = v.hit.shadingNormal;
+                    lv.uv = v.hit.uv;
+                }
+                vertices.push_back(lv);
             }
             // Light tracing: connect to the camera (a path of pathLength + 1 segments).
-            if (!bsdf.isDelta() && (useVC_ || lightTraceOnly_) &&
+            if (!scatter.isDelta() && (useVC_ || lightTraceOnly_) &&
                 state.pathLength + 1 >= minLength && state.pathLength + 1 <= maxLength)
-                connectToCamera(state, hit, bsdf, splats);
+                connectToCamera(state, v, scatter, splats);
 
             // Stop if scattering would make the path too long even when connected directly.
             if (state.pathLength + 2 > maxLength) break;
-            if (!sampleScattering(rng, bsdf, hit, state)) break;
+            if (!sampleScattering(rng, scatter, v, state)) break;
         }
         pathEnds[pathIndex - begin] = uint32_t(vertices.size());
     }
 }
 
-void VertexCM::connectToCamera(const SubPath& state, const Hit& hit, const Bsdf& bsdf,
-                               SplatBuffer::Chunk& splats) const {
+void VertexCM::connectToCamera(const SubPath& state, const PathVertex& v,
+                               const VertexScatter& scatter, SplatBuffer::Chunk& splats) const {
     const Camera& camera = scene_.camera;
     Vec2 raster;
-    if (!camera.worldToRaster(hit.pos, &raster)) return;
-    Vec3 dirToCamera = camera.position() - hit.pos;
+    if (!camera.worldToRaster(v.pos, &raster)) return;
+    Vec3 dirToCamera = camera.position() - v.pos;
     const float distSqr = lengthSqr(dirToCamera);
     const float distance = std::sqrt(distSqr);
     dirToCamera /= distance;
 
     float cosToCamera = 0.0f, bsdfRevPdfW = 0.0f;
-    Rgb f = bsdf.evaluate(dirToCamera, &cosToCamera, nullptr, &bsdfRevPdfW);
+    Rgb f = scatter.evaluate(dirToCamera, &cosToCamera, nullptr, &bsdfRevPdfW);
     if (isBlack(f)) return;
-    bsdfRevPdfW *= vcmContinuationProb(bsdf);
+    bsdfRevPdfW *= scatter.continuationProb();
 
     const float cosAtCamera = dot(camera.forward(), -dirToCamera);
     if (cosAtCamera <= 0.0f) return;
-    // Image-plane area (unit pixel area) to surface area at hit.pos [TR Sec. 5.2]:
-    // p_cam,W = d_img^2 / cos^3, and p_cam,A = p_cam,W cos_y / d^2.
+    // Image-plane area (unit pixel area) to surface area at v.pos [TR Sec. 5.2]:
+    // p_cam,W = d_img^2 / cos^3, and p_cam,A = p_cam,W cos_y / d^2 (cos_y = 1 in a medium).
     const float imagePointToCameraDist = camera.imagePlaneDist() / cosAtCamera;
     const float imageToSolidAngle = imagePointToCameraDist * imagePointToCameraDist / cosAtCamera;
     const float imageToSurface = imageToSolidAngle * cosToCamera / distSqr;
-    const float cameraPdfA = imageToSurface;
+
+    // Visibility, and with media the transmittance of the chain from the camera (walked from
+    // the camera's media) with the pdf of the camera ray stopping at v (ub_mis.h, MEDIA).
+    Rgb transmittance(1.0f);
+    float distPdfToVertex = 1.0f;
+    if (useMedia_) {
+        const MediumShadow sh = scene_.shadowTransmittance(
+            camera.position(), Vec3(0.0f), scene_.cameraMediumStack, v.pos, v.geoNormal());
+        if (sh.blocked || isBlack(sh.transmittance)) return;
+        transmittance = sh.transmittance;
+        distPdfToVertex = v.inMedium ? sh.pdfScatterFwdL : sh.probPass;
+    }
+    const float cameraPdfA = imageToSurface * distPdfToVertex;
 
     // Light tracing alone has no MIS; otherwise the weight of [TR (46), (47)].
     const float weight = lightTraceOnly_
                              ? 1.0f
                              : ub_mis_weight_light_trace(mis_, state.mis, cameraPdfA, bsdfRevPdfW);
-    const Rgb contrib = state.throughput * f * (weight * imageToSurface / lightSubPathCount_);
+    const Rgb contrib =
+        state.throughput * f * transmittance * (weight * imageToSurface / lightSubPathCount_);
     if (isBlack(contrib)) return;
-    if (scene_.occluded(hit.pos, hit.geoNormal, camera.position(), Vec3(0.0f))) return;
+    if (!useMedia_ && scene_.occluded(v.pos, v.geoNormal(), camera.position(), Vec3(0.0f))) return;
     splats.add(raster, contrib);
 }
 

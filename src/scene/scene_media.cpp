@@ -361,10 +361,16 @@ void Scene::replayCrossings(const MediumTrace& trace, int k, MediumStack* stack)
 namespace {
 
 /// Walks from `from` along dir for up to maxDist (kInf: to infinity) through imaginary and
-/// skipped boundaries, accumulating the chain; blocked on a real surface.
-MediumShadow walkShadow(const Scene& scene, Vec3 from, const Vec3& dir, float maxDist,
+/// skipped boundaries, accumulating the chain; blocked on a real surface. For a finite walk,
+/// target = from + maxDist * dir is the end point, and each leg after a crossing aims at it
+/// again: the crossing's origin offset moves the ray off the line by ~eps, and keeping the
+/// old direction and remaining length would, at grazing angles to a surface at the target
+/// (an area light), reach that surface before the target (the end offset is ~eps as well).
+MediumShadow walkShadow(const Scene& scene, Vec3 from, Vec3 dir, float maxDist,
                         MediumStack stack) {
     ChainPdfs chain;
+    const bool finite = maxDist < kInf;
+    const Vec3 target = finite ? from + dir * maxDist : Vec3(0.0f);
     float remaining = maxDist;
     for (int guard = 0; guard < MediumTrace::kMaxSegments; ++guard) {
         Ray r;
@@ -385,9 +391,14 @@ MediumShadow walkShadow(const Scene& scene, Vec3 from, const Vec3& dir, float ma
         chain.add(scene, stack.mediumId(), from, dir, length(h.pos - from));
         if (!scene.crossBoundary(h.shapeId, h.geoNormal, dir, &stack)) return blockedShadow();
         Vec3 next = Scene::offsetRayOrigin(h.pos, h.geoNormal, dir);
-        if (remaining < kInf) remaining -= dot(next - from, dir);
+        if (finite) {
+            const Vec3 toTarget = target - next;
+            remaining = dot(toTarget, dir);
+            if (!(remaining > 0.0f)) return chain.result();
+            remaining = length(toTarget);
+            dir = toTarget / remaining;
+        }
         from = next;
-        if (!(remaining > 0.0f)) return chain.result();
     }
     return blockedShadow();  // more crossings than a trace can hold: treated as blocked
 }

@@ -12,6 +12,13 @@
 //  * recursiveWeights: the dVCM/dVC/dVM recursion of ub_mis.h run along the two
 //    subpaths exactly as the renderer runs it.
 //
+// Media (vlt, vbpt): a vertex may be a medium vertex (cosines 1, phase pdfs, never
+// specular), and each segment x_{i-1} x_i carries the free-flight pdfs of both
+// directions, distFwd[i] (from x_{i-1}, stopping at x_i if it is a medium vertex,
+// passing otherwise) and distRev[i] (from x_i, stopping at or passing x_{i-1}); then
+// a_i gains distFwd[i] and b_{i-1} gains distRev[i] (ub_mis.h, MEDIA; notes/mis.md
+// Sec. 1). Merging (surface photon mapping) is not a technique at medium vertices.
+//
 // Only tests use this file.
 #pragma once
 
@@ -32,6 +39,7 @@ struct MisVertex {
     float pdfRevW = 1;      ///< p(dir to x_{i-1} | from x_{i+1}), without continuation probability
     float cont = 1;         ///< Russian-roulette continuation probability at x_i
     bool specular = false;  ///< delta lobe: pdfs are the discrete lobe probability (equal)
+    bool medium = false;    ///< medium vertex: cosines 1, phase pdfs, not specular
 };
 
 enum class MisLightKind { Area, Point, Directional, Environment };
@@ -49,7 +57,12 @@ struct MisPath {
     std::vector<float> dist;   ///< dist[i] = |x_i - x_{i-1}|, i = 1..k (dist[0] unused)
     std::vector<MisVertex> v;  ///< v[i], i = 1..k-1 (v[0] unused)
     float cameraPdfW = 1;      ///< p_cam,W of the direction from the camera to x_{k-1}
+    /// Free-flight pdfs of segment i (x_{i-1} x_i), i = 1..k, in the light (Fwd) and camera
+    /// (Rev) directions; empty: no media (all 1).
+    std::vector<float> distFwd, distRev;
     int k() const { return int(dist.size()) - 1; }
+    float tFwd(int i) const { return distFwd.empty() ? 1.0f : distFwd[size_t(i)]; }
+    float tRev(int i) const { return distRev.empty() ? 1.0f : distRev[size_t(i)]; }
     bool lightIsDelta() const {
         return lightKind == MisLightKind::Point || lightKind == MisLightKind::Directional;
     }
@@ -91,7 +104,7 @@ inline std::vector<MisTechnique> validTechniques(const MisPath& p, const MisConf
     }
     if (cfg.useVM)
         for (int i = 1; i <= k - 1; ++i)
-            if (connectible(i)) out.push_back({true, i});
+            if (connectible(i) && !p.v[i].medium) out.push_back({true, i});
     return out;
 }
 
@@ -109,10 +122,12 @@ inline std::vector<MisTechnique> bruteForceWeights(const MisPath& p, const MisCo
     if (k >= 2) {
         a[1] = finite ? double(p.emitDirPdfW) * p.v[1].cosIn / (double(p.dist[1]) * p.dist[1])
                       : double(p.emitPosPdf) * p.v[1].cosIn;
+        a[1] *= p.tFwd(1);
     }
     for (int i = 2; i <= k - 1; ++i) {
         const MisVertex& prev = p.v[i - 1];
-        a[i] = double(prev.pdfFwdW) * prev.cont * p.v[i].cosIn / (double(p.dist[i]) * p.dist[i]);
+        a[i] = double(prev.pdfFwdW) * prev.cont * p.v[i].cosIn * p.tFwd(i) /
+               (double(p.dist[i]) * p.dist[i]);
     }
     // Backward (camera-direction) pdfs b_0..b_{k-1}; b_k = 1 (pinhole).
     for (int i = 0; i <= k - 1; ++i) {
@@ -121,7 +136,7 @@ inline std::vector<MisTechnique> bruteForceWeights(const MisPath& p, const MisCo
         if (i == 0 && !finite) d2 = 1;  // solid-angle measure at infinity
         double pw =
             i + 1 == k ? double(p.cameraPdfW) : double(p.v[i + 1].pdfRevW) * p.v[i + 1].cont;
-        b[i] = pw * cosHere / d2;
+        b[i] = pw * cosHere * p.tRev(i + 1) / d2;
     }
     if (p.lightIsDelta()) b[0] = 0;
 
@@ -166,7 +181,7 @@ inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisCon
                                            p.lightIsDelta(), finite);
     for (int i = 1; i <= k - 1; ++i) {
         const MisVertex& x = p.v[i];
-        lp = ub_mis_at_hit(c, lp, p.dist[i], x.cosIn, i > 1 || finite);
+        lp = ub_mis_at_hit_media(c, lp, p.dist[i], x.cosIn, i > 1 || finite, p.tFwd(i), p.tRev(i));
         L[i] = lp;
         lp = ub_mis_scatter(c, lp, x.cosOut, x.pdfFwdW * x.cont, x.pdfRevW * x.cont, x.specular);
     }
@@ -174,12 +189,13 @@ inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisCon
     ub_mis_partials ep = ub_mis_init_camera(c, p.cameraPdfW);
     for (int i = k - 1; i >= 1; --i) {
         const MisVertex& x = p.v[i];
-        ep = ub_mis_at_hit(c, ep, p.dist[i + 1], x.cosOut, 1);
+        ep = ub_mis_at_hit_media(c, ep, p.dist[i + 1], x.cosOut, 1, p.tRev(i + 1), p.tFwd(i + 1));
         E[i] = ep;
         ep = ub_mis_scatter(c, ep, x.cosIn, x.pdfRevW * x.cont, x.pdfFwdW * x.cont, x.specular);
     }
     // Lights at infinity are "hit" by escaping rays: no distance and no cosine.
-    E[0] = finite ? ub_mis_at_hit(c, ep, p.dist[1], p.cosLight, 1) : ep;
+    E[0] = finite ? ub_mis_at_hit_media(c, ep, p.dist[1], p.cosLight, 1, p.tRev(1), p.tFwd(1))
+                  : ub_mis_at_hit_media(c, ep, 0.0f, 1.0f, 0, p.tRev(1), p.tFwd(1));
 
     std::vector<MisTechnique> techs = validTechniques(p, cfg);
     for (MisTechnique& t : techs) {
@@ -196,19 +212,19 @@ inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisCon
             float cosAtLight = finite && !p.lightIsDelta() ? p.cosLight : 1.0f;
             float directPdfW = finite ? p.directPdfA * sq(p.dist[1]) / cosAtLight : p.directPdfA;
             float bsdfDirPdfW = p.lightIsDelta() ? 0.0f : x.pdfRevW * x.cont;
-            w = ub_mis_weight_nee(c, E[1], bsdfDirPdfW, x.pdfFwdW * x.cont, pick, directPdfW,
-                                  emissionPdfW, x.cosIn, cosAtLight);
+            w = ub_mis_weight_nee_media(c, E[1], bsdfDirPdfW, x.pdfFwdW * x.cont, pick, directPdfW,
+                                        emissionPdfW, x.cosIn, cosAtLight, p.tRev(1), p.tFwd(1));
         } else if (t.index == k) {
             const MisVertex& y = p.v[k - 1];
-            float cameraPdfA = p.cameraPdfW * y.cosOut / sq(p.dist[k]);
+            float cameraPdfA = p.cameraPdfW * y.cosOut * p.tRev(k) / sq(p.dist[k]);
             w = ub_mis_weight_light_trace(c, L[k - 1], cameraPdfA, y.pdfRevW * y.cont);
         } else {
             int s = t.index;
             const MisVertex& y = p.v[s - 1];  // light vertex
             const MisVertex& z = p.v[s];      // camera vertex
             float d2 = sq(p.dist[s]);
-            float cameraDirPdfA = z.pdfRevW * z.cont * y.cosOut / d2;
-            float lightDirPdfA = y.pdfFwdW * y.cont * z.cosIn / d2;
+            float cameraDirPdfA = z.pdfRevW * z.cont * y.cosOut * p.tRev(s) / d2;
+            float lightDirPdfA = y.pdfFwdW * y.cont * z.cosIn * p.tFwd(s) / d2;
             w = ub_mis_weight_connect(c, L[s - 1], E[s], cameraDirPdfA, y.pdfRevW * y.cont,
                                       lightDirPdfA, z.pdfFwdW * z.cont);
         }

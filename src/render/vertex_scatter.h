@@ -1,0 +1,109 @@
+// The scattering function at a vertex of a bidirectional subpath: a surface BSDF
+// (scene/bsdf.h) or, at a medium vertex, the Henyey-Greenstein phase function of
+// the medium (kernels/shared/ub_phase.h). One type with a tag, so that the
+// connection, NEE and light-tracing code of render/vcm*.cpp is written once for
+// both kinds of vertex (no virtual calls per sample).
+//
+// At a medium vertex the "BSDF" of the path integral is sigma_s * phase; sigma_s
+// is carried by the free-flight throughput weight T sigma_s / pdf (scene/medium.h),
+// so evaluate() and sample() return the phase value alone, cosines are 1 (no
+// surface), the phase is its own adjoint (reverse pdf = forward pdf) and never a
+// delta. The Russian-roulette probability of a medium vertex is the single-
+// scattering albedo max_c sigma_s,c / sigma_t,c at the vertex (as `vpt`), the same
+// for light and camera subpaths, as the MIS partials assume.
+//
+// Directions follow scene/bsdf.h: dirFix towards the previous vertex of the subpath
+// being traced, dirGen towards the next one, both pointing away from the vertex.
+#pragma once
+
+#include <algorithm>
+
+#include "kernels/shared/ub_phase.h"
+#include "render/vcm.h"
+#include "scene/bsdf.h"
+#include "scene/medium.h"
+#include "scene/scene.h"
+
+namespace ub {
+
+/// Single-scattering albedo max_c sigma_s,c / sigma_t,c, clamped to [0, 1] (0 where
+/// sigma_t = 0): the Russian-roulette continuation probability at a medium vertex.
+inline float mediumContinuationProb(const MediumCoefficients& c) {
+    float a = 0.0f;
+    for (int i = 0; i < 3; ++i)
+        if (c.sigmaT[i] > 0.0f) a = std::max(a, c.sigmaS[i] / c.sigmaT[i]);
+    return std::min(a, 1.0f);
+}
+
+class VertexScatter {
+  public:
+    /// Surface vertex at a hit: sets up the BSDF with its textures (Scene::setupBsdf; false
+    /// if degenerate or the hit has no material).
+    bool setupSurface(const Scene& scene, const Hit& hit, const Vec3& dirFix, bool fromLight) {
+        inMedium_ = false;
+        if (!scene.setupBsdf(&bsdf_, hit, dirFix, fromLight)) return false;
+        contProb_ = vcmContinuationProb(bsdf_);
+        return true;
+    }
+    /// The same from stored vertex data (a light vertex).
+    bool setupSurface(const Scene& scene, int materialId, const Vec2& uv, const Vec3& dirFix,
+                      const Vec3& geoNormal, const Vec3& shadingNormal, bool fromLight) {
+        inMedium_ = false;
+        if (!scene.setupBsdf(&bsdf_, materialId, uv, dirFix, geoNormal, shadingNormal, fromLight))
+            return false;
+        contProb_ = vcmContinuationProb(bsdf_);
+        return true;
+    }
+    /// Medium vertex with HG parameter g and roulette probability contProb.
+    void setupMedium(float g, const Vec3& dirFix, float contProb) {
+        inMedium_ = true;
+        g_ = g;
+        dirFix_ = dirFix;
+        contProb_ = contProb;
+    }
+
+    bool inMedium() const { return inMedium_; }
+    bool isDelta() const { return !inMedium_ && bsdf_.isDelta(); }
+    /// |cos| at the vertex of the segment to the previous vertex (1 in a medium).
+    float cosThetaFix() const { return inMedium_ ? 1.0f : bsdf_.cosThetaFix(); }
+    /// Russian-roulette continuation probability of the bidirectional engine here.
+    float continuationProb() const { return contProb_; }
+    const Bsdf& bsdf() const { return bsdf_; }
+
+    /// f (BSDF value, or phase value) for dirGen; pdfs without roulette, as Bsdf::evaluate.
+    Rgb evaluate(const Vec3& dirGen, float* cosThetaGen, float* directPdfW,
+                 float* reversePdfW) const {
+        if (!inMedium_) return bsdf_.evaluate(dirGen, cosThetaGen, directPdfW, reversePdfW);
+        const float p = ub_hg_pdf(f3(dirFix_), f3(dirGen), g_);
+        if (cosThetaGen) *cosThetaGen = 1.0f;
+        if (directPdfW) *directPdfW = p;
+        if (reversePdfW) *reversePdfW = p;
+        return Rgb(p);
+    }
+    /// Samples dirGen; as Bsdf::sample (value * cos / pdf is the throughput factor).
+    Rgb sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
+               uint32_t* sampledEvent) const {
+        if (!inMedium_) return bsdf_.sample(rnd, dirGen, pdfW, cosThetaGen, sampledEvent);
+        ub_float3 w = ub_hg_sample(f3(dirFix_), g_, rnd.x, rnd.y, pdfW);
+        *dirGen = normalize(Vec3(w.x, w.y, w.z));
+        *cosThetaGen = 1.0f;
+        *sampledEvent = kEventDiffuse;  // any non-specular event
+        return Rgb(*pdfW);
+    }
+    /// Pdf of dirGen (or, reverse, of dirFix given dirGen), without roulette.
+    float pdf(const Vec3& dirGen, bool reverse = false) const {
+        if (!inMedium_) return bsdf_.pdf(dirGen, reverse);
+        return ub_hg_pdf(f3(dirFix_), f3(dirGen), g_);
+    }
+
+  private:
+    static ub_float3 f3(const Vec3& v) { return ub_make_float3(v.x, v.y, v.z); }
+
+    bool inMedium_ = false;
+    Bsdf bsdf_;
+    float g_ = 0.0f;
+    Vec3 dirFix_;
+    float contProb_ = 0.0f;
+};
+
+}  // namespace ub
