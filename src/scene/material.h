@@ -39,7 +39,7 @@ struct Material {
     float exponent = 1.0f;          ///< Phong exponent (> 0)
     Rgb specular{1, 1, 1};          ///< Mirror / Dielectric / Rough* tint
     float ior = 1.5f;               ///< Dielectric, RoughDielectric: interior / exterior IOR
-    Rgb eta{0.2f, 0.92f, 1.1f};     ///< RoughConductor: real part of the complex IOR (default gold)
+    Rgb eta{0.2f, 0.92f, 1.1f};     ///< RoughConductor: real part of the complex IOR (default: copper)
     Rgb k{3.9f, 2.45f, 2.14f};      ///< RoughConductor: imaginary part
     float alpha = 0.1f;             ///< GGX roughness (alpha = roughness^2 convention NOT used: alpha as given)
     /// Two-sided: if true (default for opaque materials), the back side of a surface

@@ -165,7 +165,7 @@ public:
     std::vector<Light> lights;
     std::vector<Texture> textures;  ///< referenced by Material::textures
     int backgroundLightId = -1;   ///< environment light hit by escaping rays, or -1
-    SceneSphere sceneSphere;      ///< bounding sphere of the geometry (and camera)
+    SceneSphere sceneSphere;      ///< bounding sphere of the geometry only (as SmallVCM; the camera may lie outside)
     Bounds3 bounds;
     std::vector<ShapeInfo> shapes;
     std::string sourceFile;       ///< path the scene was loaded from
