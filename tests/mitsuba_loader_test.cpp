@@ -12,6 +12,7 @@
 #include "scene/io/mitsuba_loader.h"
 #include "scene/io/mitsuba_spectra.h"
 #include "scene/io/scene_loader.h"
+#include "scene/texture.h"
 
 using namespace ub;
 namespace fs = std::filesystem;
@@ -286,6 +287,45 @@ TEST(MitsubaSpectra, ConstantReflectanceIsWhiteAndEmissionIsLinear) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(2 * a[c], b[c], 1e-5f);
 }
 
+TEST(MitsubaXml, CheckerboardTextureAndPlastics) {
+    auto s = load(scene(std::string(kLight) + R"(<shape type="rectangle"><bsdf type="diffuse">
+  <texture type="checkerboard" name="reflectance"><rgb name="color0" value="0.2"/>
+    <rgb name="color1" value="0.4"/><transform name="to_uv"><scale x="16" y="16"/></transform>
+  </texture></bsdf></shape>
+<shape type="cube"><bsdf type="roughplastic"><string name="distribution" value="ggx"/>
+  <float name="alpha" value="0.2"/><rgb name="diffuse_reflectance" value="0.3, 0.4, 0.5"/></bsdf></shape>
+<shape type="sphere"><bsdf type="thindielectric"><string name="int_ior" value="water"/></bsdf></shape>
+)"));
+    const Material& d = s->materials[size_t(s->shapes[0].materialId)];
+    ASSERT_GE(d.textures.diffuse, 0);
+    const Texture& t = s->textures[size_t(d.textures.diffuse)];
+    EXPECT_EQ(t.type, TextureType::Checkerboard);
+    EXPECT_FLOAT_EQ(t.color0.x, 0.2f);
+    EXPECT_FLOAT_EQ(t.toUv.m[0][0], 16.0f);
+    const Material& p = s->materials[size_t(s->shapes[1].materialId)];
+    EXPECT_EQ(p.type, MaterialType::RoughPlastic);
+    EXPECT_NEAR(p.ior, 1.49f / 1.000277f, 1e-5f);
+    EXPECT_FLOAT_EQ(p.alpha, 0.2f);
+    const Material& th = s->materials[size_t(s->shapes[2].materialId)];
+    EXPECT_EQ(th.type, MaterialType::ThinDielectric);
+    EXPECT_NEAR(th.ior, 1.333f / 1.000277f, 1e-4f);
+}
+
+TEST(MitsubaXml, SpotLightFollowsToWorld) {
+    auto s = load(scene(R"(<emitter type="spot"><rgb name="intensity" value="4"/>
+  <float name="cutoff_angle" value="30"/>
+  <transform name="to_world"><lookat origin="0, 3, 0" target="0, 0, 0" up="0, 0, 1"/></transform>
+</emitter>
+)"));
+    ASSERT_EQ(s->lights.size(), 1u);
+    const Light& l = s->lights[0];
+    EXPECT_EQ(l.type, LightType::Spot);
+    EXPECT_NEAR(l.position.y, 3.0f, 1e-6f);
+    EXPECT_NEAR(l.direction.y, -1.0f, 1e-6f);
+    EXPECT_FLOAT_EQ(l.cutoffAngleDeg, 30.0f);
+    EXPECT_FLOAT_EQ(l.beamWidthDeg, 22.5f);  // Mitsuba's default: 3/4 of the cutoff
+}
+
 TEST(MitsubaXml, MediaOnShapesBecomeBoundaries) {
     auto s = load(scene(std::string(kLight) + R"(<medium id="fog" type="homogeneous">
   <rgb name="sigma_t" value="1, 2, 3"/><rgb name="albedo" value="0.5"/><float name="scale" value="2"/>
@@ -309,4 +349,23 @@ TEST(MitsubaXml, MediaOnShapesBecomeBoundaries) {
                                    "  <ref id=\"f\" name=\"exterior\"/></shape>\n"));
     EXPECT_TRUE(contains(e, "scene.xml:11:3: error: <shape type=\"sphere\">: exterior media are "
                             "not supported")) << e;
+}
+
+TEST(MitsubaXml, SharedTestScenesLoad) {
+    // Every Mitsuba scene in ../shared loads without errors (the reference test renders them).
+    const std::string dir = std::string(UNIBEAM_SHARED_DIR) +
+                            "/scenes/mitsuba/tests/scenes/participating_media";
+    if (!fs::is_directory(dir)) GTEST_SKIP() << "shared scenes not present";
+    int n = 0;
+    for (const auto& e : fs::directory_iterator(dir)) {
+        if (e.path().extension() != ".xml") continue;
+        ++n;
+        std::vector<Diagnostic> warnings;
+        std::unique_ptr<Scene> s;
+        EXPECT_NO_THROW(s = loadMitsubaScene(e.path().string(), {}, &warnings)) << e.path();
+        if (!s) continue;
+        EXPECT_EQ(s->camera.width(), 48);
+        EXPECT_EQ(s->media.size(), 1u) << e.path();
+    }
+    EXPECT_EQ(n, 5);
 }

@@ -1,5 +1,9 @@
 // Mitsuba <bsdf> plugins -> unibeam materials (docs/mitsuba.md lists the mapping).
+#include <cctype>
 #include <cmath>
+
+#include "core/image.h"
+#include "scene/texture.h"
 
 #include "scene/io/mitsuba_build.h"
 
@@ -7,12 +11,82 @@ namespace ub {
 
 namespace {
 
-const std::vector<std::string> kBsdfs = {"diffuse",         "conductor", "roughconductor",
-                                         "dielectric",      "roughdielectric", "null",
-                                         "twosided"};
+const std::vector<std::string> kBsdfs = {
+    "diffuse",         "conductor",      "roughconductor", "dielectric", "roughdielectric",
+    "thindielectric",  "plastic",        "roughplastic",   "null",       "twosided"};
+const std::vector<std::string> kTextures = {"checkerboard", "bitmap"};
 
 constexpr float kAirIor = 1.000277f;  // Mitsuba's default ext_ior ("air")
 constexpr float kBk7Ior = 1.5046f;    // Mitsuba's default int_ior ("bk7")
+constexpr float kPolypropyleneIor = 1.49f;  // Mitsuba's default int_ior of plastics
+
+/// A <texture> -> index into Scene::textures (cached per object); -1 on an error.
+int buildTexture(MitsubaBuild& b, const XmlObject& t) {
+    auto cached = b.textureIds.find(&t);
+    if (cached != b.textureIds.end()) return cached->second;
+    XmlReader& r = b.r;
+    const size_t before = r.errorCount();
+    Texture tex;
+    tex.name = t.id.empty() ? t.type : t.id;
+    if (t.type == "checkerboard") {
+        tex.type = TextureType::Checkerboard;
+        tex.color0 = r.getColor(t, "color0", Rgb(0.4f), ColorUse::Reflectance);
+        tex.color1 = r.getColor(t, "color1", Rgb(0.2f), ColorUse::Reflectance);
+    } else if (t.type == "bitmap") {
+        tex.type = TextureType::Bitmap;
+        std::string filter = r.getString(t, "filter_type", "bilinear");
+        if (filter != "bilinear")
+            r.error(t.find("filter_type")->pos, t.label() + ": filter_type '" + filter +
+                                                    "' is not supported (only bilinear)");
+        std::string wrap = r.getString(t, "wrap_mode", "repeat");
+        if (wrap != "repeat")
+            r.error(t.find("wrap_mode")->pos, t.label() + ": wrap_mode '" + wrap +
+                                                  "' is not supported (only repeat)");
+        const bool raw = r.getBool(t, "raw", false);
+        std::string file = r.getString(t, "filename", "");
+        if (file.empty()) {
+            r.error(t.pos, t.label() + ": needs <string name=\"filename\">");
+        } else if (std::string path = b.resolveFile(t, "filename", file); !path.empty()) {
+            std::string ext = path.size() > 4 ? path.substr(path.size() - 4) : "";
+            for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+            try {
+                if (ext == ".exr") tex.image = std::make_shared<Image>(readExr(path));
+                else if (ext == ".png") tex.image = std::make_shared<Image>(readPng(path, !raw));
+                else r.error(t.find("filename")->pos, t.label() + ": '" + file +
+                                                          "' is not a .png or .exr file");
+            } catch (const InputError& e) {
+                for (const Diagnostic& d : e.diagnostics())
+                    r.error(t.find("filename")->pos, t.label() + ": " + d.format());
+            }
+        }
+    } else {
+        r.unsupportedPlugin(t, kTextures);
+        b.textureIds[&t] = -1;
+        return -1;
+    }
+    if (t.find("to_uv")) tex.toUv = UvTransform::fromMatrix4(r.getTransform(t, "to_uv"));
+    r.checkUnused(t);
+    int id = -1;
+    if (r.errorCount() == before) {
+        try {
+            id = b.scene.addTexture(tex);
+        } catch (const InputError& e) {
+            for (const Diagnostic& d : e.diagnostics()) r.error(t.pos, t.label() + ": " + d.message);
+        }
+    }
+    b.textureIds[&t] = id;
+    return id;
+}
+
+/// A reflectance given as a colour or as a nested/referenced texture.
+void readReflectance(MitsubaBuild& b, const XmlObject& o, const std::string& name, Rgb def,
+                     Rgb* value, int* texture) {
+    if (const XmlObject* tex = b.r.child(o, "texture", name)) {
+        *texture = buildTexture(b, *tex);
+        return;
+    }
+    *value = b.r.getColor(o, name, def, ColorUse::Reflectance);
+}
 
 /// Reads a GGX roughness: `alpha`, or `alpha_u` = `alpha_v` (anisotropy is not supported),
 /// and insists on distribution="ggx" (Mitsuba's default is Beckmann, which unibeam lacks).
@@ -105,7 +179,8 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
                                        "sides are not supported), got " +
                                std::to_string(inner.size()));
         } else if (inner[0]->type == "dielectric" || inner[0]->type == "roughdielectric" ||
-                   inner[0]->type == "null" || inner[0]->type == "twosided") {
+                   inner[0]->type == "thindielectric" || inner[0]->type == "null" ||
+                   inner[0]->type == "twosided") {
             r.error(inner[0]->pos, o.label() + ": cannot wrap a '" + inner[0]->type + "' BSDF");
         } else {
             int innerId = buildMitsubaBsdf(b, *inner[0]);
@@ -117,12 +192,7 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
         }
     } else if (o.type == "diffuse") {
         m.type = MaterialType::Diffuse;
-        if (const XmlObject* tex = r.child(o, "texture", "reflectance")) {
-            r.error(tex->pos, o.label() + ": textured reflectance (" + tex->label() +
-                                  ") is not supported yet");
-        } else {
-            m.diffuse = r.getColor(o, "reflectance", Rgb(0.5f), ColorUse::Reflectance);
-        }
+        readReflectance(b, o, "reflectance", Rgb(0.5f), &m.diffuse, &m.textures.diffuse);
     } else if (o.type == "conductor") {
         readConductorIor(b, o, m);
         m.specular = r.getColor(o, "specular_reflectance", Rgb(1.0f), ColorUse::Reflectance);
@@ -144,6 +214,27 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
         m.type = MaterialType::Dielectric;
         m.ior = readRelativeIor(r, o);
         m.specular = readDielectricTint(r, o);
+    } else if (o.type == "thindielectric") {
+        m.type = MaterialType::ThinDielectric;
+        m.ior = readRelativeIor(r, o);
+        readReflectance(b, o, "specular_reflectance", Rgb(1.0f), &m.specular,
+                        &m.textures.specular);
+        readReflectance(b, o, "specular_transmittance", Rgb(1.0f), &m.transmittance,
+                        &m.textures.transmittance);
+    } else if (o.type == "plastic" || o.type == "roughplastic") {
+        const bool rough = o.type == "roughplastic";
+        m.type = rough ? MaterialType::RoughPlastic : MaterialType::Plastic;
+        float intIor = r.getIor(o, "int_ior", kPolypropyleneIor);
+        float extIor = r.getIor(o, "ext_ior", kAirIor);
+        m.ior = intIor / extIor;
+        if (rough && intIor == extIor)
+            r.error(o.pos, o.label() + ": int_ior equals ext_ior (a rough coating needs an "
+                                       "index mismatch)");
+        readReflectance(b, o, "diffuse_reflectance", Rgb(0.5f), &m.diffuse, &m.textures.diffuse);
+        readReflectance(b, o, "specular_reflectance", Rgb(1.0f), &m.specular,
+                        &m.textures.specular);
+        m.nonlinear = r.getBool(o, "nonlinear", false);
+        if (rough) m.alpha = readGgxAlpha(r, o);
     } else if (o.type == "roughdielectric") {
         m.type = MaterialType::RoughDielectric;
         m.ior = readRelativeIor(r, o);

@@ -17,7 +17,8 @@ namespace fs = std::filesystem;
 namespace {
 
 const std::vector<std::string> kShapes = {"obj", "ply", "rectangle", "cube", "sphere"};
-const std::vector<std::string> kEmitters = {"area", "point", "directional", "constant", "envmap"};
+const std::vector<std::string> kEmitters = {"area",     "point",  "spot",
+                                            "directional", "constant", "envmap"};
 const std::vector<std::string> kIntegrators = {"path", "volpath", "volpathmis", "moment"};
 const std::vector<std::string> kSamplers = {"independent", "stratified", "multijitter",
                                             "orthogonal", "ldsampler"};
@@ -398,6 +399,18 @@ void Builder::readEmitter(const XmlObject& o) {
             r_.error(o.find("position")->pos, o.label() + ": give either 'position' or 'to_world'");
         light.position = o.find("position") ? r_.getPoint(o, "position", Vec3(0.0f))
                                             : r_.getTransform(o, "to_world").point(Vec3(0.0f));
+    } else if (o.type == "spot") {
+        light.type = LightType::Spot;
+        light.intensity = r_.getColor(o, "intensity", Rgb(1.0f), ColorUse::Emission);
+        light.cutoffAngleDeg = r_.getFloatIn(o, "cutoff_angle", 20.0f, 0.0f, 180.0f, true);
+        light.beamWidthDeg = r_.getFloatIn(o, "beam_width", 0.75f * light.cutoffAngleDeg, 0.0f,
+                                           light.cutoffAngleDeg);
+        // Mitsuba's spot shines along +z of to_world from its origin.
+        Transform m = r_.getTransform(o, "to_world");
+        light.position = m.point(Vec3(0.0f));
+        light.direction = m.vector(Vec3(0, 0, 1));
+        if (o.find("texture") || r_.child(o, "texture", "texture"))
+            r_.error(o.pos, o.label() + ": projected textures are not supported");
     } else if (o.type == "directional") {
         light.type = LightType::Directional;
         light.radiance = r_.getColor(o, "irradiance", Rgb(1.0f), ColorUse::Emission);
