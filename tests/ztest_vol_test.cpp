@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -39,6 +40,23 @@ void noisyImage(int w, int h, int n, float mu, float sigma, uint32_t seed, Image
             var->pixels[i][c] = float((s2 - n * m * m) / (n - 1));
         }
     }
+}
+
+/// Image of `n` iterations of a heavy-tailed estimator: each sample is `value` with
+/// probability `hit`, else 0 (mean value*hit), and its per-sample variance estimate.
+void heavyTailedImage(int w, int h, int n, double hit, double value, uint32_t seed,
+                      Image* mean, Image* var) {
+    std::mt19937 rng(seed);
+    std::binomial_distribution<int> hits(n, hit);
+    *mean = Image(w, h);
+    *var = Image(w, h);
+    for (size_t i = 0; i < mean->pixels.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            const int k = hits(rng);
+            const double m = k * value / n;
+            mean->pixels[i][c] = float(m);
+            var->pixels[i][c] = float((k * value * value - n * m * m) / (n - 1));
+        }
 }
 
 Image constant(int w, int h, float v) {
@@ -85,6 +103,43 @@ TEST(ZTest, UnbiasedNoisyImagePassesAndBiasedFails) {
     EXPECT_EQ(single.failures[0].x, 5);
     EXPECT_EQ(single.failures[0].y, 9);
     EXPECT_EQ(single.minX, 5);
+}
+
+TEST(ZTest, PooledVarianceKeepsAlphaForHeavyTailsAndStillFindsBias) {
+    // Samples are 100 with probability 0.01 (mean 1, variance 99), 1024 per pixel: ~10
+    // hits per pixel-channel, so the per-pixel variance estimate is skewed (a pixel with few
+    // hits has a low mean AND a low variance). Over 20 seeds the per-pixel test of a correct
+    // 24x24 image rejects far more often than alpha = 0.01 allows, while the variance pooled
+    // over 3x3 pixels keeps the level: P(>= 3 rejections of 20 | level 0.01) ~ 1e-3.
+    // Measured: per-pixel 20/20 rejections, pooled 1/20.
+    // A bias of +100% (1 = 3.2 sd of a pixel mean) is found by the pooled test in every
+    // seed: among 1728 tests some exceed the level (z > 4.8).
+    const Image ref = constant(24, 24, 1.0f), refVar = constant(24, 24, 99.0f);
+    ZTestOptions perPixel, pooled;
+    perPixel.samples = pooled.samples = 1024;
+    perPixel.referenceSamples = pooled.referenceSamples = 1e6;
+    pooled.varianceRadius = 1;
+    int rejectPerPixel = 0, rejectPooled = 0, biasFound = 0;
+    for (uint32_t seed = 1; seed <= 20; ++seed) {
+        Image mean, var;
+        heavyTailedImage(24, 24, 1024, 0.01, 100.0, seed, &mean, &var);
+        rejectPerPixel += !zTest(mean, &var, ref, refVar, perPixel).passed;
+        rejectPooled += !zTest(mean, &var, ref, refVar, pooled).passed;
+        Image biased, biasedVar;
+        heavyTailedImage(24, 24, 1024, 0.02, 100.0, seed + 100, &biased, &biasedVar);
+        biasFound += !zTest(biased, &biasedVar, ref, refVar, pooled).passed;
+    }
+    std::printf("[ ztest    ] heavy tails, 20 seeds: per-pixel rejects %d, pooled %d, "
+                "pooled finds the bias %d\n", rejectPerPixel, rejectPooled, biasFound);
+    EXPECT_GE(rejectPerPixel, 10);
+    EXPECT_LE(rejectPooled, 2);
+    EXPECT_EQ(biasFound, 20);
+    ZTestOptions bad = pooled;
+    Image mean, var;
+    heavyTailedImage(4, 4, 16, 0.5, 1.0, 1, &mean, &var);
+    EXPECT_THROW(zTest(mean, nullptr, ref, refVar, bad), InputError);  // pooling needs var
+    bad.varianceRadius = -1;
+    EXPECT_THROW(zTest(mean, &var, mean, var, bad), InputError);
 }
 
 TEST(ZTest, RejectsMismatchedSizesAndBadValues) {

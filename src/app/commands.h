@@ -43,6 +43,7 @@ struct CompareArgs {
     double samples = 0;           ///< --spp: iterations averaged into IMAGE
     double referenceSamples = 0;  ///< --ref-spp (0: exact reference)
     double alpha = 0.01;
+    int varianceRadius = 0;       ///< --variance-radius: pool the image variance (needs --image-var)
 };
 
 /// Default number of iterations when neither -t nor -i is given.

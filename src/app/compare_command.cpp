@@ -41,6 +41,9 @@ int runCompareZTest(const CompareArgs& args) {
     o.alpha = args.alpha;
     o.samples = args.samples;
     o.referenceSamples = args.referenceSamples;
+    o.varianceRadius = args.varianceRadius;
+    if (o.varianceRadius > 0 && args.imageVariance.empty())
+        throw UsageError("compare: --variance-radius needs --image-var");
     ZTestResult r = zTest(img, args.imageVariance.empty() ? nullptr : &imgVar, ref, refVar, o);
     std::printf("%s\n", describeZTest(r, o).c_str());
     return r.passed ? 0 : 1;

@@ -81,7 +81,7 @@ int run(int argc, char** argv) {
     std::string seedText, maxLengthText;
     float radius = 0, alpha = 0;
     CLI::App* render = app.add_subcommand("render", "Render a scene progressively");
-    render->add_option("scene", ra.scene, "Scene file (native .json)")
+    render->add_option("scene", ra.scene, "Scene file: unibeam .json, Mitsuba 3 .xml, or SmallUPBP .obj (with its .obj.aux)")
         ->required()
         ->type_name("SCENE");
     render
@@ -196,6 +196,12 @@ int run(int argc, char** argv) {
                      "(default 0.01)")
         ->check(positiveReal(0.999))
         ->type_name("A");
+    compare
+        ->add_option("--variance-radius", ca.varianceRadius,
+                     "Pool the image variance over (2R+1)^2 pixels (needs --image-var; guards "
+                     "against heavy-tailed estimators; default 0: per pixel)")
+        ->check(CLI::Range(0, 8))
+        ->type_name("R");
 
     if (argc >= 2 && argv[1][0] != '-' && std::string(argv[1]) != "render" &&
         std::string(argv[1]) != "info" && std::string(argv[1]) != "compare") {

@@ -21,6 +21,9 @@ ZTestResult zTest(const Image& image, const Image* imageVariance, const Image& r
         fail("an image variance needs at least 2 iterations");
     if (!(o.referenceSamples >= 0.0)) fail("reference sample count must be >= 0");
     if (!(o.varianceFloor >= 0.0)) fail("variance floor must be >= 0");
+    if (o.varianceRadius < 0) fail("variance radius must be >= 0");
+    if (o.varianceRadius > 0 && !imageVariance)
+        fail("a pooled variance (radius > 0) needs the image variance");
     auto sameSize = [&](const Image& a, const char* what) {
         if (a.width != reference.width || a.height != reference.height)
             fail(std::string(what) + " is " + std::to_string(a.width) + "x" +
@@ -36,6 +39,23 @@ ZTestResult zTest(const Image& image, const Image* imageVariance, const Image& r
     r.tests = size_t(reference.width) * reference.height * 3;
     // 1 - (1 - alpha)^(1/m) without cancellation: -expm1(log1p(-alpha) / m).
     r.perTestLevel = -std::expm1(std::log1p(-o.alpha) / double(r.tests));
+    // Image variance of each (pixel, channel): its own or pooled over the neighbourhood
+    // (see the header), each per-pixel value floored first.
+    auto floored = [&](int x, int y, int c) {
+        return std::max(double(imageVariance->at(x, y)[c]), o.varianceFloor);
+    };
+    auto pooledVariance = [&](int x, int y, int c) {
+        const int rad = o.varianceRadius;
+        double sum = 0;
+        int count = 0;
+        for (int yy = std::max(0, y - rad); yy <= std::min(reference.height - 1, y + rad); ++yy)
+            for (int xx = std::max(0, x - rad); xx <= std::min(reference.width - 1, x + rad);
+                 ++xx) {
+                sum += floored(xx, yy, c);
+                ++count;
+            }
+        return sum / count;
+    };
     std::set<std::pair<int, int>> failing;
     for (int y = 0; y < reference.height; ++y)
         for (int x = 0; x < reference.width; ++x)
@@ -58,6 +78,7 @@ ZTestResult zTest(const Image& image, const Image* imageVariance, const Image& r
                 // slightly negative value; the floor below covers it.
                 varRef = std::max(varRef, o.varianceFloor);
                 varImg = std::max(varImg, o.varianceFloor);
+                if (o.varianceRadius > 0) varImg = pooledVariance(x, y, c);
                 double var = varImg / o.samples;
                 if (o.referenceSamples > 0) var += varRef / o.referenceSamples;
                 const double z = var > 0 ? (v - ref) / std::sqrt(var)
