@@ -17,11 +17,16 @@
 #include "kernels/shared/ub_fresnel.h"
 #include "kernels/shared/ub_plastic.h"
 #include "scene/bsdf.h"
+#include "tests/support/bsdf_probe.h"
 #include "tests/support/chi2.h"
 
 using namespace ub;
 
 namespace {
+
+using ub::test::albedo;
+using ub::test::Albedo;
+using ub::test::TestFrame;
 
 const Vec3 kNormal = normalize(Vec3(-0.3f, 0.2f, 0.9f));
 const float kAnglesDeg[] = {5.0f, 45.0f, 80.0f};
@@ -112,44 +117,6 @@ std::string str(const Rgb& c) {
 /// The mirror direction of dirFix about the normal on dirFix's side.
 Vec3 mirrorOf(const Vec3& fix) {
     return reflect(fix, dot(fix, kNormal) > 0 ? kNormal : -kNormal);
-}
-
-struct TestFrame {
-    Vec3 e1, e2, e3;
-    TestFrame(const Vec3& n, const Vec3& dirFix) : e1(n) {
-        e2 = normalize(dirFix - dot(dirFix, n) * n);
-        e3 = cross(e1, e2);
-    }
-    Vec3 toTest(const Vec3& d) const { return {dot(d, e1), dot(d, e2), dot(d, e3)}; }
-    Vec3 toWorld(const Vec3& t) const { return e1 * t.x + e2 * t.y + e3 * t.z; }
-};
-
-struct Albedo {
-    Rgb mean, stdErr;
-};
-
-/// rho(dirFix) = E[f cos / pdf] over sample() (delta lobes included), per channel.
-Albedo albedo(const Bsdf& bsdf, int n, uint64_t seed) {
-    Rng rng(seed, 17);
-    double s[3] = {0, 0, 0}, s2[3] = {0, 0, 0};
-    for (int i = 0; i < n; ++i) {
-        Vec3 dir;
-        float pdfW, cosGen;
-        Rgb f = bsdf.sample(rng.uniform3(), &dir, &pdfW, &cosGen, nullptr);
-        if (pdfW == 0) continue;
-        Rgb w = f * (cosGen / pdfW);
-        for (int k = 0; k < 3; ++k) {
-            s[k] += w[k];
-            s2[k] += double(w[k]) * w[k];
-        }
-    }
-    Albedo a;
-    for (int k = 0; k < 3; ++k) {
-        double m = s[k] / n, var = std::max(0.0, s2[k] / n - m * m);
-        a.mean[k] = float(m);
-        a.stdErr[k] = float(std::sqrt(var / n));
-    }
-    return a;
 }
 
 /// Exact hemispherical diffuse reflectance 2 int_0^1 F(mu, eta) mu dmu (midpoint rule,
