@@ -343,12 +343,20 @@ TEST(MitsubaXml, MediaOnShapesBecomeBoundaries) {
     EXPECT_FALSE(s->shapes[1].imaginary);
     EXPECT_EQ(s->shapes[1].interiorMediumId, 0);
 
-    std::string e = errorsOf(scene(std::string(kLight) +
-                                   "<medium id=\"f\" type=\"homogeneous\"/>\n"
-                                   "<shape type=\"sphere\"><bsdf type=\"null\"/>\n"
-                                   "  <ref id=\"f\" name=\"exterior\"/></shape>\n"));
-    EXPECT_TRUE(contains(e, "scene.xml:11:3: error: <shape type=\"sphere\">: exterior media are "
-                            "not supported")) << e;
+    // Mitsuba's volpath semantics (docs/mitsuba.md, scene.h).
+    EXPECT_EQ(s->settings.mediumTransitions, MediumTransitions::kShapeSides);
+    EXPECT_EQ(s->settings.depthCounting, DepthCounting::kNonNullVertices);
+
+    // An exterior medium alone also makes a boundary (entering: vacuum, leaving: fog).
+    auto ext = load(scene(std::string(kLight) +
+                          "<medium id=\"f\" type=\"homogeneous\"/>\n"
+                          "<shape type=\"sphere\"><bsdf type=\"null\"/>\n"
+                          "  <ref id=\"f\" name=\"exterior\"/></shape>\n"));
+    ASSERT_EQ(ext->shapes.size(), 1u);
+    EXPECT_TRUE(ext->shapes[0].isMediumBoundary);
+    EXPECT_TRUE(ext->shapes[0].imaginary);
+    EXPECT_EQ(ext->shapes[0].interiorMediumId, -1);
+    EXPECT_EQ(ext->shapes[0].exteriorMediumId, 0);
 }
 
 TEST(MitsubaXml, SharedTestScenesLoad) {

@@ -86,6 +86,7 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
             throw InputError(scene.sourceFile, "radius reduction alpha must be in (0, 1], got " +
                                                    std::to_string(options.alpha));
     }
+    nullNotCounted_ = scene.settings.depthCounting == DepthCounting::kNonNullVertices;
     const bool volumetric = options.algorithm == "vlt" || options.algorithm == "vbpt";
     useMedia_ = volumetric && scene.hasMedia();
     if (useMedia_) {
@@ -238,12 +239,14 @@ bool VertexCM::stackTowards(const PathVertex& v, const SubPath& state, const Vec
 }
 
 bool VertexCM::sampleScattering(Rng& rng, const VertexScatter& scatter, const PathVertex& v,
-                                SubPath& state) const {
+                                SubPath& state, bool onlyNull) const {
     Vec3 dirGen;
     float dirPdfW = 0.0f, cosThetaOut = 0.0f;
     uint32_t event = kEventNone;
     Rgb f = scatter.sample(rng.uniform3(), &dirGen, &dirPdfW, &cosThetaOut, &event);
     if (isBlack(f) || !(dirPdfW > 0.0f)) return false;
+    const bool nullEvent = nullNotCounted_ && scatter.isNullEvent(event);
+    if (onlyNull && !nullEvent) return false;
     const bool specular = (event & kEventSpecular) != 0;
     // For a delta lobe the reverse pdf equals the forward one; otherwise evaluate it.
     float revPdfW = specular ? dirPdfW : scatter.pdf(dirGen, /*reverse=*/true);
@@ -271,6 +274,7 @@ bool VertexCM::sampleScattering(Rng& rng, const VertexScatter& scatter, const Pa
         state.ray = scene_.spawnRay(v.hit, dirGen);
     }
     state.rayFromMedium = v.inMedium;
+    if (nullEvent) --state.pathLength;  // not a vertex of the path's length
     return true;
 }
 

@@ -43,7 +43,11 @@
 // scenes. Without media vlt and vbpt are lt and bpt.
 //
 // Conventions shared with `pt` (render/pt.h): path length counts segments, a
-// light seen directly has length 1; surfaces that emit and have a material keep
+// light seen directly has length 1 (with DepthCounting::kNonNullVertices, Mitsuba
+// scenes, a vertex whose sampled lobe continues the ray unchanged, a thin sheet's
+// transmission, ends no segment: the lengths of both subpaths and of connections
+// count the other vertices only; such a vertex stays a delta vertex for MIS, never
+// connected to); surfaces that emit and have a material keep
 // scattering; Russian roulette with Bsdf::continuationProb(). Light tracing
 // needs a pinhole camera: lt, bpt, vcm, vlt and vbpt reject thin-lens cameras.
 #pragma once
@@ -142,15 +146,19 @@ class VertexCM : public Integrator {
 
     // Shared: samples the next direction (Russian roulette, MIS update [TR (34)-(36)],
     // [TR (53)-(55)]), updates the medium stack and spawns the ray. Returns false if the
-    // subpath ends.
+    // subpath ends. With nullNotCounted_, a null-lobe event decrements state.pathLength
+    // (the caller's increment then leaves it unchanged: the vertex is not counted), and
+    // onlyNull (the subpath is at its length limit) ends the subpath on any other event.
     bool sampleScattering(Rng& rng, const VertexScatter& scatter, const PathVertex& v,
-                          SubPath& state) const;
+                          SubPath& state, bool onlyNull = false) const;
 
     const Scene& scene_;
     RenderOptions options_;
     Algorithm algorithm_;
     bool useVC_ = false, useVM_ = false, lightTraceOnly_ = false, ppm_ = false;
     bool useMedia_ = false;                 ///< vlt/vbpt on a scene with media
+    /// DepthCounting::kNonNullVertices: null-lobe vertices do not count towards the length.
+    bool nullNotCounted_ = false;
     std::vector<MediumStack> lightStacks_;  ///< media where each light's subpaths start
     float baseRadius_ = 0;
     float lightPickProb_ = 0;

@@ -66,15 +66,18 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration) const {
         }
         // Light tracing uses the camera pass only for directly visible emitters.
         if (lightTraceOnly_) break;
-        if (state.pathLength >= maxLength) break;
+        // At the length limit only a null lobe (not counted) may continue the subpath.
+        const bool atLimit = state.pathLength >= maxLength;
+        if (atLimit && !nullNotCounted_) break;
 
         VertexScatter scatter;  // BSDF, or phase function at a medium vertex
         if (!setupScatter(v, state, /*fromLight=*/false, &scatter)) break;
+        if (atLimit && !scatter.hasNullLobe()) break;
         // Complete the partials at this vertex [TR (31)-(36)] (ub_mis.h, MEDIA).
         state.mis = ub_mis_at_hit_media(mis_, state.mis, v.dist, scatter.cosThetaFix(), 1,
                                         v.distPdfFwd, v.distPdfRev);
 
-        if (!scatter.isDelta() && useVC_) {
+        if (!atLimit && !scatter.isDelta() && useVC_) {
             // Next-event estimation: a path of pathLength + 1 segments.
             if (state.pathLength + 1 >= minLength)
                 color += state.throughput * directIllumination(rng, state, v, scatter);
@@ -88,11 +91,11 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration) const {
                 color += state.throughput * lv.throughput * connectVertices(lv, state, v, scatter);
             }
         }
-        if (!scatter.isDelta() && useVM_) {
+        if (!atLimit && !scatter.isDelta() && useVM_) {
             color += state.throughput * mergeVertices(state, v.hit, scatter.bsdf());
             if (ppm_) break;  // PPM merges at the first non-specular camera vertex only
         }
-        if (!sampleScattering(rng, scatter, v, state)) break;
+        if (!sampleScattering(rng, scatter, v, state, atLimit)) break;
     }
     return color;
 }

@@ -98,9 +98,11 @@ void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuf
                 state.pathLength + 1 >= minLength && state.pathLength + 1 <= maxLength)
                 connectToCamera(state, v, scatter, splats);
 
-            // Stop if scattering would make the path too long even when connected directly.
-            if (state.pathLength + 2 > maxLength) break;
-            if (!sampleScattering(rng, scatter, v, state)) break;
+            // Stop if scattering would make the path too long even when connected directly
+            // (unless the vertex may pass the ray on through a null lobe, not counted).
+            const bool atLimit = state.pathLength + 2 > maxLength;
+            if (atLimit && !(nullNotCounted_ && scatter.hasNullLobe())) break;
+            if (!sampleScattering(rng, scatter, v, state, atLimit)) break;
         }
         pathEnds[pathIndex - begin] = uint32_t(vertices.size());
     }

@@ -64,6 +64,9 @@ class VertexScatter {
 
     bool inMedium() const { return inMedium_; }
     bool isDelta() const { return !inMedium_ && bsdf_.isDelta(); }
+    /// A lobe that continues the ray unchanged (Bsdf::hasNullLobe; never in a medium).
+    bool hasNullLobe() const { return !inMedium_ && bsdf_.hasNullLobe(); }
+    bool isNullEvent(uint32_t event) const { return !inMedium_ && bsdf_.isNullEvent(event); }
     /// |cos| at the vertex of the segment to the previous vertex (1 in a medium).
     float cosThetaFix() const { return inMedium_ ? 1.0f : bsdf_.cosThetaFix(); }
     /// Russian-roulette continuation probability of the bidirectional engine here.

@@ -57,6 +57,9 @@ Rgb VolPathTracer::tracePixel(int x, int y, int iteration) const {
     const int maxLength = options_.maxPathLength;
     const int minLength = options_.minPathLength;
     const int lightCount = int(scene_.lights.size());
+    // Mitsuba's depth: a null-lobe event (thin-sheet transmission) is not a vertex.
+    const bool nullNotCounted =
+        scene_.settings.depthCounting == DepthCounting::kNonNullVertices;
 
     Rng rng = Rng::forPath(options_.seed, uint64_t(iteration),
                            uint64_t(y) * uint64_t(camera.width()) + uint64_t(x));
@@ -212,13 +215,16 @@ Rgb VolPathTracer::tracePixel(int x, int y, int iteration) const {
                 radiance += throughput * le * emitterHitWeight(pathLength, passProb, lightPdfW);
             }
         }
-        if (pathLength >= maxLength || hit.materialId < 0) break;
+        // At the length limit only a null lobe, which is not counted, may continue the path.
+        const bool atLimit = pathLength >= maxLength;
+        if ((atLimit && !nullNotCounted) || hit.materialId < 0) break;
 
         Bsdf bsdf;
         const Vec3 dirFix = -ray.dir;
         if (!scene_.setupBsdf(&bsdf, hit, dirFix, /*fromLight=*/false)) break;
+        if (atLimit && !bsdf.hasNullLobe()) break;
         const float contProb = std::min(1.0f, bsdf.continuationProb());
-        if (!bsdf.isDelta() && lightCount > 0 && pathLength + 1 >= minLength) {
+        if (!atLimit && !bsdf.isDelta() && lightCount > 0 && pathLength + 1 >= minLength) {
             nextEvent(
                 hit.pos, hit.geoNormal,
                 [&](const Vec3& dir, float* pdfW) {
@@ -240,6 +246,9 @@ Rgb VolPathTracer::tracePixel(int x, int y, int iteration) const {
         uint32_t event = kEventNone;
         Rgb f = bsdf.sample(rng.uniform3(), &dirGen, &pdfW, &cosThetaGen, &event);
         if (isBlack(f) || !(pdfW > 0.0f)) break;
+        const bool nullEvent = nullNotCounted && bsdf.isNullEvent(event);
+        if (atLimit && !nullEvent) break;
+        if (nullEvent) --pathLength;  // the loop's increment leaves the length unchanged
         throughput *= f * (cosThetaGen / (pdfW * contProb));
         if (isBlack(throughput) || !isFinite(throughput)) break;
         lastDelta = (event & kEventSpecular) != 0;

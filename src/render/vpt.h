@@ -39,7 +39,12 @@
 // Path length counts segments, every vertex (surface or medium) ending one
 // (SmallUPBP semantics): a medium vertex seen from the camera ends a path of
 // length 1, its NEE makes length 2. A path of length L contributes only if
-// minPathLength <= L <= maxPathLength.
+// minPathLength <= L <= maxPathLength. With DepthCounting::kNonNullVertices
+// (Mitsuba scenes, scene.h) a surface vertex whose sampled lobe continues the
+// ray unchanged (Bsdf::isNullEvent: thin-sheet transmission) ends no segment,
+// like an imaginary boundary: the segments on both sides count as one. It stays
+// a delta vertex for MIS. Medium transitions follow Scene::crossSurface and
+// RenderSettings::mediumTransitions.
 //
 // Determinism: pixel (x, y) of iteration i draws every random number from
 // Rng::forPath(seed, i, y * width + x); rows are rendered in parallel.

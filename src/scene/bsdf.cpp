@@ -403,6 +403,10 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
     return f;
 }
 
+bool Bsdf::hasNullLobe() const {
+    return mat_ && mat_->type == MaterialType::ThinDielectric;
+}
+
 Rgb Bsdf::sampleDelta(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
                       uint32_t* sampledEvent) const {
     const Vec3& fix = localDirFix_;

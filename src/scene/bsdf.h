@@ -96,6 +96,12 @@ public:
     /// mixes a delta reflection with a diffuse lobe: isDelta() is false, evaluate() and pdf()
     /// cover the diffuse lobe and sample() reports kEventReflect for the delta one.
     bool isDelta() const { return isDelta_; }
+    /// True if a lobe continues the ray unchanged, dirGen = -dirFix (Mitsuba 3's Null flag:
+    /// the transmission of a ThinDielectric sheet), which DepthCounting::kNonNullVertices
+    /// does not count as a vertex.
+    bool hasNullLobe() const;
+    /// True if sample() reported `event` for that lobe.
+    bool isNullEvent(uint32_t event) const { return hasNullLobe() && (event & kEventRefract); }
     /// Russian-roulette continuation probability: max over RGB of the albedo
     /// estimate, clamped to [0,1] (SmallVCM's mContinuationProb).
     float continuationProb() const { return contProb_; }

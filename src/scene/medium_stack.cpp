@@ -49,4 +49,9 @@ bool MediumStack::pop(int32_t shapeId) {
     return false;
 }
 
+void MediumStack::setOnly(int32_t shapeId, int32_t mediumId) {
+    count = 1;
+    entries[0] = {shapeId, mediumId, kGlobalPriority};
+}
+
 }  // namespace ub

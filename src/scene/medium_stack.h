@@ -31,6 +31,9 @@
 //  * At a real hit on a boundary the stack is the one on the incoming side; a
 //    continuation (or shadow ray) that leaves on the other side of the
 //    surface crosses S (Scene::crossSurface).
+// Mitsuba 3's rule (RenderSettings::mediumTransitions = kShapeSides) uses the
+// same type with a single entry (setOnly): crossing S sets the medium to S's
+// interior (entering) or exterior (leaving) medium, forgetting the others.
 // Overflow: pushing onto a full stack fails (push returns false) and callers
 // end the path; Scene validation rejects scenes in which more than
 // kCapacity - 1 boundaries can overlap, so a valid scene never overflows.
@@ -68,6 +71,10 @@ struct MediumStack {
     bool push(int32_t shapeId, int32_t mediumId, int32_t priority);
     /// Leaves boundary shapeId; false if it was not on the stack (no-op).
     bool pop(int32_t shapeId);
+    /// Replaces the whole stack by one entry of the lowest priority: the medium mediumId set
+    /// by crossing shapeId (MediumTransitions::kShapeSides, Mitsuba 3's rule; any boundary
+    /// then has a priority >= the current one, so none is skipped).
+    void setOnly(int32_t shapeId, int32_t mediumId);
 };
 
 static_assert(sizeof(MediumStackEntry) == 12, "flat layout");

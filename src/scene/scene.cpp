@@ -378,6 +378,13 @@ void Scene::setMediumBoundary(uint32_t shapeId, int interiorMediumId, int priori
     s.imaginary = imaginary;
 }
 
+void Scene::setExteriorMedium(uint32_t shapeId, int exteriorMediumId) {
+    if (impl_->committed) throw std::logic_error("Scene::setExteriorMedium called after commit()");
+    if (shapeId >= shapes.size() || !shapes[shapeId].isMediumBoundary)
+        throw std::out_of_range("Scene::setExteriorMedium: not a medium boundary");
+    shapes[shapeId].exteriorMediumId = exteriorMediumId;
+}
+
 void Scene::meshTriangle(uint32_t shapeId, uint32_t tri, Vec3 p[3]) const {
     const ShapeGeom& g = impl_->geoms.at(shapeId);
     if (g.isSphere) throw std::logic_error("Scene::meshTriangle called on a sphere");

@@ -44,6 +44,28 @@ struct Hit {
     int lightId = -1;          ///< index into Scene::lights if the shape is emissive, else -1
 };
 
+/// How the medium of a path changes where it crosses a medium boundary.
+enum class MediumTransitions : uint8_t {
+    /// Nested media with priorities (scene/medium_stack.h; SmallUPBP): the medium is the
+    /// highest-priority one among the boundaries the path is inside. JSON and SmallUPBP scenes.
+    kPriorityStack,
+    /// Mitsuba 3: crossing a boundary sets the medium to that shape's interior medium when
+    /// entering it and to its exterior medium (ShapeInfo::exteriorMediumId, vacuum if none)
+    /// when leaving it, whatever other boundaries the path is inside; every boundary that is
+    /// not imaginary is a real surface. Set by the Mitsuba XML loader.
+    kShapeSides,
+};
+
+/// Which vertices count towards RenderSettings::maxPathLength.
+enum class DepthCounting : uint8_t {
+    /// Every surface and medium vertex (SmallVCM): a path of k segments has length k.
+    kAllVertices,
+    /// Mitsuba 3's volpath: a surface vertex whose sampled lobe continues the ray unchanged
+    /// (Bsdf::isNullEvent, Mitsuba's Null flag: thin-sheet transmission) is not counted,
+    /// like an imaginary boundary. Set by the Mitsuba XML loader.
+    kNonNullVertices,
+};
+
 /// What the renderer needs from the scene file besides geometry.
 struct RenderSettings {
     int maxPathLength = 10;    ///< max number of path segments (SmallVCM semantics)
@@ -52,6 +74,8 @@ struct RenderSettings {
     /// --resolution keeps the horizontal field of view instead of the vertical one
     /// (SmallUPBP scenes: its -r keeps CAMERA_FOV, a horizontal angle).
     bool keepHorizontalFov = false;
+    MediumTransitions mediumTransitions = MediumTransitions::kPriorityStack;
+    DepthCounting depthCounting = DepthCounting::kAllVertices;
 };
 
 struct ShapeInfo {
@@ -64,6 +88,8 @@ struct ShapeInfo {
     // Medium boundary (scene/medium_stack.h); set by Scene::setMediumBoundary.
     bool isMediumBoundary = false;
     int interiorMediumId = -1;  ///< index into Scene::media, -1 = vacuum
+    /// Medium outside the shape (-1 = vacuum); MediumTransitions::kShapeSides only.
+    int exteriorMediumId = -1;
     int mediumPriority = 0;
     bool imaginary = false;     ///< changes the medium only: never scatters nor emits
 };
@@ -89,6 +115,9 @@ public:
     /// Declares shape shapeId a medium boundary (scene/medium_stack.h): interior medium
     /// (-1 = vacuum), priority, imaginary or not.
     void setMediumBoundary(uint32_t shapeId, int interiorMediumId, int priority, bool imaginary);
+    /// Sets the exterior medium of boundary shapeId (after setMediumBoundary); only valid with
+    /// settings.mediumTransitions == kShapeSides (mediumIssues() reports it otherwise).
+    void setExteriorMedium(uint32_t shapeId, int exteriorMediumId);
     /// Problems with the media set-up (open boundary meshes, conflicting priorities, too
     /// deep nesting, bad medium ids), one per offending shape or medium; empty if valid.
     /// Callable before commit() (loaders use it to point at the file position).
@@ -120,12 +149,16 @@ public:
     // ---- media (thread-safe after commit; scene/medium_trace.h) ----
     /// True if any medium can be met: a global medium or a boundary.
     bool hasMedia() const;
-    /// Stack of the media containing point p (traces to infinity, counting crossings).
+    /// Stack of the media containing point p (traces to infinity, counting crossings). With
+    /// kShapeSides: the medium on p's side of the nearest boundary (majority of three rays).
     MediumStack mediumStackAt(const Vec3& p) const;
     /// Crosses boundary shapeId along direction dir at a hit with geometric normal n
-    /// (push or pop). False if the stack is full (the path must end).
+    /// (push or pop; with kShapeSides the stack becomes that side's medium alone). False if
+    /// the stack is full (the path must end).
     bool crossBoundary(uint32_t shapeId, const Vec3& geoNormal, const Vec3& dir,
                        MediumStack* stack) const;
+    /// Crosses boundary shapeId, entering or leaving it, by the scene's MediumTransitions.
+    bool applyCrossing(uint32_t shapeId, bool entering, MediumStack* stack) const;
     /// At a real surface hit reached along -dirFix with stack *stack (the incoming side):
     /// updates the stack for a continuation dirGen (crosses the shape if dirGen leaves on the
     /// other side of the geometric surface). False on stack overflow.
@@ -175,6 +208,8 @@ public:
     MediumStack cameraMediumStack;  ///< set by commit(): media at the camera position
 
 private:
+    MediumStack mediumStackAtShapeSides(const Vec3& p) const;
+
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };

@@ -181,6 +181,16 @@ std::vector<MediumIssue> Scene::mediumIssues() const {
             add(int(s), -1,
                 name + ": interior medium id " + std::to_string(sh.interiorMediumId) +
                     " is out of range");
+        if (sh.exteriorMediumId < -1 || sh.exteriorMediumId >= int(media.size()))
+            add(int(s), -1,
+                name + ": exterior medium id " + std::to_string(sh.exteriorMediumId) +
+                    " is out of range");
+        if (sh.exteriorMediumId >= 0 &&
+            settings.mediumTransitions != MediumTransitions::kShapeSides)
+            add(int(s), -1,
+                name + " has an exterior medium, which only Mitsuba's medium transitions use "
+                       "(the priority stack derives the outside medium from the boundaries "
+                       "around the shape)");
         if (sh.imaginary && sh.lightId >= 0)
             add(int(s), -1, name + " is an imaginary medium boundary and cannot emit light");
         if (!sh.isSphere) {
@@ -196,6 +206,8 @@ std::vector<MediumIssue> Scene::mediumIssues() const {
                         "); a medium boundary must be a closed, consistently oriented surface");
         }
     }
+    // Mitsuba's transitions keep one medium and ignore priorities: overlaps are allowed.
+    if (settings.mediumTransitions == MediumTransitions::kShapeSides) return issues;
     // Conflicting priorities: overlapping boundaries of equal priority and different media
     // would make the current medium depend on the order in which a path enters them.
     int maxOverlap = 0;
@@ -234,10 +246,18 @@ bool Scene::hasMedia() const {
 
 bool Scene::crossBoundary(uint32_t shapeId, const Vec3& geoNormal, const Vec3& dir,
                           MediumStack* stack) const {
+    if (!shapes[shapeId].isMediumBoundary) return true;
+    return applyCrossing(shapeId, dot(dir, geoNormal) < 0.0f, stack);
+}
+
+bool Scene::applyCrossing(uint32_t shapeId, bool entering, MediumStack* stack) const {
     const ShapeInfo& s = shapes[shapeId];
-    if (!s.isMediumBoundary) return true;
-    if (dot(dir, geoNormal) < 0.0f)
-        return stack->push(int32_t(shapeId), s.interiorMediumId, s.mediumPriority);
+    if (settings.mediumTransitions == MediumTransitions::kShapeSides) {
+        // Mitsuba 3: the medium on the side of the shape the path goes to.
+        stack->setOnly(int32_t(shapeId), entering ? s.interiorMediumId : s.exteriorMediumId);
+        return true;
+    }
+    if (entering) return stack->push(int32_t(shapeId), s.interiorMediumId, s.mediumPriority);
     stack->pop(int32_t(shapeId));
     return true;
 }
@@ -246,6 +266,11 @@ bool Scene::crossSurface(const Hit& hit, const Vec3& dirFix, const Vec3& dirGen,
                          MediumStack* stack) const {
     const bool fixOutside = dot(dirFix, hit.geoNormal) > 0.0f;
     const bool genOutside = dot(dirGen, hit.geoNormal) > 0.0f;
+    // Mitsuba 3 sets the medium of dirGen's side at every interaction with a boundary, a
+    // reflection included (the path may have reached the surface in another medium).
+    if (settings.mediumTransitions == MediumTransitions::kShapeSides &&
+        shapes[hit.shapeId].isMediumBoundary)
+        return applyCrossing(hit.shapeId, !genOutside, stack);
     if (fixOutside == genOutside) return true;  // reflection: same side, same media
     return crossBoundary(hit.shapeId, hit.geoNormal, dirGen, stack);
 }
@@ -256,6 +281,8 @@ MediumStack Scene::mediumStackAt(const Vec3& p) const {
     bool anyBoundary = false;
     for (const ShapeInfo& s : shapes) anyBoundary |= s.isMediumBoundary;
     if (!anyBoundary) return stack;
+    if (settings.mediumTransitions == MediumTransitions::kShapeSides)
+        return mediumStackAtShapeSides(p);
     // Three rays in generic directions; a boundary contains p if it does along at least two
     // (a ray grazing an edge or a tangent cannot then flip the answer). Along one ray,
     // p is inside S if the ray leaves S once more than it enters it.
@@ -350,12 +377,42 @@ void Scene::replayCrossings(const MediumTrace& trace, int k, MediumStack* stack)
     for (int j = 0; j < k && j < trace.count; ++j) {
         const MediumTraceSegment& seg = trace.segments[j];
         if (seg.crossingShape < 0) continue;
-        const ShapeInfo& s = shapes[size_t(seg.crossingShape)];
-        if (seg.crossingEntering)
-            stack->push(seg.crossingShape, s.interiorMediumId, s.mediumPriority);
-        else
-            stack->pop(seg.crossingShape);
+        applyCrossing(uint32_t(seg.crossingShape), seg.crossingEntering != 0, stack);
     }
+}
+
+MediumStack Scene::mediumStackAtShapeSides(const Vec3& p) const {
+    // The medium a path arriving at p from the nearest boundary along a ray would carry: the
+    // side of that boundary p is on. Three generic directions, majority vote (the first
+    // ray's answer if all differ), so that a ray grazing an edge cannot decide alone. In a
+    // scene whose boundaries overlap the medium at a point can depend on the path (Mitsuba
+    // 3 has the same ambiguity; its sensors and emitters name their medium instead).
+    const Vec3 dirs[3] = {normalize(Vec3(0.5773f, 0.6181f, 0.5331f)),
+                          normalize(Vec3(-0.4131f, 0.3167f, -0.8537f)),
+                          normalize(Vec3(0.2719f, -0.9146f, 0.2993f))};
+    MediumStack found[3];
+    for (int i = 0; i < 3; ++i) {
+        found[i].reset(globalMediumId);
+        Ray r;
+        r.org = p;
+        r.dir = dirs[i];
+        for (int guard = 0; guard < 100000; ++guard) {
+            Hit h;
+            if (!intersect(r, &h)) break;
+            if (shapes[h.shapeId].isMediumBoundary) {
+                // Leaving the shape along dirs[i]: p is inside it.
+                const ShapeInfo& s = shapes[h.shapeId];
+                const bool inside = dot(dirs[i], h.geoNormal) > 0.0f;
+                found[i].setOnly(int32_t(h.shapeId),
+                                 inside ? s.interiorMediumId : s.exteriorMediumId);
+                break;
+            }
+            r = spawnRay(h, dirs[i]);
+        }
+    }
+    if (found[1].mediumId() == found[2].mediumId() && found[0].mediumId() != found[1].mediumId())
+        return found[1];
+    return found[0];
 }
 
 namespace {

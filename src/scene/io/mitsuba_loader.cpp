@@ -353,19 +353,17 @@ void Builder::readShape(const XmlObject& o) {
             }
         }
     }
-    int interiorId = -1;
+    // Media on both sides (Mitsuba's rule: entering gives the interior, leaving the exterior;
+    // an absent one is vacuum). Either makes the shape a medium boundary.
+    int interiorId = -1, exteriorId = -1;
     const XmlObject* interior = r_.child(o, "medium", "interior");
     if (interior) interiorId = mediumId(*interior);
-    if (const XmlObject* ext = r_.child(o, "medium", "exterior")) {
-        const XmlPos refPos = r_.lastChildPos();
-        mediumId(*ext);
-        r_.error(refPos, o.label() + ": exterior media are not supported: unibeam derives the "
-                                       "medium outside a shape from the boundaries around it "
-                                       "(docs/mitsuba.md, medium tracking)");
-    }
+    const XmlObject* exterior = r_.child(o, "medium", "exterior");
+    if (exterior) exteriorId = mediumId(*exterior);
+    const bool boundary = interior || exterior;
     r_.checkUnused(o);
     if (r_.errorCount() != before) return;
-    if (materialId == -1 && !em && !interior) {
+    if (materialId == -1 && !em && !boundary) {
         r_.warning(o.pos, o.label() + " '" + name + "' has a null BSDF and no medium: it is "
                                                     "invisible and is left out");
         return;
@@ -385,7 +383,10 @@ void Builder::readShape(const XmlObject& o) {
     const uint32_t shapeId =
         isSphere ? b_.scene.addSphere(center, radius, materialId, lightId, name)
                  : b_.scene.addMesh(std::move(mesh), materialId, lightId, name);
-    if (interior) b_.scene.setMediumBoundary(shapeId, interiorId, 0, imaginary);
+    if (boundary) {
+        b_.scene.setMediumBoundary(shapeId, interiorId, 0, imaginary);
+        b_.scene.setExteriorMedium(shapeId, exteriorId);
+    }
 }
 
 void Builder::readEmitter(const XmlObject& o) {
@@ -471,6 +472,10 @@ std::unique_ptr<Scene> buildFromXml(const XmlScene& xml, Diagnostics& diags,
     diags.throwIfErrors();
     auto scene = std::make_unique<Scene>();
     scene->sourceFile = xml.file;
+    // Mitsuba 3's volpath semantics (docs/mitsuba.md): a crossed shape sets the medium, and
+    // null-lobe events do not count towards max_depth.
+    scene->settings.mediumTransitions = MediumTransitions::kShapeSides;
+    scene->settings.depthCounting = DepthCounting::kNonNullVertices;
     XmlReader reader(diags);
     MitsubaBuild b{reader, xml, *scene, {}, {}, {}, false};
     Builder(b).build();
