@@ -12,8 +12,10 @@
 #include "core/error.h"
 #include "core/ztest.h"
 #include "scene/vol_grid.h"
+#include "tests/support/vol_file.h"
 
 using namespace ub;
+using ub::test::volBytes;
 namespace fs = std::filesystem;
 
 namespace {
@@ -156,22 +158,6 @@ TEST(ZTest, RejectsMismatchedSizesAndBadValues) {
 }
 
 namespace {
-
-std::string volBytes(int nx, int ny, int nz, int channels, const std::vector<float>& data,
-                     uint8_t version = 3, int32_t encoding = 1) {
-    std::string s = "VOL";
-    s += char(version);
-    auto i32 = [&](int32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); };
-    auto f32 = [&](float v) { s.append(reinterpret_cast<const char*>(&v), 4); };
-    i32(encoding);
-    i32(nx);
-    i32(ny);
-    i32(nz);
-    i32(channels);
-    for (float v : {0.f, 0.f, 0.f, 1.f, 1.f, 1.f}) f32(v);
-    for (float v : data) f32(v);
-    return s;
-}
 
 std::string writeVol(const std::string& name, const std::string& bytes) {
     fs::path p = fs::temp_directory_path() / ("unibeam_vol_test_" + name + ".vol");

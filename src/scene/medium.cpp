@@ -1,6 +1,7 @@
 // Regular tracking through homogeneous and NanoVDB grid media (see medium.h).
 #include "scene/medium.h"
 
+#include "scene/albedo_grid.h"
 #include "scene/medium_trilinear.h"
 
 #include <algorithm>
@@ -194,7 +195,7 @@ MediumCoefficients mediumCoefficientsAt(const Medium& m, const Vec3& p) {
     if (m.type == MediumType::kGrid && m.filter == GridFilter::kTrilinear) {
         const float sigmaT = m.densityScale * trilinearDensityAt(m, p);
         c.sigmaT = Rgb(sigmaT);
-        c.sigmaS = m.albedo * sigmaT;
+        c.sigmaS = mediumAlbedoAt(m, p) * sigmaT;
         c.sigmaA = c.sigmaT - c.sigmaS;
         c.Le = Rgb(0.0f);
         return c;
@@ -213,7 +214,7 @@ MediumCoefficients mediumCoefficientsAt(const Medium& m, const Vec3& p) {
         bb.isInside(ijk) ? m.grid->grid().getAccessor().getValue(ijk) : m.grid->background();
     const float sigmaT = m.densityScale * density;
     c.sigmaT = Rgb(sigmaT);
-    c.sigmaS = m.albedo * sigmaT;
+    c.sigmaS = mediumAlbedoAt(m, p) * sigmaT;
     c.sigmaA = c.sigmaT - c.sigmaS;
     c.Le = Rgb(0.0f);
     return c;
@@ -251,6 +252,8 @@ MediumSegment evalMediumSegment(const Medium& m, const Vec3& origin, const Vec3&
         MediumCoefficients c = mediumCoefficientsAt(m, origin);
         seg.sigmaT0 = seg.sigmaT1 = c.sigmaT;
         seg.sigmaS1 = c.sigmaS;
+    } else if (m.albedoGrid) {  // the pieces carry the constant albedo: use the grid's at x1
+        seg.sigmaS1 = albedoGridAt(*m.albedoGrid, origin + dir * length) * seg.sigmaT1;
     }
     seg.transmittance = expNeg(tau);
     return seg;
@@ -286,13 +289,15 @@ FreeFlightSample sampleFreeFlight(const Medium& m, const Vec3& origin, const Vec
                      tau += sigmaT * len;
                      return true;
                  });
+    if (!s.scattered) s.t = tMax;
     if (first) {
         MediumCoefficients co = mediumCoefficientsAt(m, origin);
         seg.sigmaT0 = seg.sigmaT1 = co.sigmaT;
         seg.sigmaS1 = co.sigmaS;
+    } else if (m.albedoGrid) {  // sigma_s at the collision (or the end): the grid's albedo
+        seg.sigmaS1 = albedoGridAt(*m.albedoGrid, origin + dir * s.t) * seg.sigmaT1;
     }
     seg.transmittance = expNeg(tau);
-    if (!s.scattered) s.t = tMax;
     seg.length = s.t;
     s.pdf = s.scattered ? seg.pdfScatterFwdL() : seg.probPass();
     if (s.pdf > 0.0f)

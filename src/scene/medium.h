@@ -4,8 +4,12 @@
 // Coefficients are per unit world length, RGB. sigma_t = sigma_a + sigma_s.
 //  * Homogeneous: sigma_a, sigma_s, optional emitted radiance Le (the source
 //    term of the RTE is sigma_a * Le, as in pbrt-v4), HG g.
-//  * Grid: sigma_t(x) = densityScale * density(x) (grey), sigma_s = albedo *
-//    sigma_t, HG g, no emission. density(x) is piecewise constant per voxel
+//  * Grid: sigma_t(x) = densityScale * density(x) (grey), sigma_s(x) =
+//    albedo(x) * sigma_t(x), HG g, no emission. albedo(x) is the constant RGB
+//    `albedo`, or an optional albedo grid (scene/albedo_grid.h, Mitsuba's
+//    heterogeneous medium with a volume albedo) looked up only where a collision
+//    is made (mediumAlbedoAt below): tracking, transmittance and every distance
+//    pdf depend on sigma_t alone. density(x) is piecewise constant per voxel
 //    (see scene/vdb_grid.h for the cell convention); the grid's own transform
 //    maps index to grid-local space and `localToWorld` places it in the scene.
 //
@@ -49,6 +53,10 @@
 
 namespace ub {
 
+struct AlbedoGrid;
+/// Albedo of an albedo grid at world point p (scene/albedo_grid.cpp).
+Rgb albedoGridAt(const AlbedoGrid& a, const Vec3& p);
+
 enum class MediumType : uint32_t {
     kHomogeneous = 0,
     kGrid = 1,
@@ -89,6 +97,8 @@ struct Medium {
     std::shared_ptr<const VdbGrid> grid;
     float densityScale = 1.0f;  ///< sigma_t = densityScale * density
     Rgb albedo{1.0f};           ///< sigma_s / sigma_t, each channel in [0, 1]
+    /// Spatially varying albedo replacing `albedo` where set (null: the constant albedo).
+    std::shared_ptr<const AlbedoGrid> albedoGrid;
     Transform localToWorld;     ///< grid-local space -> world
     // Derived by heterogeneous(); do not set by hand.
     Transform worldToCell;  ///< world -> cell space (index space + 1/2: voxel v covers [v, v+1))
@@ -112,6 +122,12 @@ struct Medium {
 
     bool hasEmission() const { return !isBlack(Le) && !isBlack(sigmaA); }
 };
+
+/// Single-scattering albedo of a grid medium at world point p: the albedo grid's value, else
+/// the constant albedo (one branch, so media without an albedo grid pay nothing).
+inline Rgb mediumAlbedoAt(const Medium& m, const Vec3& p) {
+    return m.albedoGrid ? albedoGridAt(*m.albedoGrid, p) : m.albedo;
+}
 
 /// Coefficients at one point (grid: the voxel containing it, background outside).
 struct MediumCoefficients {

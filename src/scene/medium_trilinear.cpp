@@ -1,5 +1,6 @@
 // Exact transmittance and free-flight sampling for trilinear grid density
-// (see scene/medium_trilinear.h for the construction).
+// (see scene/medium_trilinear.h for the construction). The albedo (constant or an
+// albedo grid) is read once, at the end point (scene/albedo_grid.h).
 #include "scene/medium_trilinear.h"
 
 #include <algorithm>
@@ -186,7 +187,7 @@ MediumSegment trilinearSegment(const Medium& m, const Vec3& origin, const Vec3& 
     if (first) d0 = d1 = trilinearDensityAt(m, origin);
     seg.sigmaT0 = Rgb(float(m.densityScale * std::max(0.0, d0)));
     seg.sigmaT1 = Rgb(float(m.densityScale * std::max(0.0, d1)));
-    seg.sigmaS1 = m.albedo * seg.sigmaT1;
+    seg.sigmaS1 = mediumAlbedoAt(m, origin + dir * length) * seg.sigmaT1;
     seg.transmittance = expNeg(Rgb(float(m.densityScale * std::max(0.0, tau))));
     return seg;
 }
@@ -224,7 +225,7 @@ FreeFlightSample trilinearFreeFlight(const Medium& m, const Vec3& origin, const 
     seg.length = s.t;
     seg.sigmaT0 = Rgb(float(scale * std::max(0.0, d0)));
     seg.sigmaT1 = Rgb(float(scale * std::max(0.0, d1)));
-    seg.sigmaS1 = m.albedo * seg.sigmaT1;
+    seg.sigmaS1 = mediumAlbedoAt(m, origin + dir * s.t) * seg.sigmaT1;
     seg.transmittance = expNeg(Rgb(float(std::max(0.0, tau))));
     s.pdf = s.scattered ? seg.pdfScatterFwdL() : seg.probPass();
     if (s.pdf > 0.0f)

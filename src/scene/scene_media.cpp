@@ -153,6 +153,8 @@ std::vector<MediumIssue> Scene::mediumIssues() const {
         if (!(std::fabs(m.g) < 1.0f))
             add(-1, int(i),
                 name + ": the Henyey-Greenstein g must lie in (-1, 1), got " + std::to_string(m.g));
+        if (m.albedoGrid && m.type != MediumType::kGrid)
+            add(-1, int(i), name + ": an albedo grid needs a heterogeneous (grid) medium");
         if (m.type == MediumType::kHomogeneous) {
             if (!finiteNonNegative(m.sigmaA) || !finiteNonNegative(m.sigmaS) ||
                 !finiteNonNegative(m.Le))

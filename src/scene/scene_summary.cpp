@@ -1,5 +1,7 @@
 #include "scene/scene_summary.h"
 
+#include "scene/albedo_grid.h"
+
 #include <cstdio>
 #include <map>
 #include <sstream>
@@ -54,6 +56,12 @@ std::string num(float v) {
     char buf[32];
     std::snprintf(buf, sizeof(buf), "%g", double(v));
     return buf;
+}
+
+std::string albedoGridSummary(const AlbedoGrid& a) {
+    return "grid " + a.label + " (" + std::to_string(a.channelCount) +
+           (a.channelCount == 1 ? " channel, " : " channels, ") +
+           (a.filter == GridFilter::kNearest ? "nearest)" : "trilinear)");
 }
 
 std::string vec(const Vec3& v) {
@@ -150,7 +158,8 @@ std::string describeScene(const Scene& scene) {
                 os << "homogeneous, sigma_a " << vec(m.sigmaA) << ", sigma_s " << vec(m.sigmaS);
             else
                 os << "heterogeneous, grid '" << (m.grid ? m.grid->name() : "")
-                   << "', density scale " << num(m.densityScale) << ", albedo " << vec(m.albedo);
+                   << "', density scale " << num(m.densityScale) << ", albedo "
+                   << (m.albedoGrid ? albedoGridSummary(*m.albedoGrid) : vec(m.albedo));
             os << ", g " << num(m.g) << "\n";
         }
         for (const ShapeInfo& sh : scene.shapes)

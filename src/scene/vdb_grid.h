@@ -57,6 +57,20 @@ public:
     static std::shared_ptr<const VdbGrid> fromDense(const DenseFloatGrid& dense,
                                                     const std::string& gridName,
                                                     const std::string& label = "<dense>");
+    /// Reads grid `gridName` of a VDB file as channels: a float grid gives one, a vec3 float
+    /// grid (openvdb::Vec3SGrid) three float grids (x, y, z) with its transform. Values (of
+    /// voxels, tiles, and the background) must be finite and lie in [0, maxAllowed]; messages
+    /// call them `quantity` ("albedo"). Same errors as load() otherwise.
+    static std::vector<std::shared_ptr<const VdbGrid>> loadChannels(const std::string& path,
+                                                                    const std::string& gridName,
+                                                                    const std::string& quantity,
+                                                                    float maxAllowed);
+    /// fromDense() with the value check of loadChannels().
+    static std::shared_ptr<const VdbGrid> fromDenseChecked(const DenseFloatGrid& dense,
+                                                           const std::string& gridName,
+                                                           const std::string& label,
+                                                           const std::string& quantity,
+                                                           float maxAllowed);
 
     const nanovdb::FloatGrid& grid() const { return *grid_; }
     /// The NanoVDB buffer (for upload to OpenCL devices).
@@ -93,5 +107,15 @@ private:
 /// the file cannot be written.
 void writeDenseFloatVdb(const std::string& path, const std::string& gridName,
                         const DenseFloatGrid& dense);
+
+/// One grid of writeDenseVdb(): 1 channel makes a float grid, 3 a vec3 float grid (the
+/// channels must have equal dimensions; the first gives voxel size and origin).
+struct DenseVdbGrid {
+    std::string name;
+    std::vector<DenseFloatGrid> channels;
+};
+/// Writes several grids to one OpenVDB file (voxels where every channel is 0 stay inactive
+/// background). Throws ub::InputError if the file cannot be written or a grid is malformed.
+void writeDenseVdb(const std::string& path, const std::vector<DenseVdbGrid>& grids);
 
 }  // namespace ub

@@ -1,10 +1,12 @@
 // "media" and medium references of the native JSON scene format
 // (docs/scene-format.md, section media): homogeneous media with RGB
-// coefficients and heterogeneous media whose density comes from a .vdb file.
+// coefficients and heterogeneous media whose density comes from a .vdb file,
+// with a constant albedo or an albedo grid (a float or vec3 grid of a .vdb).
 #include <filesystem>
 #include <map>
 
 #include "scene/io/json_scene_parts.h"
+#include "scene/albedo_grid.h"
 #include "scene/vdb_grid.h"
 
 namespace ub {
@@ -59,15 +61,64 @@ void readHomogeneous(JsonReader& r, const Json& v, const std::string& ptr, Mediu
                   "the medium emits nothing: emission is scaled by sigma_a, which is 0");
 }
 
+/// Loads `gridName` of the VDB `file` (relative to the scene); errors go to filePtr for file
+/// problems and gridPtr for grid problems. load() returns the grids or throws InputError.
+template <typename Load>
+bool loadVdbFile(JsonReader& r, const JsonSceneParts& parts, const std::string& file,
+                 const std::string& filePtr, const std::string& gridPtr, Load&& load) {
+    std::string path = resolveScenePath(parts.baseDir, file);
+    if (fs::path(file).extension() != ".vdb") {
+        r.error(filePtr, "a heterogeneous medium needs a .vdb file, got '" + file + "'");
+    } else if (!fs::is_regular_file(path)) {
+        r.error(filePtr, "VDB file '" + file + "' not found (looked for '" + path +
+                             "'; paths are relative to the scene file)");
+    } else {
+        try {
+            load(path);
+            return true;
+        } catch (const InputError& e) {
+            for (const Diagnostic& d : e.diagnostics()) {
+                const bool gridProblem = d.message.find("no grid of that name") !=
+                                             std::string::npos ||
+                                         d.message.find("grid holds values of type") !=
+                                             std::string::npos;
+                r.error(gridProblem ? gridPtr : filePtr,
+                        "cannot use VDB file '" + file + "': " + d.message);
+            }
+        }
+    }
+    return false;
+}
+
+const std::vector<std::string> kAlbedoFilters = {"nearest", "trilinear"};
+
 void readHeterogeneous(JsonReader& r, const Json& v, const std::string& ptr, JsonSceneParts& parts,
                        Medium& med) {
-    r.checkKeys(v, ptr, {"type", "file", "grid", "density_scale", "albedo", "g", "transform"},
+    r.checkKeys(v, ptr,
+                {"type", "file", "grid", "density_scale", "albedo", "albedo_grid", "albedo_file",
+                 "albedo_filter", "g", "transform"},
                 "heterogeneous medium");
     size_t before = r.errorCount();
     float densityScale =
         r.getNumber(v, ptr, "density_scale", Presence::Optional, NumberRange::nonNegative(), 1.0f);
+    const bool albedoGrid = v.contains("albedo_grid") || v.contains("albedo_file");
+    if (albedoGrid && v.contains("albedo"))
+        r.error(ptr, "give either a constant \"albedo\" or an albedo grid (\"albedo_grid\", "
+                     "\"albedo_file\"), not both");
     Rgb albedo =
         r.getRgb(v, ptr, "albedo", Presence::Optional, NumberRange::closed(0.0, 1.0), Rgb(1.0f));
+    GridFilter albedoFilter = GridFilter::kNearest;
+    if (v.contains("albedo_filter")) {
+        const std::string fPtr = jsonPointerChild(ptr, "albedo_filter");
+        std::string f = r.getString(v, ptr, "albedo_filter", Presence::Optional);
+        if (!albedoGrid)
+            r.error(fPtr, "\"albedo_filter\" needs an albedo grid (\"albedo_grid\")");
+        else if (f == "trilinear")
+            albedoFilter = GridFilter::kTrilinear;
+        else if (f != "nearest" && !f.empty())
+            r.error(fPtr, "unknown albedo filter '" + f + "'" + didYouMean(f, kAlbedoFilters) +
+                              "; valid filters: " + joinNames(kAlbedoFilters));
+    }
     float g = r.getNumber(v, ptr, "g", Presence::Optional, kG, 0.0f);
     Transform toWorld;
     if (const Json* tj = r.member(v, ptr, "transform", Presence::Optional, ""))
@@ -77,27 +128,41 @@ void readHeterogeneous(JsonReader& r, const Json& v, const std::string& ptr, Jso
     std::string file = r.getString(v, ptr, "file", Presence::Required);
     const std::string filePtr = jsonPointerChild(ptr, "file");
     std::shared_ptr<const VdbGrid> grid;
-    if (!file.empty() && !gridName.empty()) {
-        std::string path = resolveScenePath(parts.baseDir, file);
-        if (fs::path(file).extension() != ".vdb") {
-            r.error(filePtr, "a heterogeneous medium needs a .vdb file, got '" + file + "'");
-        } else if (!fs::is_regular_file(path)) {
-            r.error(filePtr, "VDB file '" + file + "' not found (looked for '" + path +
-                                 "'; paths are relative to the scene file)");
-        } else {
-            try {
-                grid = VdbGrid::load(path, gridName);
-            } catch (const InputError& e) {
-                for (const Diagnostic& d : e.diagnostics())
-                    r.error(filePtr, "cannot use VDB file '" + file + "': " + d.message);
-            }
+    if (!file.empty() && !gridName.empty())
+        loadVdbFile(r, parts, file, filePtr,
+                    v.contains("grid") ? jsonPointerChild(ptr, "grid") : filePtr,
+                    [&](const std::string& path) { grid = VdbGrid::load(path, gridName); });
+
+    // Albedo grid: "albedo_grid" (default "albedo") in "albedo_file" (default: "file").
+    std::vector<std::shared_ptr<const VdbGrid>> albedoChannels;
+    std::string albedoFile = file, albedoFilePtr = filePtr, albedoGridName = "albedo";
+    const std::string gridPtr =
+        jsonPointerChild(ptr, v.contains("albedo_grid") ? "albedo_grid" : "albedo_file");
+    if (albedoGrid) {
+        if (v.contains("albedo_grid"))
+            albedoGridName = r.getString(v, ptr, "albedo_grid", Presence::Optional);
+        if (v.contains("albedo_file")) {
+            albedoFile = r.getString(v, ptr, "albedo_file", Presence::Optional);
+            albedoFilePtr = jsonPointerChild(ptr, "albedo_file");
         }
+        if (!albedoFile.empty() && !albedoGridName.empty())
+            loadVdbFile(r, parts, albedoFile, albedoFilePtr, gridPtr,
+                        [&](const std::string& path) {
+                            albedoChannels = loadVdbAlbedoChannels(path, albedoGridName);
+                        });
     }
     if (r.errorCount() != before || !grid) return;
     try {
         med = Medium::heterogeneous(grid, densityScale, albedo, g, toWorld);
+        if (albedoGrid)
+            med.albedoGrid =
+                AlbedoGrid::make(albedoChannels, albedoFilter, toWorld, nullptr, nullptr,
+                                 "'" + albedoFile + "' grid '" + albedoGridName + "'");
     } catch (const std::invalid_argument& e) {
         r.error(ptr, e.what());
+    } catch (const InputError& e) {
+        for (const Diagnostic& d : e.diagnostics())
+            r.error(gridPtr, d.message);
     }
 }
 

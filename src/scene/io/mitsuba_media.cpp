@@ -1,12 +1,14 @@
 // Mitsuba <medium> plugins -> unibeam media (docs/mitsuba.md lists the mapping):
 // homogeneous (sigma_t, albedo, scale) and heterogeneous with a gridvolume
-// (.vol or .vdb) or constvolume extinction, constant albedo, isotropic or HG
-// phase. Mitsuba's gridvolume interpolates trilinearly by default: that maps
+// (.vol or .vdb) or constvolume extinction, a constant albedo or an albedo
+// gridvolume (1 or 3 channels, its own to_world and filter; scene/albedo_grid.h),
+// isotropic or HG phase. Mitsuba's gridvolume interpolates trilinearly by default: that maps
 // onto GridFilter::kTrilinear (exact transmittance, scene/medium_trilinear.h);
 // filter_type="nearest" onto the piecewise-constant default.
 #include <filesystem>
 #include <stdexcept>
 
+#include "scene/albedo_grid.h"
 #include "scene/io/mitsuba_build.h"
 #include "scene/medium.h"
 #include "scene/vol_grid.h"
@@ -38,15 +40,21 @@ bool readConstant(XmlReader& r, const XmlObject& o, const std::string& name, Rgb
     return true;
 }
 
+/// What a gridvolume holds: the extinction (sigma_t, one channel) or the albedo (1 or 3).
+enum class VolumeRole { kSigmaT, kAlbedo };
+
 struct GridVolume {
-    std::shared_ptr<const VdbGrid> grid;
+    std::vector<std::shared_ptr<const VdbGrid>> grids;  ///< one per channel
     Transform localToWorld;
     GridMediumOptions options;
+    bool domainGiven = false;  ///< options.domainLo/Hi hold the full extent of a .vol grid
+    std::string label;         ///< file name as written in the scene, and the grid
 };
 
-bool readGridVolume(MitsubaBuild& b, const XmlObject& v, GridVolume* out) {
+bool readGridVolume(MitsubaBuild& b, const XmlObject& v, VolumeRole role, GridVolume* out) {
     XmlReader& r = b.r;
     const size_t before = r.errorCount();
+    const bool albedo = role == VolumeRole::kAlbedo;
     Transform toWorld = r.getTransform(v, "to_world");
     bool useBbox = r.getBool(v, "use_grid_bbox", false);
     std::string filter = r.getString(v, "filter_type", "trilinear");
@@ -58,7 +66,13 @@ bool readGridVolume(MitsubaBuild& b, const XmlObject& v, GridVolume* out) {
     if (wrap != "clamp")
         r.error(v.find("wrap_mode")->pos, v.label() + ": wrap_mode '" + wrap +
                                               "' is not supported (only clamp, the default)");
-    r.getBool(v, "raw", false);  // only changes colour data; a density grid is read as is
+    // raw only changes colour data in Mitsuba's spectral variants (no spectral upsampling);
+    // the rgb variants, which unibeam follows, use the values as stored either way.
+    r.getBool(v, "raw", false);
+    // unibeam's extension for .vdb files: the grid to read (Mitsuba 3 reads no .vdb).
+    const std::string defaultGrid = albedo ? "albedo" : "density";
+    const bool hasGridName = r.has(v, "grid_name");
+    std::string gridName = r.getString(v, "grid_name", defaultGrid);
     std::string file = r.getString(v, "filename", "");
     r.checkUnused(v);
     if (file.empty()) {
@@ -71,14 +85,24 @@ bool readGridVolume(MitsubaBuild& b, const XmlObject& v, GridVolume* out) {
     std::string ext = std::filesystem::path(path).extension().string();
     try {
         if (ext == ".vol") {
+            if (hasGridName)
+                r.error(v.find("grid_name")->pos,
+                        v.label() + ": grid_name applies to .vdb files only (a .vol file holds "
+                                    "one grid)");
             VolGrid vol = readVolFile(path);
-            if (vol.channels != 1) {
+            if (!albedo && vol.channels != 1) {
                 r.error(fpos, v.label() + ": '" + file + "' has " +
                                   std::to_string(vol.channels) +
                                   " channels; an extinction grid needs 1");
                 return false;
             }
-            out->grid = VdbGrid::fromDense(volChannelToDense(vol, 0), "density", path);
+            out->label = "'" + file + "'";
+            for (int c = 0; c < vol.channels; ++c) {
+                DenseFloatGrid dense = volChannelToDense(vol, c);
+                out->grids.push_back(
+                    albedo ? VdbGrid::fromDenseChecked(dense, "albedo", path, "albedo", 1.0f)
+                           : VdbGrid::fromDense(dense, "density", path));
+            }
             Transform unit = volCellToUnitCube(vol);
             if (useBbox)
                 unit = Transform::translate(vol.bboxMin) *
@@ -91,12 +115,15 @@ bool readGridVolume(MitsubaBuild& b, const XmlObject& v, GridVolume* out) {
                 out->options.domainLo[a] = 0;
                 out->options.domainHi[a] = n[a] - 1;
             }
+            out->domainGiven = true;
         } else if (ext == ".vdb") {
             if (useBbox)
                 r.error(v.find("use_grid_bbox")->pos,
                         v.label() + ": use_grid_bbox does not apply to .vdb files (their own "
                                     "transform places the grid)");
-            out->grid = VdbGrid::load(path, "density");
+            out->label = "'" + file + "' grid '" + gridName + "'";
+            if (albedo) out->grids = loadVdbAlbedoChannels(path, gridName);
+            else out->grids = {VdbGrid::load(path, gridName)};
             out->localToWorld = toWorld;
         } else {
             r.error(fpos, v.label() + ": '" + file + "' is neither a .vol nor a .vdb file");
@@ -118,10 +145,19 @@ bool buildMitsubaMedium(MitsubaBuild& b, const XmlObject& o, Medium* out) {
     r.getBool(o, "sample_emitters", true);  // sampling strategy only
     const float g = readPhase(r, o);
     Rgb albedo(0.75f);
+    const XmlObject* albedoVol = nullptr;  // a gridvolume albedo
+    GridVolume albedoGrid;
     if (!readConstant(r, o, "albedo", Rgb(0.75f), ColorUse::Reflectance, &albedo)) {
         const XmlObject* v = r.child(o, "volume", "albedo");
-        r.error(v->pos, o.label() + ": a spatially varying albedo (" + v->label() +
-                            ") is not supported yet; give a constant <rgb name=\"albedo\">");
+        if (v->type != "gridvolume") {
+            r.unsupportedPlugin(*v, {"gridvolume", "constvolume"});
+        } else if (o.type == "homogeneous") {
+            r.error(v->pos, o.label() + ": a spatially varying albedo (" + v->label() +
+                                ") needs a heterogeneous medium; a homogeneous one takes a "
+                                "constant albedo");
+        } else if (readGridVolume(b, *v, VolumeRole::kAlbedo, &albedoGrid)) {
+            albedoVol = v;
+        }
     }
     if (o.type == "homogeneous") {
         Rgb sigmaT(1.0f);
@@ -149,11 +185,16 @@ bool buildMitsubaMedium(MitsubaBuild& b, const XmlObject& o, Medium* out) {
         ok = readConstant(r, o, "sigma_t", Rgb(1.0f), ColorUse::Unbounded, &constSigmaT);
         vol = nullptr;
     } else if (vol->type == "gridvolume") {
-        ok = readGridVolume(b, *vol, &gv);
+        ok = readGridVolume(b, *vol, VolumeRole::kSigmaT, &gv);
     } else {
         r.unsupportedPlugin(*vol, {"gridvolume", "constvolume"});
         ok = false;
     }
+    if (albedoVol && !vol && ok)
+        r.error(albedoVol->pos,
+                o.label() + ": a spatially varying albedo (" + albedoVol->label() +
+                    ") needs sigma_t as a gridvolume; with a constant sigma_t give a constant "
+                    "albedo");
     r.checkUnused(o);
     if (!ok || r.errorCount() != before) return false;
     try {
@@ -161,10 +202,22 @@ bool buildMitsubaMedium(MitsubaBuild& b, const XmlObject& o, Medium* out) {
             const Rgb st = constSigmaT * scale, ss = albedo * st;
             *out = Medium::homogeneous(vmax(st - ss, Rgb(0.0f)), ss, g);
         } else {
-            *out = Medium::heterogeneous(gv.grid, scale, albedo, g, gv.localToWorld, gv.options);
+            *out = Medium::heterogeneous(gv.grids[0], scale, albedo, g, gv.localToWorld,
+                                         gv.options);
+        }
+        if (albedoVol) {
+            const GridMediumOptions& ao = albedoGrid.options;
+            out->albedoGrid = AlbedoGrid::make(
+                albedoGrid.grids, ao.filter, albedoGrid.localToWorld,
+                albedoGrid.domainGiven ? ao.domainLo : nullptr,
+                albedoGrid.domainGiven ? ao.domainHi : nullptr, albedoGrid.label);
         }
     } catch (const std::invalid_argument& e) {
         r.error(o.pos, o.label() + ": " + e.what());
+        return false;
+    } catch (const InputError& e) {
+        for (const Diagnostic& d : e.diagnostics())
+            r.error(albedoVol ? albedoVol->pos : o.pos, o.label() + ": " + d.message);
         return false;
     }
     return true;

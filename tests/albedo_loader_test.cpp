@@ -1,0 +1,379 @@
+// Albedo grids in the scene formats (docs/mitsuba.md, docs/scene-format.md):
+//  * Mitsuba: <volume name="albedo" type="gridvolume"> in a heterogeneous medium (.vol with
+//    1 or 3 channels, .vdb float or vec3 grids chosen by grid_name), with its own to_world
+//    and filter_type; the sigma_t gridvolume reads a named .vdb grid; errors name
+//    file:line:col;
+//  * JSON: "albedo_grid", "albedo_file", "albedo_filter" of heterogeneous media and their
+//    errors at the JSON pointer of the key.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "core/error.h"
+#include "scene/albedo_grid.h"
+#include "scene/io/json_loader.h"
+#include "scene/io/mitsuba_loader.h"
+#include "scene/scene.h"
+#include "scene/vdb_grid.h"
+#include "scene/vol_grid.h"
+#include "tests/support/vol_file.h"
+
+using namespace ub;
+using namespace ub::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+bool contains(const std::string& s, const std::string& part) {
+    return s.find(part) != std::string::npos;
+}
+
+/// Scratch folder (removed at the end of the test).
+struct ScratchDir {
+    fs::path path;
+    ScratchDir() {
+        path = fs::temp_directory_path() /
+               ("unibeam_albedo_loader_" +
+                std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        fs::create_directories(path);
+    }
+    ~ScratchDir() {
+        std::error_code ec;
+        fs::remove_all(path, ec);
+    }
+    std::string operator/(const std::string& name) const { return (path / name).string(); }
+};
+
+const char* kSensor = R"(<sensor type="perspective">
+  <float name="fov" value="40"/>
+  <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+  <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film>
+</sensor>
+<emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+)";
+
+/// A Mitsuba scene whose medium "m" (given in full) fills a null-BSDF cube.
+std::string xmlScene(const std::string& medium) {
+    return std::string("<scene version=\"3.0.0\">\n") + kSensor + medium +
+           "\n<shape type=\"cube\"><bsdf type=\"null\"/><ref id=\"m\" name=\"interior\"/></shape>\n"
+           "</scene>\n";
+}
+
+std::unique_ptr<Scene> loadXml(const std::string& text, const std::string& dir) {
+    return loadMitsubaSceneFromString(text, "scene.xml", dir, {});
+}
+
+std::string xmlErrors(const std::string& text, const std::string& dir) {
+    try {
+        loadXml(text, dir);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+/// "scene.xml:LINE:COL" of the first occurrence of `what` in text (1-based, as the loader).
+std::string where(const std::string& text, const std::string& what) {
+    size_t at = text.find(what);
+    if (at == std::string::npos) return "<not in the text>";
+    int line = 1;
+    size_t lineStart = 0;
+    for (size_t i = 0; i < at; ++i)
+        if (text[i] == '\n') ++line, lineStart = i + 1;
+    return "scene.xml:" + std::to_string(line) + ":" + std::to_string(at - lineStart + 1);
+}
+
+std::string gridVolume(const std::string& name, const std::string& file,
+                       const std::string& extra = "") {
+    return "<volume name=\"" + name + "\" type=\"gridvolume\"><string name=\"filename\" value=\"" +
+           file + "\"/>" + extra + "</volume>";
+}
+
+std::string heterogeneous(const std::string& sigmaT, const std::string& albedo) {
+    return "<medium id=\"m\" type=\"heterogeneous\">" + sigmaT + albedo + "</medium>";
+}
+
+/// 2x2x2 density 1 and a 2x1x1 RGB albedo: voxel 0 (0.1, 0.2, 0.3), voxel 1 (0.7, 0.8, 0.9).
+void writeVolFiles(const ScratchDir& dir) {
+    writeBinaryFile(dir / "sigma.vol", volBytes(2, 2, 2, 1, std::vector<float>(8, 1.0f)));
+    writeBinaryFile(dir / "albedo.vol", volBytes(2, 1, 1, 3, {0.1f, 0.2f, 0.3f, 0.7f, 0.8f, 0.9f}));
+    writeBinaryFile(dir / "grey.vol", volBytes(2, 1, 1, 1, {0.25f, 0.75f}));
+    writeBinaryFile(dir / "hot.vol", volBytes(2, 1, 1, 1, {0.25f, 1.5f}));
+    writeBinaryFile(dir / "rgb_sigma.vol", volBytes(1, 1, 1, 3, {1.0f, 1.0f, 1.0f}));
+}
+
+void expectRgbNear(const Rgb& a, const Rgb& b, const char* what) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 1e-5f) << what << " channel " << c;
+}
+
+}  // namespace
+
+TEST(MitsubaAlbedo, VolAlbedoGridHasItsOwnTransformAndFilter) {
+    ScratchDir dir;
+    writeVolFiles(dir);
+    const std::string toWorld =
+        "<transform name=\"to_world\"><translate x=\"-0.5\" y=\"-0.5\" z=\"-0.5\"/></transform>";
+    // Default filter (trilinear): the unit cube moved to [-0.5, 0.5]^3; voxel centres at
+    // x = -0.25 and 0.25, linear in between, clamped beyond.
+    auto s = loadXml(xmlScene(heterogeneous(gridVolume("sigma_t", "sigma.vol"),
+                                            gridVolume("albedo", "albedo.vol", toWorld))),
+                     dir.path.string());
+    ASSERT_EQ(s->media.size(), 1u);
+    const Medium& m = s->media[0];
+    ASSERT_TRUE(m.albedoGrid);
+    EXPECT_EQ(m.albedoGrid->channelCount, 3);
+    EXPECT_EQ(m.albedoGrid->filter, GridFilter::kTrilinear);
+    expectRgbNear(albedoGridAt(*m.albedoGrid, Vec3(-0.25f, 0.1f, 0.0f)), Rgb(0.1f, 0.2f, 0.3f),
+                  "voxel 0 centre");
+    expectRgbNear(albedoGridAt(*m.albedoGrid, Vec3(0.0f, 0.0f, 0.3f)), Rgb(0.4f, 0.5f, 0.6f),
+                  "half-way");
+    expectRgbNear(albedoGridAt(*m.albedoGrid, Vec3(0.45f, -0.4f, 0.0f)), Rgb(0.7f, 0.8f, 0.9f),
+                  "beyond voxel 1 centre (clamped)");
+    // sigma_s = albedo * sigma_t at a point.
+    const MediumCoefficients c = mediumCoefficientsAt(m, Vec3(0.25f, 0.5f, 0.5f));
+    EXPECT_NEAR(c.sigmaS.y, 0.8f * c.sigmaT.y, 1e-5f);
+
+    // filter_type="nearest", a grey grid, no to_world (the unit cube).
+    s = loadXml(
+        xmlScene(heterogeneous(
+            gridVolume("sigma_t", "sigma.vol"),
+            gridVolume("albedo", "grey.vol", "<string name=\"filter_type\" value=\"nearest\"/>"))),
+        dir.path.string());
+    const AlbedoGrid& a = *s->media[0].albedoGrid;
+    EXPECT_EQ(a.channelCount, 1);
+    EXPECT_EQ(a.filter, GridFilter::kNearest);
+    expectRgbNear(albedoGridAt(a, Vec3(0.49f, 0.5f, 0.5f)), Rgb(0.25f), "nearest voxel 0");
+    expectRgbNear(albedoGridAt(a, Vec3(0.51f, 0.5f, 0.5f)), Rgb(0.75f), "nearest voxel 1");
+}
+
+TEST(MitsubaAlbedo, SharedTestAlbedoVolMatchesTheFile) {
+    // The RGB albedo.vol of Mitsuba's participating-media tests (16^3 x 3): at voxel centres
+    // the trilinear lookup returns the stored values.
+    const std::string dir =
+        std::string(UNIBEAM_SHARED_DIR) + "/scenes/mitsuba/tests/scenes/participating_media";
+    if (!fs::is_directory(dir)) GTEST_SKIP() << "shared scenes not present";
+    auto s = loadXml(xmlScene(heterogeneous(gridVolume("sigma_t", "textures/sigmat.vol"),
+                                            gridVolume("albedo", "textures/albedo.vol"))),
+                     dir);
+    const AlbedoGrid& a = *s->media[0].albedoGrid;
+    VolGrid vol = readVolFile(dir + "/textures/albedo.vol");
+    ASSERT_EQ(vol.channels, 3);
+    for (int k : {0, 5, 15})
+        for (int j : {0, 7, 15})
+            for (int i : {0, 3, 15}) {
+                const Vec3 p((i + 0.5f) / 16.0f, (j + 0.5f) / 16.0f, (k + 0.5f) / 16.0f);
+                expectRgbNear(albedoGridAt(a, p),
+                              Rgb(vol.at(i, j, k, 0), vol.at(i, j, k, 1), vol.at(i, j, k, 2)),
+                              "voxel centre");
+            }
+}
+
+TEST(MitsubaAlbedo, VdbGridNamesForSigmaTAndAlbedo) {
+    ScratchDir dir;
+    DenseFloatGrid one(2, 2, 2, 1.0f), half(2, 2, 2, 0.5f), quarter(2, 2, 2, 0.25f);
+    writeDenseVdb(dir / "media.vdb", {{"density", {half}},
+                                      {"sigma", {one}},
+                                      {"albedo", {half, quarter, one}},
+                                      {"tint", {quarter}}});
+    // Defaults: grid_name "density" for sigma_t, "albedo" for the albedo.
+    auto s = loadXml(xmlScene(heterogeneous(gridVolume("sigma_t", "media.vdb"),
+                                            gridVolume("albedo", "media.vdb"))),
+                     dir.path.string());
+    const Medium& m = s->media[0];
+    EXPECT_EQ(m.grid->name(), "density");
+    ASSERT_TRUE(m.albedoGrid);
+    EXPECT_EQ(m.albedoGrid->channelCount, 3);
+    expectRgbNear(albedoGridAt(*m.albedoGrid, Vec3(0.5f)), Rgb(0.5f, 0.25f, 1.0f), "vec3 grid");
+    // Named grids.
+    const std::string named = "<string name=\"grid_name\" value=\"";
+    s = loadXml(xmlScene(heterogeneous(gridVolume("sigma_t", "media.vdb", named + "sigma\"/>"),
+                                       gridVolume("albedo", "media.vdb", named + "tint\"/>"))),
+                dir.path.string());
+    EXPECT_EQ(s->media[0].grid->name(), "sigma");
+    EXPECT_EQ(s->media[0].albedoGrid->channelCount, 1);
+    expectRgbNear(albedoGridAt(*s->media[0].albedoGrid, Vec3(0.5f)), Rgb(0.25f), "float grid");
+
+    // A missing grid names the grids present, at the filename of the volume.
+    std::string text =
+        xmlScene(heterogeneous(gridVolume("sigma_t", "media.vdb", named + "smoke\"/>"), ""));
+    std::string e = xmlErrors(text, dir.path.string());
+    EXPECT_TRUE(contains(
+        e, where(text, "<string name=\"filename\"") + ": error: <volume type=\"gridvolume\">"))
+        << e;
+    EXPECT_TRUE(contains(e,
+                         "cannot load grid 'smoke': no grid of that name in the file; grids "
+                         "present: 'albedo' (vec3s), 'density' (float), 'sigma' (float), "
+                         "'tint' (float)"))
+        << e;
+    // sigma_t needs a float grid.
+    e = xmlErrors(
+        xmlScene(heterogeneous(gridVolume("sigma_t", "media.vdb", named + "albedo\"/>"), "")),
+        dir.path.string());
+    EXPECT_TRUE(contains(e, "expected a float (density) grid")) << e;
+}
+
+TEST(MitsubaAlbedo, UnsupportedAlbedoVolumesAreErrorsWithPositions) {
+    ScratchDir dir;
+    writeVolFiles(dir);
+    const std::string sigma = gridVolume("sigma_t", "sigma.vol");
+    // Bad filter value.
+    std::string text = xmlScene(heterogeneous(
+        sigma,
+        gridVolume("albedo", "albedo.vol", "<string name=\"filter_type\" value=\"cubic\"/>")));
+    std::string e = xmlErrors(text, dir.path.string());
+    EXPECT_TRUE(contains(e, where(text, "<string name=\"filter_type\"") +
+                                ": error: <volume type=\"gridvolume\">: filter_type 'cubic' is "
+                                "not one of trilinear, nearest"))
+        << e;
+    // An extinction grid with 3 channels.
+    text = xmlScene(heterogeneous(gridVolume("sigma_t", "rgb_sigma.vol"), ""));
+    e = xmlErrors(text, dir.path.string());
+    EXPECT_TRUE(contains(e, where(text, "<string name=\"filename\"") +
+                                ": error: <volume type=\"gridvolume\">: 'rgb_sigma.vol' has 3 "
+                                "channels; an extinction grid needs 1"))
+        << e;
+    // Albedo values above 1.
+    text = xmlScene(heterogeneous(sigma, gridVolume("albedo", "hot.vol")));
+    e = xmlErrors(text, dir.path.string());
+    EXPECT_TRUE(contains(e, "grid 'albedo' has an albedo 1.5 at voxel (1, 0, 0)")) << e;
+    EXPECT_TRUE(contains(e, "hot.vol")) << e;
+    // grid_name on a .vol file.
+    text = xmlScene(heterogeneous(
+        sigma, gridVolume("albedo", "albedo.vol", "<string name=\"grid_name\" value=\"x\"/>")));
+    e = xmlErrors(text, dir.path.string());
+    EXPECT_TRUE(contains(e, where(text, "<string name=\"grid_name\"") +
+                                ": error: <volume type=\"gridvolume\">: grid_name applies to .vdb "
+                                "files only"))
+        << e;
+    // An albedo volume in a homogeneous medium, or with a constant sigma_t.
+    text = xmlScene("<medium id=\"m\" type=\"homogeneous\">" + gridVolume("albedo", "albedo.vol") +
+                    "</medium>");
+    e = xmlErrors(text, dir.path.string());
+    EXPECT_TRUE(contains(e, where(text, "<volume name=\"albedo\"") +
+                                ": error: <medium type=\"homogeneous\">: a spatially varying "
+                                "albedo (<volume type=\"gridvolume\">) needs a heterogeneous "
+                                "medium"))
+        << e;
+    text = xmlScene(
+        heterogeneous("<float name=\"sigma_t\" value=\"2\"/>", gridVolume("albedo", "albedo.vol")));
+    e = xmlErrors(text, dir.path.string());
+    EXPECT_TRUE(contains(e, "needs sigma_t as a gridvolume")) << e;
+    // An unknown volume plugin lists the supported ones.
+    text = xmlScene(heterogeneous(sigma, "<volume name=\"albedo\" type=\"noise\"/>"));
+    e = xmlErrors(text, dir.path.string());
+    EXPECT_TRUE(contains(e, where(text, "<volume name=\"albedo\"") +
+                                ": error: unsupported volume plugin 'noise' (supported: "
+                                "gridvolume, constvolume)"))
+        << e;
+    // A constvolume albedo stays a constant.
+    auto s = loadXml(
+        xmlScene(heterogeneous(sigma,
+                               "<volume name=\"albedo\" type=\"constvolume\"><rgb name=\"value\" "
+                               "value=\"0.2, 0.4, 0.6\"/></volume>")),
+        dir.path.string());
+    EXPECT_FALSE(s->media[0].albedoGrid);
+    expectRgbNear(s->media[0].albedo, Rgb(0.2f, 0.4f, 0.6f), "constvolume");
+}
+
+// ---- JSON -------------------------------------------------------------------------------
+
+namespace {
+
+std::string jsonScene(const std::string& medium) {
+    return R"({"camera": {"position": [0, 0, 5], "target": [0, 0, 0], "resolution": [16, 16]},
+"media": {"smoke": )" +
+           medium + R"(},
+"shapes": [{"type": "cube", "interior_medium": "smoke", "imaginary": true}],
+"lights": [{"type": "point", "position": [0, 2.5, 0], "intensity": 1}]})";
+}
+
+std::string jsonErrors(const std::string& text, const std::string& dir) {
+    std::string all;
+    try {
+        loadJsonSceneFromString(text, "scene.json", dir);
+    } catch (const InputError& e) {
+        for (const auto& d : e.diagnostics()) all += d.format() + "\n";
+    }
+    return all;
+}
+
+void writeJsonVdbs(const ScratchDir& dir) {
+    DenseFloatGrid one(2, 2, 2, 1.0f), half(2, 2, 2, 0.5f), quarter(2, 2, 2, 0.25f),
+        hot(2, 2, 2, 0.5f);
+    hot.at(0, 1, 1) = 3.0f;
+    writeDenseVdb(dir / "smoke.vdb", {{"density", {one}},
+                                      {"albedo", {half, quarter, one}},
+                                      {"grey", {quarter}},
+                                      {"hot", {hot}}});
+    writeDenseVdb(dir / "other.vdb", {{"albedo", {quarter}}});
+}
+
+}  // namespace
+
+TEST(JsonAlbedo, AlbedoGridKeysLoad) {
+    ScratchDir dir;
+    writeJsonVdbs(dir);
+    const std::string base = dir.path.string();
+    // In the density's file, nearest by default.
+    auto s = loadJsonSceneFromString(
+        jsonScene(R"({"type": "heterogeneous", "file": "smoke.vdb", "albedo_grid": "albedo"})"),
+        "scene.json", base);
+    const Medium& m = s->media[0];
+    ASSERT_TRUE(m.albedoGrid);
+    EXPECT_EQ(m.albedoGrid->channelCount, 3);
+    EXPECT_EQ(m.albedoGrid->filter, GridFilter::kNearest);
+    expectRgbNear(albedoGridAt(*m.albedoGrid, Vec3(1.0f, 0.0f, 1.0f)), Rgb(0.5f, 0.25f, 1.0f),
+                  "vec3");
+    // A grey grid, trilinear; the medium's transform moves both grids.
+    s = loadJsonSceneFromString(
+        jsonScene(R"({"type": "heterogeneous", "file": "smoke.vdb", "albedo_grid": "grey",
+                      "albedo_filter": "trilinear", "transform": {"translate": [5, 0, 0]}})"),
+        "scene.json", base);
+    EXPECT_EQ(s->media[0].albedoGrid->channelCount, 1);
+    EXPECT_EQ(s->media[0].albedoGrid->filter, GridFilter::kTrilinear);
+    expectRgbNear(albedoGridAt(*s->media[0].albedoGrid, Vec3(5.5f, 0.5f, 0.5f)), Rgb(0.25f),
+                  "grey");
+    // Another file, default grid name "albedo".
+    s = loadJsonSceneFromString(
+        jsonScene(R"({"type": "heterogeneous", "file": "smoke.vdb", "albedo_file": "other.vdb"})"),
+        "scene.json", base);
+    EXPECT_EQ(s->media[0].albedoGrid->channelCount, 1);
+    expectRgbNear(albedoGridAt(*s->media[0].albedoGrid, Vec3(0.0f)), Rgb(0.25f), "other file");
+}
+
+TEST(JsonAlbedo, AlbedoGridErrorsNameTheKey) {
+    ScratchDir dir;
+    writeJsonVdbs(dir);
+    const std::string base = dir.path.string();
+    auto err = [&](const std::string& medium) { return jsonErrors(jsonScene(medium), base); };
+    std::string e = err(R"({"type": "heterogeneous", "file": "smoke.vdb", "albedo": 0.5,
+                            "albedo_grid": "albedo"})");
+    EXPECT_TRUE(contains(e, "at /media/smoke: give either a constant \"albedo\" or an albedo grid"))
+        << e;
+    e = err(R"({"type": "heterogeneous", "file": "smoke.vdb", "albedo_filter": "nearest"})");
+    EXPECT_TRUE(contains(e,
+                         "at /media/smoke/albedo_filter: \"albedo_filter\" needs an albedo "
+                         "grid"))
+        << e;
+    e = err(R"({"type": "heterogeneous", "file": "smoke.vdb", "albedo_grid": "albedo",
+                "albedo_filter": "trilinar"})");
+    EXPECT_TRUE(contains(e, "at /media/smoke/albedo_filter: unknown albedo filter 'trilinar'"))
+        << e;
+    EXPECT_TRUE(contains(e, "valid filters: nearest, trilinear")) << e;
+    e = err(R"({"type": "heterogeneous", "file": "smoke.vdb", "albedo_grid": "colour"})");
+    EXPECT_TRUE(contains(e,
+                         "at /media/smoke/albedo_grid: cannot use VDB file 'smoke.vdb': "
+                         "cannot load grid 'colour': no grid of that name in the file; grids "
+                         "present: 'albedo' (vec3s), 'density' (float), 'grey' (float), "
+                         "'hot' (float)"))
+        << e;
+    e = err(R"({"type": "heterogeneous", "file": "smoke.vdb", "albedo_grid": "hot"})");
+    EXPECT_TRUE(contains(e, "grid 'hot' has an albedo 3 at voxel (0, 1, 1)")) << e;
+    e = err(R"({"type": "heterogeneous", "file": "smoke.vdb", "albedo_file": "missing.vdb"})");
+    EXPECT_TRUE(contains(e, "at /media/smoke/albedo_file: VDB file 'missing.vdb' not found")) << e;
+    e = err(R"({"type": "heterogeneous", "file": "smoke.vdb", "albedo_grid": 3})");
+    EXPECT_TRUE(contains(e, "/media/smoke/albedo_grid")) << e;
+}
