@@ -9,7 +9,6 @@
 //    (block z-tests, vpt and vbpt);
 //  * validation messages of albedo grids and .vdb albedo channels.
 #include "scene/albedo_grid.h"
-#include "scene/io/mitsuba_loader.h"
 
 #include <gtest/gtest.h>
 #include <openvdb/io/File.h>
@@ -22,6 +21,7 @@
 
 #include "core/error.h"
 #include "render/integrator.h"
+#include "scene/io/mitsuba_loader.h"
 #include "scene/medium.h"
 #include "scene/scene.h"
 #include "scene/shapes.h"
@@ -292,8 +292,8 @@ TEST(AlbedoGrid, TwoHalvesMatchTwoHomogeneousMedia) {
 // 24x24 pixels, blocks of 4x4: 108 z-tests, Sidak family-wise level 1e-3 (|z| < 4.4), image
 // means |z| < 3.9 per channel (bounds and standard errors as TwoHalvesMatchTwoHomogeneousMedia).
 TEST(AlbedoGrid, MitsubaAlbedoVolSceneVbptAgreesWithVpt) {
-    const std::string dir = std::string(UNIBEAM_SHARED_DIR) +
-                            "/scenes/mitsuba/tests/scenes/participating_media";
+    const std::string dir =
+        std::string(UNIBEAM_SHARED_DIR) + "/scenes/mitsuba/tests/scenes/participating_media";
     if (!fs::is_directory(dir)) GTEST_SKIP() << "shared scenes not present";
     const std::string toWorld = R"(<transform name="to_world">
         <scale x="1.5" y="1.5" z="1.5"/><translate x="-0.75" y="-0.75" z="-0.75"/></transform>)";
