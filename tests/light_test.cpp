@@ -60,7 +60,7 @@ Light sphereLight(const Vec3& c, float r) {
 
 /// 64x32 lat-long map: a smooth gradient in u and v plus a 3x3-pixel spot 40x brighter,
 /// rotated so the map's +y axis is not a world axis.
-Light envMapLight(bool rotated = true) {
+Light envMapLight(bool rotated = true, EnvFilter filter = EnvFilter::Nearest) {
     auto img = std::make_shared<Image>(64, 32);
     for (int y = 0; y < img->height; ++y)
         for (int x = 0; x < img->width; ++x) {
@@ -74,6 +74,7 @@ Light envMapLight(bool rotated = true) {
     l.name = "sky";
     l.radiance = Rgb(1.0f, 1.2f, 0.9f);
     l.envMap = img;
+    l.envFilter = filter;
     if (rotated) l.envToWorld = Transform::rotate(35.0f, Vec3(1.0f, 0.3f, -0.2f));
     l.prepare();
     return l;
@@ -391,6 +392,8 @@ TEST(Light, AreaPdfsMatchRadianceAlong) {
 TEST(Light, EnvironmentPdfsMatchRadianceAlong) {
     checkConsistency(constantEnvLight(), 15);
     checkConsistency(envMapLight(), 16);
+    // Bilinear map (Mitsuba 3's envmap); more of its tests are in env_map_test.cpp.
+    checkConsistency(envMapLight(true, EnvFilter::Bilinear), 17);
 }
 
 TEST(Light, DeltaLightsCannotBeHit) {
@@ -420,22 +423,24 @@ TEST(Light, EnvMapPdfIntegratesToOne) {
     // Midpoint rule over world (theta, phi), d omega = sin(theta) dtheta dphi. The map
     // is rotated so its poles (where pdfW ~ 1 / sin(theta_env), integrable) and pixel
     // edges do not align with the grid; a 1000 x 2000 grid keeps the quadrature error
-    // from those edges well below the 1e-3 bound.
-    Light l = envMapLight();
-    const int nt = 1000, np = 2000;
-    double sum = 0;
-    for (int i = 0; i < nt; ++i) {
-        double theta = (i + 0.5) * M_PI / nt;
-        double st = std::sin(theta), ct = std::cos(theta), rowSum = 0;
-        for (int j = 0; j < np; ++j) {
-            double phi = (j + 0.5) * 2 * M_PI / np;
-            rowSum +=
-                envPdfW(l, Vec3(float(st * std::cos(phi)), float(st * std::sin(phi)), float(ct)));
+    // from those edges well below the 1e-3 bound. Both filters.
+    for (EnvFilter filter : {EnvFilter::Nearest, EnvFilter::Bilinear}) {
+        Light l = envMapLight(true, filter);
+        const int nt = 1000, np = 2000;
+        double sum = 0;
+        for (int i = 0; i < nt; ++i) {
+            double theta = (i + 0.5) * M_PI / nt;
+            double st = std::sin(theta), ct = std::cos(theta), rowSum = 0;
+            for (int j = 0; j < np; ++j) {
+                double phi = (j + 0.5) * 2 * M_PI / np;
+                rowSum += envPdfW(
+                    l, Vec3(float(st * std::cos(phi)), float(st * std::sin(phi)), float(ct)));
+            }
+            sum += rowSum * st;
         }
-        sum += rowSum * st;
+        sum *= (M_PI / nt) * (2 * M_PI / np);
+        EXPECT_NEAR(sum, 1.0, 1e-3) << envFilterName(filter);
     }
-    sum *= (M_PI / nt) * (2 * M_PI / np);
-    EXPECT_NEAR(sum, 1.0, 1e-3);
 }
 
 TEST(Light, EnvMapMatchesMitsubaOrientation) {

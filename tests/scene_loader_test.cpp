@@ -232,6 +232,23 @@ TEST(JsonLoader, LightsOfEveryType) {
     Vec3 x = env.envToWorld.vector(Vec3(1, 0, 0));  // +90 deg about y: x -> -z
     EXPECT_NEAR(x.z, -1.0f, 1e-5f);
     EXPECT_EQ(scene->backgroundLightId, 2);
+    EXPECT_EQ(env.envFilter, EnvFilter::Bilinear);  // the default
+}
+
+TEST(JsonLoader, EnvMapFilterIsBilinearOrNearest) {
+    TempDir tmp;
+    Image sky(8, 4);
+    for (auto& p : sky.pixels) p = Rgb(0.5f, 1.0f, 2.0f);
+    writeExr((tmp.path / "sky.exr").string(), sky);
+    for (const char* name : {"bilinear", "nearest"}) {
+        const std::string light =
+            std::string(R"json({"type": "envmap", "file": "sky.exr", "filter": ")json") + name +
+            R"json("})json";
+        auto scene = loadJsonSceneFromString(sceneWith(kWhite, kRect, light), "scene.json",
+                                             tmp.path.string());
+        ASSERT_EQ(scene->lights.size(), 1u);
+        EXPECT_STREQ(envFilterName(scene->lights[0].envFilter), name);
+    }
 }
 
 TEST(JsonLoader, ObjMeshPathIsRelativeToTheSceneFile) {
@@ -564,6 +581,29 @@ TEST(JsonLoaderErrors, MissingMeshAndEnvMapFiles) {
                          "scene.json:5:39: error: at /lights/0/file: environment "
                          "map 'nowhere/sky.exr' not found"))
         << d[1].format();
+}
+
+TEST(JsonLoaderErrors, UnknownEnvMapFilterListsTheFilters) {
+    TempDir tmp;
+    Image sky(8, 4);
+    for (auto& p : sky.pixels) p = Rgb(1.0f);
+    writeExr((tmp.path / "sky.exr").string(), sky);
+    std::string e = onlyError(
+        sceneWith(kWhite, kRect,
+                  R"json({"type": "envmap", "file": "sky.exr", "filter": "bilinar"})json"),
+        tmp.path.string());
+    EXPECT_TRUE(contains(e, "scene.json:5:")) << e;
+    EXPECT_TRUE(contains(e, "error: at /lights/0/filter: unknown environment map filter "
+                            "'bilinar' (did you mean 'bilinear'?); valid filters: "))
+        << e;
+    e = onlyError(sceneWith(kWhite, kRect,
+                            R"json({"type": "envmap", "file": "sky.exr", "filter": ""})json"),
+                  tmp.path.string());
+    EXPECT_TRUE(contains(e, "at /lights/0/filter: expected a non-empty string")) << e;
+    e = onlyError(sceneWith(kWhite, kRect,
+                            R"json({"type": "envmap", "file": "sky.exr", "filter": 1})json"),
+                  tmp.path.string());
+    EXPECT_TRUE(contains(e, "at /lights/0/filter")) << e;
 }
 
 TEST(JsonLoaderErrors, UnreadableEnvMapMergesTheImageError) {

@@ -104,8 +104,8 @@ Vec2 latLongUv(const Vec3& d, float* sinTheta) {
 
 /// Radiance towards the environment direction dirToLight (world, unit) and the
 /// solid-angle pdf with which illuminate() samples it. Constant environments sample
-/// the uniform sphere; maps sample luminance x sin(theta) per pixel
-/// (pdfW = pdfUv / (2 pi^2 sin theta), ub_latlong_pdf_w).
+/// the uniform sphere; maps sample (u, v) with LatLongMap (env_map.h), and
+/// pdfW = pdfUv / (2 pi^2 sin theta) (ub_latlong_pdf_w).
 Rgb envEval(const Light& l, const Vec3& dirToLight, float* pdfW) {
     if (l.type == LightType::ConstantEnv) {
         *pdfW = uniformSpherePdfW();
@@ -114,18 +114,15 @@ Rgb envEval(const Light& l, const Vec3& dirToLight, float* pdfW) {
     Vec3 local = normalize(l.worldToEnv.vector(dirToLight));
     float sinTheta;
     Vec2 uv = latLongUv(local, &sinTheta);
-    *pdfW = ub_latlong_pdf_w(l.envDistribution->pdf(uv), sinTheta);
-    const Image& img = *l.envMap;
-    int x = std::min(int(uv.x * float(img.width)), img.width - 1);
-    int y = std::min(int(uv.y * float(img.height)), img.height - 1);
-    return img.at(x, y) * l.radiance;
+    *pdfW = ub_latlong_pdf_w(l.envLatLong->pdfUv(uv), sinTheta);
+    return l.envLatLong->eval(uv);
 }
 
 /// Samples a direction towards the environment (world, unit).
 Vec3 envSampleDirection(const Light& l, const Vec2& rnd) {
     if (l.type == LightType::ConstantEnv) return sampleUniformSphere(rnd);
     float pdfUv;
-    Vec2 uv = l.envDistribution->sampleContinuous(rnd, &pdfUv);
+    Vec2 uv = l.envLatLong->sample(rnd, &pdfUv);
     return normalize(l.envToWorld.vector(latLongDirection(uv)));
 }
 
@@ -238,23 +235,21 @@ void Light::prepare() {
                 throwLightError(*this, "environment map has no image");
             if (!isRotation(envToWorld))
                 throwLightError(*this, "environment map transform must be a rotation");
+            if (envFilter != EnvFilter::Nearest && envFilter != EnvFilter::Bilinear)
+                throwLightError(*this, "unknown environment map filter " +
+                                           std::to_string(uint32_t(envFilter)));
             worldToEnv = envToWorld.inverse();
             const Image& img = *envMap;
-            std::vector<float> f(size_t(img.width) * img.height);
-            for (int y = 0; y < img.height; ++y) {
-                // sin(theta) at the row centre: the Jacobian of the lat-long map.
-                float sinTheta = std::sin(kPi * (float(y) + 0.5f) / float(img.height));
-                for (int x = 0; x < img.width; ++x) {
-                    const Rgb& c = img.at(x, y);
-                    if (!isFiniteNonNegative(c))
+            for (int y = 0; y < img.height; ++y)
+                for (int x = 0; x < img.width; ++x)
+                    if (!isFiniteNonNegative(img.at(x, y)))
                         throwLightError(*this, "environment map pixel (" + std::to_string(x) +
                                                    ", " + std::to_string(y) +
                                                    ") is negative or not finite");
-                    f[size_t(y) * img.width + x] =
-                        std::max(0.0f, luminance(c * radiance)) * sinTheta;
-                }
-            }
-            envDistribution = std::make_shared<Distribution2D>(f, img.width, img.height);
+            envLatLong = std::make_shared<LatLongMap>(envMap, radiance, envFilter);
+            // Aliasing pointer: envDistribution lives as long as envLatLong.
+            envDistribution = std::shared_ptr<const Distribution2D>(
+                envLatLong, &envLatLong->cellDistribution());
             break;
         }
         default:

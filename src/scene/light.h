@@ -30,13 +30,15 @@
 //
 // Environment map orientation (same as Mitsuba 3's `envmap`): a direction
 // d = (dx, dy, dz) in the map's frame (d = worldToEnv(dirToLight)) looks up
-//   u = atan2(dx, -dz) / (2 pi)  (wrapped to [0,1)),   v = acos(dy) / pi,
-// pixel (floor(u * width), floor(v * height)), row 0 at the top (v = 0 is +y).
+//   u = atan2(dx, -dz) / (2 pi)  (wrapped to [0,1)),   v = acos(dy) / pi.
 // Inverse: d = (sin(phi) sin(theta), cos(theta), -cos(phi) sin(theta)) with
-// phi = 2 pi u, theta = pi v. Differences from Mitsuba: the map is piecewise
-// constant per pixel (no bilinear filtering), and envToWorld must be a rotation.
-// Sampling: Distribution2D over luminance(pixel * radiance) * sin(theta_row centre),
-// pdfW = pdfUv / (2 pi^2 sin theta) (0 at the poles).
+// phi = 2 pi u, theta = pi v; row 0 of the image is at the top (v = 0 is +y).
+// envFilter picks the reconstruction (scene/env_map.h): Bilinear is Mitsuba 3's
+// (pixel centres at u = (x + 1/2) / W, rows at v = y / (H - 1), bilinear between
+// them, periodic in phi), Nearest is piecewise constant on pixel (floor(u W), floor(v H))
+// (SmallUPBP's). Unlike Mitsuba, envToWorld must be a rotation.
+// Sampling: LatLongMap::sample (a cell by luminance, then the bilinear patch inside it
+// for Bilinear), pdfW = pdfUv / (2 pi^2 sin theta) (0 at the poles).
 #pragma once
 
 #include <cstdint>
@@ -47,6 +49,7 @@
 #include "core/image.h"
 #include "core/sampling.h"
 #include "core/vec.h"
+#include "scene/env_map.h"
 
 namespace ub {
 
@@ -89,10 +92,12 @@ struct Light {
     float totalArea = 0.0f;
 
     // ---- Environment map ----
-    std::shared_ptr<const Image> envMap;      ///< lat-long, u = phi / 2pi, v = theta / pi, +y up
-    std::shared_ptr<const Distribution2D> envDistribution;
-    Transform envToWorld;                     ///< rotation of the map (identity by default)
-    Transform worldToEnv;                     ///< set by prepare()
+    std::shared_ptr<const Image> envMap;       ///< lat-long, u = phi / 2pi, v = theta / pi, +y up
+    EnvFilter envFilter = EnvFilter::Nearest;  ///< lookup (Mitsuba and JSON loaders: Bilinear)
+    std::shared_ptr<const LatLongMap> envLatLong;  ///< set by prepare(): lookup and sampling
+    std::shared_ptr<const Distribution2D> envDistribution;  ///< set by prepare(): its cells
+    Transform envToWorld;                      ///< rotation of the map (identity by default)
+    Transform worldToEnv;                      ///< set by prepare()
 
     bool prepared = false;                    ///< set by prepare()
 

@@ -216,9 +216,20 @@ void readLight(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
         light.type = LightType::ConstantEnv;
         light.radiance = r.getRgb(v, ptr, "radiance", Presence::Required, nonNeg, Rgb(0.0f));
     } else if (type == "envmap") {
-        keys.insert(keys.end(), {"file", "scale", "rotate"});
+        keys.insert(keys.end(), {"file", "scale", "rotate", "filter"});
         r.checkKeys(v, ptr, keys, "envmap light");
         light.type = LightType::EnvMap;
+        light.envFilter = EnvFilter::Bilinear;  // smooth by default, as Mitsuba 3's envmap
+        if (v.contains("filter")) {
+            const std::vector<std::string> filters = {"bilinear", "nearest"};
+            const std::string filter = r.getString(v, ptr, "filter", Presence::Optional);
+            if (filter == "nearest")
+                light.envFilter = EnvFilter::Nearest;
+            else if (filter != "bilinear" && !filter.empty())  // "" was reported by getString
+                r.error(jsonPointerChild(ptr, "filter"),
+                        "unknown environment map filter '" + filter + "'" +
+                            didYouMean(filter, filters) + "; valid filters: " + joinNames(filters));
+        }
         light.radiance = r.getRgb(v, ptr, "scale", Presence::Optional, nonNeg, Rgb(1.0f));
         if (const Json* rot = r.member(v, ptr, "rotate", Presence::Optional, "")) {
             light.envToWorld = readJsonRotation(r, *rot, jsonPointerChild(ptr, "rotate"));

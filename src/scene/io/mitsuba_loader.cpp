@@ -428,6 +428,7 @@ void Builder::readEmitter(const XmlObject& o) {
         light.radiance = r_.getColor(o, "radiance", Rgb(1.0f), ColorUse::Emission);
     } else if (o.type == "envmap") {
         light.type = LightType::EnvMap;
+        light.envFilter = EnvFilter::Bilinear;  // Mitsuba 3's envmap interpolates bilinearly
         light.radiance = Rgb(r_.getFloatIn(o, "scale", 1.0f, 0.0f, kInf));
         Transform m = r_.getTransform(o, "to_world");
         light.envToWorld = m;
