@@ -99,11 +99,12 @@ const RefCase kCases[] = {
 
 // Scenes that do not pass yet, each for a known modelling difference (docs/mitsuba.md):
 //  * test_homo_dielectric_envmap: with the bilinear envmap (Mitsuba's) the directly seen
-//    map passes; what is left (256 its.: 23 failing pixels, max |z| 11; 16384 its.: 40,
-//    max |z| 25, all darker than Mitsuba) lies on the silhouettes of the smooth-shaded
-//    water spheres: unibeam's geometric-normal guard (scene/bsdf.cpp) ends dielectric
-//    samples that leave on the wrong side of the geometric surface, Mitsuba keeps them
-//    (with the guard switched off the scene passes at 4096 its.).
+//    map agrees. Left: a bias on the silhouettes of the smooth-shaded water spheres, all
+//    pixels darker than Mitsuba (e.g. (14, 28) G: 0.18 vs 0.34), which the z-test hides at
+//    256 its. (passes) but shows at 512 (1 failing pixel), 1024 (5, max |z| 7.0) and 16384
+//    (37, max |z| 22). Cause: unibeam's geometric-normal guard (scene/bsdf.cpp) ends
+//    dielectric samples that leave on the wrong side of the geometric surface; Mitsuba
+//    keeps them (with the guard switched off the scene passes at 4096 its.).
 // Run them with --gtest_also_run_disabled_tests.
 const RefCase kKnownDifferences[] = {
     {"test_homo_dielectric_envmap_volpath.xml", "test_homo_dielectric_envmap", 256},
