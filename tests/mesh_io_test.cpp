@@ -243,3 +243,17 @@ TEST(MeshIo, ObjWithCrlfAndMaterialStatements) {
     EXPECT_TRUE(m.normals.empty());
     EXPECT_TRUE(diags.all().empty()) << diags.all()[0].format();
 }
+
+// Assimp reserves memory for every element a PLY header announces before reading any: a header
+// claiming 4e9 vertices ended in std::bad_alloc (or the OOM killer). Counts are checked against
+// the bytes the file has first; a negative count is not a count.
+TEST(MeshIo, ErrorPlyCountsTheFileCannotHold) {
+    Diagnostic d = loadError(meshPath("huge_count.ply"));
+    EXPECT_EQ(d.line, 4);
+    EXPECT_EQ(d.message,
+              "PLY header announces 4000000000 'vertex' elements (at least 12 bytes each), but "
+              "the file has only 0 bytes after the header (truncated or corrupt file?)");
+    d = loadError(meshPath("negative_count.ply"));
+    EXPECT_EQ(d.line, 3);
+    EXPECT_EQ(d.message, "PLY element 'vertex' has count '-5' (expected a non-negative integer)");
+}

@@ -377,3 +377,40 @@ TEST(MitsubaXml, SharedTestScenesLoad) {
     }
     EXPECT_EQ(n, 5);
 }
+
+// A file that includes itself twice would be read 2^32 times under the depth bound alone (a
+// hang); the cycle is an error at the first repeated file, and mutual includes are found too.
+TEST(MitsubaXml, IncludeCyclesAreErrorsNotHangs) {
+    std::string dir = scratchDir("cycle");
+    writeFile(dir + "/self.xml", "<scene version=\"3.0.0\">\n<include filename=\"self.xml\"/>\n"
+                                 "<include filename=\"self.xml\"/>\n</scene>\n");
+    writeFile(dir + "/a.xml", "<scene version=\"3.0.0\">\n<include filename=\"b.xml\"/>\n</scene>\n");
+    writeFile(dir + "/b.xml", "<scene version=\"3.0.0\">\n\n<include filename=\"a.xml\"/>\n</scene>\n");
+    std::string e = errorsOf(scene("<include filename=\"self.xml\"/>\n" + std::string(kLight)), dir);
+    EXPECT_TRUE(contains(e, "self.xml:2:1: error: include cycle: '")) << e;
+    EXPECT_TRUE(contains(e, "self.xml:3:1: error: include cycle: '")) << e;
+    EXPECT_TRUE(contains(e, "is already being read (it includes itself, directly or through "
+                            "other files)"))
+        << e;
+    e = errorsOf(scene("<include filename=\"a.xml\"/>\n" + std::string(kLight)), dir);
+    EXPECT_TRUE(contains(e, "b.xml:3:1: error: include cycle: '")) << e;
+}
+
+// Plugin objects nested 20000 deep overflowed the stack (segmentation fault) while reading;
+// nesting is bounded at 64 with an error at the first object too deep.
+TEST(MitsubaXml, DeepObjectNestingIsAnErrorNotACrash) {
+    std::string body = "<shape type=\"cube\">";
+    for (int i = 0; i < 20000; ++i) body += "<bsdf type=\"twosided\">";
+    for (int i = 0; i < 20000; ++i) body += "</bsdf>";
+    body += "</shape>\n";
+    std::string e = errorsOf(scene(std::string(kLight) + body));
+    EXPECT_TRUE(contains(e, "error: <bsdf> is nested more than 64 objects deep")) << e.substr(0, 500);
+}
+
+// Bytes that are not UTF-8 and control characters in a quoted token are printed escaped, never
+// raw onto the terminal.
+TEST(MitsubaXml, NonUtf8PluginNameIsEscapedInTheMessage) {
+    std::string e = errorsOf(scene(std::string(kLight) + "<shape type=\"cu\xff\xfe" "be\"/>\n"));
+    EXPECT_TRUE(contains(e, "scene.xml:9:1: error: unsupported shape plugin 'cu\\xff\\xfebe'"))
+        << e;
+}

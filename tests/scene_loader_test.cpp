@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -777,4 +779,105 @@ TEST(JsonLoaderErrors, TransformMistakes) {
     EXPECT_EQ(d[3].where, "/shapes/3/transform/rotate/axis");
     EXPECT_EQ(d[3].message, "expected a non-zero direction [x, y, z], got [0,0,0]");
     EXPECT_EQ(d[4].message, "\"emission_two_sided\" needs an \"emission\" on the same shape");
+}
+
+namespace {
+
+uint32_t crc32(const std::string& bytes) {
+    uint32_t c = 0xFFFFFFFFu;
+    for (unsigned char b : bytes) {
+        c ^= b;
+        for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
+    }
+    return ~c;
+}
+
+std::string bigEndian(uint32_t v) {
+    return {char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
+}
+
+std::string pngChunk(const std::string& type, const std::string& data) {
+    return bigEndian(uint32_t(data.size())) + type + data + bigEndian(crc32(type + data));
+}
+
+/// A PNG whose IHDR announces width x height 8-bit RGB pixels, followed by a few bytes of
+/// (not even compressed) image data: a reader has to stop at the header.
+std::string pngHeaderOnly(uint32_t width, uint32_t height) {
+    return std::string("\x89PNG\r\n\x1a\n", 8) +
+           pngChunk("IHDR", bigEndian(width) + bigEndian(height) +
+                                std::string("\x08\x02\0\0\0", 5)) +
+           pngChunk("IDAT", "xxxx") + pngChunk("IEND", "");
+}
+
+}  // namespace
+
+// Image headers announcing absurd sizes are errors before anything is allocated: a PNG of
+// 200000 x 200000 pixels ended in std::bad_alloc and exit status 1.
+TEST(JsonLoaderErrors, ImageHeaderWithAbsurdSizeIsAnError) {
+    TempDir tmp;
+    const std::string png = (tmp.path / "huge.png").string();
+    std::ofstream(png, std::ios::binary) << pngHeaderOnly(200000, 200000);
+    try {
+        readPng(png);
+        ADD_FAILURE() << "readPng accepted a 200000 x 200000 image";
+    } catch (const InputError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  png + ": error: PNG image of 200000 x 200000 pixels is too large (expected at "
+                        "most 65536 pixels on a side and 268435456 pixels in all)");
+    }
+    std::string e = onlyError(
+        sceneWith(std::string(kWhite) + R"json(, "t": {"type": "diffuse", "reflectance":
+                  {"type": "bitmap", "file": "huge.png"}})json",
+                  kRect, kPoint),
+        tmp.path.string());
+    EXPECT_TRUE(contains(e, "cannot read bitmap 'huge.png': PNG image of 200000 x 200000 pixels "
+                            "is too large"))
+        << e;
+
+    // An OpenEXR file whose data window claims 1e6 x 1e6 pixels (readExr computed the window
+    // size in int, which overflows for a corrupt window): a valid 2 x 2 file with the window's
+    // maximum corner patched (the attribute is "dataWindow\0box2i\0", size, 4 int32).
+    const std::string exr = (tmp.path / "huge.exr").string();
+    writeExr(exr, Image(2, 2));
+    std::string bytes;
+    {
+        std::ifstream in(exr, std::ios::binary);
+        bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    const std::string tag("dataWindow\0box2i\0", 17);
+    const size_t at = bytes.find(tag);
+    ASSERT_NE(at, std::string::npos);
+    const int32_t maxCorner = 999999;
+    std::memcpy(&bytes[at + tag.size() + 4 + 8], &maxCorner, 4);
+    std::memcpy(&bytes[at + tag.size() + 4 + 12], &maxCorner, 4);
+    std::ofstream(exr, std::ios::binary) << bytes;
+    try {
+        readExr(exr);
+        ADD_FAILURE() << "readExr accepted a 1e6 x 1e6 data window";
+    } catch (const InputError& err) {
+        // OpenEXR itself reads the scanline offset table on opening and finds the file too
+        // short; either way the error names the file and no image buffer is allocated.
+        const std::string m = err.what();
+        EXPECT_EQ(m.rfind(exr + ": error: ", 0), 0u) << m;
+        EXPECT_TRUE(contains(m, "OpenEXR image of 1000000 x 1000000 pixels is too large") ||
+                    contains(m, "cannot read OpenEXR image: "))
+            << m;
+    }
+}
+
+// Messages quote what the file holds; control characters, bytes that are not UTF-8 and
+// megabytes of text are printed escaped and cut, never raw (a NUL cut the message short).
+TEST(JsonLoaderErrors, QuotedTextIsPrintedEscapedAndCut) {
+    std::string e = onlyError(sceneWith(kWhite,
+                                        R"json({"type": "cube", "material": "wh\u0000ite\u001b[31m"})json",
+                                        kPoint));
+    EXPECT_TRUE(contains(e, "unknown material 'wh\\x00ite\\x1b[31m'")) << e;
+    Diagnostic d{"f.obj", 3, 7, "", "bad token '\xff\xfe" + std::string(10000, '1') + "'"};
+    const std::string f = d.format();
+    EXPECT_EQ(f.substr(0, 40), "f.obj:3:7: error: bad token '\\xff\\xfe111");
+    EXPECT_LT(f.size(), 2100u);
+    EXPECT_TRUE(contains(f, "... (")) << f;
+    EXPECT_EQ(f.substr(f.size() - 11), "more bytes)");
+    // Well-formed UTF-8 stays as it is.
+    EXPECT_EQ((Diagnostic{"é.json", 1, 2, "", "ü ≥ 𝄞\tok"}.format()), "é.json:1:2: error: ü ≥ 𝄞\tok");
 }

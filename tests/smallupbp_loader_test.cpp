@@ -541,3 +541,34 @@ TEST(SmallUpbpBoundary, CavityStaysWithItsShell) {
     EXPECT_EQ(s.cavities, 1u);
     EXPECT_NEAR(signedVolume(s.pieces[0]), 27.0 - 1.0, 1e-4);
 }
+
+// A diffuse or Phong colour above 1 creates energy: SmallUPBP renders it as written, so it
+// loads, with a warning at its line.
+TEST(SmallUpbpLoader, ReflectanceAboveOneIsAWarning) {
+    TinyScene t("kdabove1");
+    t.mtl = "newmtl white\nKd 5 0.5 0.5\nnewmtl glass\nKd 0 0 0\nnewmtl lamp\nKd 0 0 0\nKe 2 2 2\n";
+    std::vector<Diagnostic> w;
+    EXPECT_EQ(t.errors(&w), "");
+    EXPECT_TRUE(contains(allMessages(w),
+                         "t.mtl:2:1: warning: 'Kd' above 1 reflects more light than arrives"))
+        << allMessages(w);
+}
+
+// Binary garbage, bytes that are not UTF-8 and a 10 MB token give errors with positions whose
+// text is escaped and cut, never a crash or megabytes of output.
+TEST(SmallUpbpLoader, GarbageFilesGiveShortPrintableErrors) {
+    TinyScene t("garbage");
+    std::string binary;
+    for (int i = 0; i < 4096; ++i) binary += char(i * 37 % 256);
+    t.aux = binary;
+    std::string e = t.errors();
+    EXPECT_TRUE(contains(e, "t.obj.aux:1:")) << e.substr(0, 300);
+    for (char c : e) EXPECT_TRUE(c == '\n' || c == '\t' || (unsigned char)c >= 0x20) << int(c);
+
+    TinyScene u("longtoken");
+    u.obj += "v " + std::string(10000000, '1') + " 0 0\n";
+    e = u.errors();
+    EXPECT_TRUE(contains(e, "t.obj:23:3: error: '111")) << e.substr(0, 300);
+    EXPECT_LT(e.size(), 4000u);
+    EXPECT_TRUE(contains(e, "more bytes)")) << e.substr(0, 300);
+}

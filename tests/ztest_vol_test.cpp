@@ -221,3 +221,34 @@ TEST(VolFile, SharedSceneGridReads) {
     // create_volume_data.py: sigmat_f = 5 where x > 0.2, y > 0.7, z < 0.5 (x = i / 16).
     EXPECT_FLOAT_EQ(v.at(15, 15, 0, 0), 5.0f);
 }
+
+// Headers announcing absurd sizes (1e9 voxels, int32 overflow of x * y * z, negative counts),
+// non-finite voxels and bounding boxes are errors naming the file, read before any voxel is
+// allocated; the exact messages are asserted.
+TEST(VolFile, AbsurdHeadersAreErrorsBeforeAllocation) {
+    const std::string billion = volError("billion", volBytes(1000, 1000, 1000, 1, {1.0f}));
+    EXPECT_NE(billion.find("billion.vol: error: invalid .vol file: the header announces 1000 x "
+                           "1000 x 1000 x 1 float32 values (4000000048 bytes with the header), "
+                           "but the file has 52 bytes"),
+              std::string::npos)
+        << billion;
+    const int32_t big = 2147483647;
+    EXPECT_NE(volError("overflow", volBytes(big, big, big, 3, {})).find(
+                  "more than 2^32 values (a corrupt header?)"),
+              std::string::npos);
+    EXPECT_NE(volError("negative", volBytes(4, -1, 4, 1, {})).find(
+                  "resolution 4 x -1 x 4 (expected positive sizes)"),
+              std::string::npos);
+    std::vector<float> inf(8, 1.0f);
+    inf[7] = INFINITY;
+    EXPECT_NE(volError("inf", volBytes(2, 2, 2, 1, inf)).find(
+                  "non-finite value at voxel (1, 1, 1), channel 0"),
+              std::string::npos);
+    std::string badBox = volBytes(2, 2, 2, 1, std::vector<float>(8, 1.0f));
+    const float nan = NAN;
+    std::memcpy(&badBox[24], &nan, 4);
+    EXPECT_NE(volError("bbox", badBox).find("empty, inverted or non-finite bounding box"),
+              std::string::npos);
+    EXPECT_NE(volError("empty", "").find("the file has 0 bytes, shorter than the 48-byte header"),
+              std::string::npos);
+}

@@ -64,6 +64,33 @@ CLI::Validator positiveReal(double max = 1e30) {
         "");
 }
 
+/// CLI11 validator: a decimal integer in [1, max].
+CLI::Validator integerUpTo(long max) {
+    return CLI::Validator(
+        [max](std::string& s) -> std::string {
+            bool ok = !s.empty() && s.size() <= 9 &&
+                      s.find_first_not_of("0123456789") == std::string::npos;
+            if (ok && std::stol(s) > 0 && std::stol(s) <= max) return {};
+            return "expected an integer in [1, " + std::to_string(max) + "], got '" + s + "'";
+        },
+        "");
+}
+
+/// CLI11 validator: a finite real number in [-limit, limit].
+CLI::Validator finiteReal(double limit) {
+    return CLI::Validator(
+        [limit](std::string& s) -> std::string {
+            char* end = nullptr;
+            double v = std::strtod(s.c_str(), &end);
+            if (!s.empty() && end && *end == '\0' && std::isfinite(v) && std::fabs(v) <= limit)
+                return {};
+            char range[64];
+            std::snprintf(range, sizeof(range), "in [%g, %g]", -limit, limit);
+            return std::string("expected a number ") + range + ", got '" + s + "'";
+        },
+        "");
+}
+
 std::string algorithmList() {
     std::string s;
     for (const auto& n : ub::integratorNames()) s += (s.empty() ? "" : ", ") + n;
@@ -110,10 +137,13 @@ int run(int argc, char** argv) {
                      "current directory unless only --png is given")
         ->type_name("FILE.exr");
     render->add_option("--png", ra.pngPath, "Also write an 8-bit sRGB PNG")->type_name("FILE.png");
-    render->add_option("--exposure", ra.exposure, "PNG exposure in stops (PNG = 2^EV x image)")
+    render->add_option("--exposure", ra.exposure,
+                       "PNG exposure in stops, in [-64, 64] (PNG = 2^EV x image)")
+        ->check(finiteReal(64.0))
         ->type_name("EV");
-    render->add_option("--threads", ra.threads, "Number of threads (> 0; default: all cores)")
-        ->check(positiveInteger())
+    // Bounded: TBB stalls when told to allow a billion threads.
+    render->add_option("--threads", ra.threads, "Number of threads, in [1, 4096] (default: all cores)")
+        ->check(integerUpTo(4096))
         ->type_name("N");
     render->add_option("--seed", seedText, "Random seed (non-negative integer; default: scene)")
         ->type_name("S");

@@ -11,6 +11,7 @@
 #include <ImfStringAttribute.h>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -28,14 +29,35 @@ Rgb Image::mean() const {
     return {float(s[0] / n), float(s[1] / n), float(s[2] / n)};
 }
 
+namespace {
+
+// Largest image the readers accept: 65536 pixels on a side and 2^28 pixels in all (a 16k x 16k
+// environment map; 3 GiB as float RGB). A corrupt or hostile header announcing more would
+// otherwise make the reader allocate whatever it claims before a single pixel is read.
+constexpr int64_t kMaxImageSide = 65536;
+constexpr int64_t kMaxImagePixels = int64_t(1) << 28;
+
+void checkImageSize(const std::string& path, const char* format, int64_t w, int64_t h) {
+    if (w > kMaxImageSide || h > kMaxImageSide || w * h > kMaxImagePixels)
+        throw InputError(path, std::string(format) + " image of " + std::to_string(w) + " x " +
+                                   std::to_string(h) + " pixels is too large (expected at most " +
+                                   std::to_string(kMaxImageSide) + " pixels on a side and " +
+                                   std::to_string(kMaxImagePixels) + " pixels in all)");
+}
+
+}  // namespace
+
 Image readExr(const std::string& path, ImageMetadata* metadata) {
     if (!std::filesystem::exists(path)) throw InputError(path, "image file does not exist");
     try {
         Imf::InputFile file(path.c_str());
         const Imf::Header& h = file.header();
         Imath::Box2i dw = h.dataWindow();
-        int w = dw.max.x - dw.min.x + 1, ht = dw.max.y - dw.min.y + 1;
-        if (w <= 0 || ht <= 0) throw InputError(path, "OpenEXR image has an empty data window");
+        // In 64 bits: a corrupt window (min -2^31, max 2^31-1) overflows int.
+        const int64_t w64 = int64_t(dw.max.x) - dw.min.x + 1, h64 = int64_t(dw.max.y) - dw.min.y + 1;
+        if (w64 <= 0 || h64 <= 0) throw InputError(path, "OpenEXR image has an empty data window");
+        checkImageSize(path, "OpenEXR", w64, h64);
+        const int w = int(w64), ht = int(h64);
         const Imf::ChannelList& ch = h.channels();
         bool hasRgb = ch.findChannel("R") && ch.findChannel("G") && ch.findChannel("B");
         bool hasY = ch.findChannel("Y");
@@ -43,8 +65,9 @@ Image readExr(const std::string& path, ImageMetadata* metadata) {
             throw InputError(path, "OpenEXR image has neither R,G,B nor Y channels");
         Image img(w, ht);
         Imf::FrameBuffer fb;
+        // OpenEXR addresses pixel (x, y) of the data window as base + x * xs + y * ys.
         char* base = reinterpret_cast<char*>(img.pixels.data()) -
-                     (size_t(dw.min.x) + size_t(dw.min.y) * w) * sizeof(Rgb);
+                     (int64_t(dw.min.x) + int64_t(dw.min.y) * w) * int64_t(sizeof(Rgb));
         size_t xs = sizeof(Rgb), ys = sizeof(Rgb) * w;
         if (hasRgb) {
             fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
@@ -136,8 +159,14 @@ Image readPng(const std::string& path, bool linearize) {
     png_init_io(png, fp);
     png_set_sig_bytes(png, 8);
     png_read_info(png, info);
-    width = int(png_get_image_width(png, info));
-    height = int(png_get_image_height(png, info));
+    const int64_t w64 = png_get_image_width(png, info), h64 = png_get_image_height(png, info);
+    if (w64 > kMaxImageSide || h64 > kMaxImageSide || w64 * h64 > kMaxImagePixels) {
+        png_destroy_read_struct(&png, &info, nullptr);
+        std::fclose(fp);
+        checkImageSize(path, "PNG", w64, h64);  // throws
+    }
+    width = int(w64);
+    height = int(h64);
     bitDepth = png_get_bit_depth(png, info);
     const int colorType = png_get_color_type(png, info);
     // Normalise to 8/16-bit RGB without alpha.

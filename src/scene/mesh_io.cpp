@@ -289,7 +289,104 @@ bool loadObj(const std::string& path, const std::string& text, Reporter& rep, Tr
 
 // ---- PLY ----------------------------------------------------------------------
 
+/// Checks the element counts of a PLY header against the file size before Assimp sees the
+/// file: Assimp reserves memory for every announced element first, so a corrupt or hostile
+/// count (`element vertex 4000000000`) would end in an allocation failure rather than a
+/// message. Each element needs at least its scalar properties' bytes (binary; a list at least
+/// its count) or two characters per property (ASCII: a digit and a separator). Anything else
+/// in the header is left to Assimp. Returns false (with an error) on a count the file cannot
+/// hold.
+bool checkPlyCounts(const std::string& path, Reporter& rep) {
+    std::ifstream in(path, std::ios::binary);
+    std::error_code ec;
+    const uintmax_t fileBytes = std::filesystem::file_size(path, ec);
+    if (!in || ec) return true;  // Assimp reports unreadable files
+    auto scalarBytes = [](const std::string& t) -> int {
+        if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+        if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+        if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" ||
+            t == "float32")
+            return 4;
+        if (t == "double" || t == "float64") return 8;
+        return 0;
+    };
+    struct Element {
+        std::string name;
+        unsigned long long count = 0;
+        int line = 0;
+        uintmax_t minBytes = 0;  // per element
+    };
+    std::vector<Element> elements;
+    bool ascii = false;
+    std::string line;
+    int lineNo = 0;
+    uintmax_t headerBytes = 0;
+    bool ended = false;
+    while (lineNo < 10000 && std::getline(in, line)) {
+        ++lineNo;
+        headerBytes += line.size() + 1;
+        std::istringstream ls(line);
+        std::string kw;
+        ls >> kw;
+        if (kw == "end_header") {
+            ended = true;
+            break;
+        }
+        if (kw == "format") {
+            std::string f;
+            ls >> f;
+            ascii = f == "ascii";
+        } else if (kw == "element") {
+            Element e;
+            std::string count;
+            ls >> e.name >> count;
+            e.line = lineNo;
+            const bool digits =
+                !count.empty() && count.size() <= 19 &&
+                count.find_first_not_of("0123456789") == std::string::npos;
+            if (!digits) {
+                rep.error("PLY element '" + e.name + "' has count '" + count +
+                              "' (expected a non-negative integer)",
+                          lineNo);
+                return false;
+            }
+            e.count = std::stoull(count);
+            elements.push_back(e);
+        } else if (kw == "property" && !elements.empty()) {
+            std::string type;
+            ls >> type;
+            if (ascii) {
+                elements.back().minBytes += 2;
+            } else if (type == "list") {
+                std::string countType;
+                ls >> countType;
+                elements.back().minBytes += uintmax_t(scalarBytes(countType));
+            } else {
+                elements.back().minBytes += uintmax_t(scalarBytes(type));
+            }
+        }
+    }
+    if (!ended) return true;  // Assimp reports the malformed header
+    const uintmax_t available = fileBytes > headerBytes ? fileBytes - headerBytes : 0;
+    uintmax_t needed = 0;
+    for (const Element& e : elements) {
+        const uintmax_t per = std::max<uintmax_t>(1, e.minBytes);
+        // Compared by division so that count * per cannot overflow.
+        if (e.count > (available - std::min(needed, available)) / per) {
+            rep.error("PLY header announces " + std::to_string(e.count) + " '" + e.name +
+                          "' elements (at least " + std::to_string(per) +
+                          " bytes each), but the file has only " + std::to_string(available) +
+                          " bytes after the header (truncated or corrupt file?)",
+                      e.line);
+            return false;
+        }
+        needed += e.count * per;
+    }
+    return true;
+}
+
 bool loadPly(const std::string& path, Reporter& rep, TriangleMesh* out) {
+    if (!checkPlyCounts(path, rep)) return false;
     Assimp::Importer importer;
     // Read without post-processing, check the face indices ourselves (Assimp's own
     // validation names no index values), then validate and triangulate; no vertex

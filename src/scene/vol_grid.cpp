@@ -36,11 +36,14 @@ VolGrid readVolFile(const std::string& path) {
     if (!std::filesystem::is_regular_file(path, ec))
         throw InputError(path, "cannot open the .vol file (not found or not a file)");
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path, "cannot open the .vol file (not readable)");
-    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
-                                     std::istreambuf_iterator<char>());
-    if (bytes.size() < kHeaderBytes)
-        fail("the file has " + std::to_string(bytes.size()) + " bytes, shorter than the " +
+    const uintmax_t fileBytes = std::filesystem::file_size(path, ec);
+    if (!in || ec) throw InputError(path, "cannot open the .vol file (not readable)");
+    // The header is validated before the voxels are read: a file whose header is garbage is
+    // not read whole into memory.
+    std::vector<unsigned char> bytes(kHeaderBytes);
+    in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(kHeaderBytes));
+    if (size_t(in.gcount()) < kHeaderBytes)
+        fail("the file has " + std::to_string(in.gcount()) + " bytes, shorter than the " +
              std::to_string(kHeaderBytes) + "-byte header");
     const unsigned char* h = bytes.data();
     if (h[0] != 'V' || h[1] != 'O' || h[2] != 'L')
@@ -70,13 +73,19 @@ VolGrid readVolFile(const std::string& path) {
     const uint64_t count = uint64_t(v.nx) * uint64_t(v.ny) * uint64_t(v.nz) * uint64_t(v.channels);
     if (count > (uint64_t(1) << 32)) fail("more than 2^32 values (a corrupt header?)");
     const uint64_t expected = kHeaderBytes + count * 4;
-    if (bytes.size() != expected) {
+    if (fileBytes != expected) {
         std::ostringstream os;
         os << "the header announces " << v.nx << " x " << v.ny << " x " << v.nz << " x "
            << v.channels << " float32 values (" << expected << " bytes with the header), but "
-           << "the file has " << bytes.size() << " bytes";
+           << "the file has " << fileBytes << " bytes";
         fail(os.str());
     }
+    bytes.resize(size_t(expected));
+    in.read(reinterpret_cast<char*>(bytes.data() + kHeaderBytes),
+            std::streamsize(expected - kHeaderBytes));
+    if (uint64_t(in.gcount()) != expected - kHeaderBytes)
+        fail("reading the voxels failed after " + std::to_string(in.gcount()) + " bytes");
+    h = bytes.data();
     v.values.resize(size_t(count));
     for (size_t i = 0; i < count; ++i) {
         float f = readF32(h + kHeaderBytes + 4 * i);

@@ -27,6 +27,13 @@ const std::vector<std::string> kPropertyTags = {"float", "integer", "boolean", "
                                                 "rgb",   "spectrum", "point", "vector",
                                                 "transform"};
 constexpr int kMaxIncludeDepth = 32;
+// Files read in all (the top file and every <include>): a file that includes another twice at
+// each of 32 levels would otherwise be read 2^32 times.
+constexpr int kMaxIncludedFiles = 1000;
+// Plugin objects nested inside each other (Mitsuba scenes nest a handful: shape > bsdf >
+// texture); the bound keeps the recursive reading and the object tree's destruction off the
+// end of the stack for hostile files.
+constexpr int kMaxObjectDepth = 64;
 
 std::string joinList(const std::vector<std::string>& v) {
     std::string s;
@@ -127,6 +134,9 @@ private:
     };
     std::vector<PendingRef> refs_;
     std::vector<std::shared_ptr<XmlObject>> owned_;  // keeps objects alive for ref resolution
+    std::vector<std::string> includeStack_;  ///< canonical paths of the files being read
+    int filesRead_ = 0;
+    int objectDepth_ = 0;
 };
 
 bool Parser::attr(const FileCtx& f, const pugi::xml_node& n, const char* name, std::string* out,
@@ -182,10 +192,25 @@ void Parser::parseFile(const std::string& path, const XmlPos& includedFrom, int 
             error(includedFrom, "cannot open the included file '" + path + "'");
         return;
     }
+    std::error_code ec;
+    fs::path canonical = fs::weakly_canonical(fs::path(path), ec);
+    const std::string key = ec ? path : canonical.string();
+    if (std::find(includeStack_.begin(), includeStack_.end(), key) != includeStack_.end()) {
+        error(includedFrom, "include cycle: '" + path + "' is already being read (it includes "
+                            "itself, directly or through other files)");
+        return;
+    }
+    if (++filesRead_ > kMaxIncludedFiles) {
+        error(includedFrom, "more than " + std::to_string(kMaxIncludedFiles) +
+                                " files read through <include> (files included repeatedly?)");
+        return;
+    }
     std::stringstream ss;
     ss << in.rdbuf();
     FileCtx f{path, ss.str(), fs::path(path).parent_path().string()};
+    includeStack_.push_back(key);
     parseText(f, depth);
+    includeStack_.pop_back();
 }
 
 void Parser::parseText(const FileCtx& f, int depth) {
@@ -302,6 +327,11 @@ void Parser::registerId(const std::shared_ptr<XmlObject>& obj) {
 }
 
 std::shared_ptr<XmlObject> Parser::parseObject(const FileCtx& f, const pugi::xml_node& n) {
+    if (objectDepth_ >= kMaxObjectDepth) {
+        error(pos(f, n), std::string("<") + n.name() + "> is nested more than " +
+                             std::to_string(kMaxObjectDepth) + " objects deep");
+        return nullptr;
+    }
     auto obj = std::make_shared<XmlObject>();
     owned_.push_back(obj);
     obj->tag = n.name();
@@ -310,7 +340,9 @@ std::shared_ptr<XmlObject> Parser::parseObject(const FileCtx& f, const pugi::xml
     if (!attr(f, n, "type", &obj->type, true)) obj->type = "?";
     attr(f, n, "id", &obj->id, false);
     registerId(obj);
+    ++objectDepth_;
     parseObjectBody(f, n, *obj);
+    --objectDepth_;
     return obj;
 }
 
@@ -342,6 +374,7 @@ void Parser::parseObjectBody(const FileCtx& f, const pugi::xml_node& node, XmlOb
             c.name = name;
             c.pos = pos(f, n);
             c.object = parseObject(f, n);
+            if (!c.object) continue;
             obj.children.push_back(c);
         } else if (isIn(tag, kPropertyTags)) {
             XmlProperty p;

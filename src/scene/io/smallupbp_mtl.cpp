@@ -3,6 +3,7 @@
 // letters: 'n' newmtl, 'N' + 's' Ns, 'K' + d/s/a/e, 'm' a texture map.
 // Standard MTL statements it skips (Ni, d, Tr, Tf, illum, other maps) are
 // skipped here too; any other statement is an error.
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -109,6 +110,9 @@ void readUpbpMtl(const std::string& path, std::vector<UpbpMaterial>* materials,
                 r.error(kw, "'" + name + "' must not be negative");
                 continue;
             }
+            if ((k[1] == 'd' || k[1] == 's') && std::max({c[0], c[1], c[2]}) > 1.0f)
+                r.warning(kw, "'" + name + "' above 1 reflects more light than arrives (the "
+                              "material creates energy); read as written, as SmallUPBP does");
             if (k[1] == 'd') current->diffuse = Rgb(c[0], c[1], c[2]);
             if (k[1] == 's') current->specular = Rgb(c[0], c[1], c[2]);
             if (k[1] == 'e') current->emission = Rgb(c[0], c[1], c[2]);
