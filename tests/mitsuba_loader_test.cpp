@@ -414,3 +414,12 @@ TEST(MitsubaXml, NonUtf8PluginNameIsEscapedInTheMessage) {
     EXPECT_TRUE(contains(e, "scene.xml:9:1: error: unsupported shape plugin 'cu\\xff\\xfebe'"))
         << e;
 }
+
+// Only regular files are included: /dev/zero never ends (reading it hung and filled memory).
+TEST(MitsubaXml, IncludeOfADeviceIsAnError) {
+    if (!fs::exists("/dev/zero")) GTEST_SKIP() << "no /dev/zero";
+    std::string e = errorsOf(scene("<include filename=\"/dev/zero\"/>\n" + std::string(kLight)));
+    EXPECT_TRUE(contains(e, "scene.xml:8:1: error: cannot open the included file '/dev/zero' (not "
+                            "a readable regular file)"))
+        << e;
+}

@@ -185,11 +185,14 @@ bool Parser::checkAttributes(const FileCtx& f, const pugi::xml_node& n,
 
 void Parser::parseFile(const std::string& path, const XmlPos& includedFrom, int depth) {
     std::ifstream in(path, std::ios::binary);
-    if (!in || fs::is_directory(path)) {
+    std::error_code regularEc;
+    // Only regular files: a directory cannot be read and a device such as /dev/zero never ends.
+    if (!in || !fs::is_regular_file(path, regularEc)) {
         if (includedFrom.file.empty())
             diags_.error(Diagnostic{path, 0, 0, "", "cannot open the scene file"});
         else
-            error(includedFrom, "cannot open the included file '" + path + "'");
+            error(includedFrom, "cannot open the included file '" + path +
+                                    "' (not a readable regular file)");
         return;
     }
     std::error_code ec;
