@@ -171,6 +171,34 @@ TEST(MitsubaAlbedo, SharedTestAlbedoVolMatchesTheFile) {
             }
 }
 
+TEST(MitsubaAlbedo, ConstantSigmaTWithAnAlbedoGrid) {
+    // A grey constant sigma_t with an albedo gridvolume: a grid medium of constant density
+    // (inside and outside the grid's one voxel), sigma_s = albedo(x) sigma_t.
+    ScratchDir dir;
+    writeVolFiles(dir);
+    auto s = loadXml(xmlScene(heterogeneous(
+                         "<float name=\"sigma_t\" value=\"2\"/><float name=\"scale\" "
+                         "value=\"1.5\"/>",
+                         gridVolume("albedo", "albedo.vol",
+                                    "<string name=\"filter_type\" value=\"nearest\"/>"))),
+                     dir.path.string());
+    const Medium& m = s->media[0];
+    ASSERT_EQ(m.type, MediumType::kGrid);
+    ASSERT_TRUE(m.albedoGrid);
+    for (const Vec3& p : {Vec3(0.25f, 0.5f, 0.5f), Vec3(0.75f, 0.2f, 0.9f), Vec3(-3, 7, 2)}) {
+        const MediumCoefficients c = mediumCoefficientsAt(m, p);
+        expectRgbNear(c.sigmaT, Rgb(3.0f), "sigma_t");
+        expectRgbNear(c.sigmaS, albedoGridAt(*m.albedoGrid, p) * 3.0f, "sigma_s");
+    }
+    expectRgbNear(mediumCoefficientsAt(m, Vec3(0.75f, 0.5f, 0.5f)).sigmaS,
+                  Rgb(0.7f, 0.8f, 0.9f) * 3.0f, "voxel 1");
+    // Transmittance through and beside the grid's voxel: exp(-3 L).
+    for (const Vec3& o : {Vec3(-1.0f, 0.5f, 0.5f), Vec3(-1.0f, 4.0f, -2.0f)}) {
+        const Rgb T = transmittance(m, o, Vec3(1, 0, 0), 2.5f);
+        expectRgbNear(T, Rgb(std::exp(-3.0f * 2.5f)), "transmittance");
+    }
+}
+
 TEST(MitsubaAlbedo, VdbGridNamesForSigmaTAndAlbedo) {
     ScratchDir dir;
     DenseFloatGrid one(2, 2, 2, 1.0f), half(2, 2, 2, 0.5f), quarter(2, 2, 2, 0.25f);
@@ -257,10 +285,14 @@ TEST(MitsubaAlbedo, UnsupportedAlbedoVolumesAreErrorsWithPositions) {
                                 "albedo (<volume type=\"gridvolume\">) needs a heterogeneous "
                                 "medium"))
         << e;
-    text = xmlScene(
-        heterogeneous("<float name=\"sigma_t\" value=\"2\"/>", gridVolume("albedo", "albedo.vol")));
+    text = xmlScene(heterogeneous("<rgb name=\"sigma_t\" value=\"1, 2, 3\"/>",
+                                  gridVolume("albedo", "albedo.vol")));
     e = xmlErrors(text, dir.path.string());
-    EXPECT_TRUE(contains(e, "needs sigma_t as a gridvolume")) << e;
+    EXPECT_TRUE(contains(e, where(text, "<volume name=\"albedo\"") +
+                                ": error: <medium type=\"heterogeneous\">: a spatially varying "
+                                "albedo (<volume type=\"gridvolume\">) with a spectrally varying "
+                                "constant sigma_t is not supported"))
+        << e;
     // An unknown volume plugin lists the supported ones.
     text = xmlScene(heterogeneous(sigma, "<volume name=\"albedo\" type=\"noise\"/>"));
     e = xmlErrors(text, dir.path.string());

@@ -259,6 +259,14 @@ std::shared_ptr<const VdbGrid> VdbGrid::fromDense(const DenseFloatGrid& dense,
     return VdbGridBuilder::build(*denseToOpenVdb(dense, gridName), label, gridName);
 }
 
+std::shared_ptr<const VdbGrid> VdbGrid::constant(float value, const std::string& label) {
+    initOpenVdb();
+    openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(value);
+    grid->setName("constant");
+    grid->tree().setValue(openvdb::Coord(0, 0, 0), value);
+    return VdbGridBuilder::build(*grid, label, "constant");
+}
+
 std::shared_ptr<const VdbGrid> VdbGrid::fromDenseChecked(const DenseFloatGrid& dense,
                                                          const std::string& gridName,
                                                          const std::string& label,

@@ -65,6 +65,9 @@ public:
                                                                     const std::string& gridName,
                                                                     const std::string& quantity,
                                                                     float maxAllowed);
+    /// A grid whose value is `value` everywhere (one active voxel at the origin holding it,
+    /// and `value` as the background): a constant extinction as a grid medium.
+    static std::shared_ptr<const VdbGrid> constant(float value, const std::string& label);
     /// fromDense() with the value check of loadChannels().
     static std::shared_ptr<const VdbGrid> fromDenseChecked(const DenseFloatGrid& dense,
                                                            const std::string& gridName,

@@ -190,15 +190,19 @@ bool buildMitsubaMedium(MitsubaBuild& b, const XmlObject& o, Medium* out) {
         r.unsupportedPlugin(*vol, {"gridvolume", "constvolume"});
         ok = false;
     }
-    if (albedoVol && !vol && ok)
+    if (albedoVol && !vol && ok &&
+        !(constSigmaT.x == constSigmaT.y && constSigmaT.y == constSigmaT.z))
         r.error(albedoVol->pos,
                 o.label() + ": a spatially varying albedo (" + albedoVol->label() +
-                    ") needs sigma_t as a gridvolume; with a constant sigma_t give a constant "
-                    "albedo");
+                    ") with a spectrally varying constant sigma_t is not supported (grid media "
+                    "have grey extinction); give a grey sigma_t");
     r.checkUnused(o);
     if (!ok || r.errorCount() != before) return false;
     try {
-        if (!vol) {  // a constant extinction: the same as homogeneous
+        if (!vol && albedoVol) {  // constant extinction, varying albedo: a constant grid
+            *out = Medium::heterogeneous(VdbGrid::constant(1.0f, "constant sigma_t"),
+                                         constSigmaT.x * scale, albedo, g, Transform());
+        } else if (!vol) {  // a constant extinction: the same as homogeneous
             const Rgb st = constSigmaT * scale, ss = albedo * st;
             *out = Medium::homogeneous(vmax(st - ss, Rgb(0.0f)), ss, g);
         } else {
