@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <exception>
 #include <iostream>
+#include <new>
 #include <string>
 
 #include "app/commands.h"
@@ -283,6 +284,10 @@ int run(int argc, char** argv) {
     } catch (const ub::InputError& e) {
         for (const auto& d : e.diagnostics()) std::fprintf(stderr, "%s\n", d.format().c_str());
         return kExitBadInput;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "unibeam: error: out of memory (a smaller --resolution, a smaller "
+                             "scene or fewer --threads need less)\n");
+        return kExitFailure;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "unibeam: error: %s\n", e.what());
         return kExitFailure;
