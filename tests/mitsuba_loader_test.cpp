@@ -346,6 +346,7 @@ TEST(MitsubaXml, MediaOnShapesBecomeBoundaries) {
     // Mitsuba's volpath semantics (docs/mitsuba.md, scene.h).
     EXPECT_EQ(s->settings.mediumTransitions, MediumTransitions::kShapeSides);
     EXPECT_EQ(s->settings.depthCounting, DepthCounting::kNonNullVertices);
+    EXPECT_EQ(s->settings.shadingNormals, ShadingNormals::kShadingOnly);
 
     // An exterior medium alone also makes a boundary (entering: vacuum, leaving: fog).
     auto ext = load(scene(std::string(kLight) +

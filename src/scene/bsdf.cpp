@@ -38,6 +38,8 @@
 // transmitted one on the other side, otherwise f = 0, pdf = 0, and sampling fails
 // (this removes light leaks through the surface and black-side reflections; the
 // rule is symmetric in dirFix/dirGen, so reciprocity and reverse pdfs survive it).
+// Switched off (ShadingNormals::kShadingOnly, Mitsuba scenes) every lobe direction is kept,
+// as Mitsuba 3 does; pdfs stay symmetric, light may leak through smooth-shaded surfaces.
 // For light subpaths f_s is multiplied by the adjoint factor
 //   |dirFix.Ns| |dirGen.Ng| / (|dirFix.Ng| |dirGen.Ns|)
 // so that f_s cos_s(dirGen) is the correct importance throughput; it is exactly 1
@@ -181,6 +183,7 @@ float Bsdf::shadingFactor(float cosShadingGen, float cosGeoGen) const {
 
 bool Bsdf::geometricSideOk(float localGenZ, float cosGeoGen) const {
     if (cosGeoGen == 0.0f) return false;
+    if (!geometricGuard_) return true;  // Mitsuba 3: the shading-frame lobe decides alone
     bool shadingReflect = localGenZ * localDirFix_.z > 0.0f;
     bool geometricReflect = cosGeoGen * cosGeoFix_ > 0.0f;
     return shadingReflect == geometricReflect;

@@ -20,7 +20,10 @@
 //    (the normal points outside).
 //  * Geometric normal guard (details in bsdf.cpp): a reflected dirGen must lie on the
 //    same side of the geometric surface as dirFix and a transmitted one on the other
-//    side; otherwise evaluate() and pdf() give 0 and sample() fails. With fromLight,
+//    side; otherwise evaluate() and pdf() give 0 and sample() fails. It can be switched
+//    off (setGeometricGuard(false), ShadingNormals::kShadingOnly: Mitsuba 3, whose BSDFs
+//    look at the shading frame only); Scene::setupBsdf does so by the scene's settings.
+//    With fromLight,
 //    the returned f_s includes Veach's shading-normal adjoint factor (1997, Sec. 5.3)
 //    |dirFix.Ns| |dirGen.Ng| / (|dirFix.Ng| |dirGen.Ns|), so callers always use
 //    f_s * cosThetaGen (shading cosine) and never apply the correction themselves.
@@ -109,6 +112,9 @@ public:
     float cosThetaFix() const { return std::fabs(localDirFix_.z); }
     const Vec3& shadingNormal() const { return frame_.n; }
     const Material* material() const { return mat_; }
+    /// Geometric-normal guard on (default) or off (Mitsuba 3); kept across setup() calls.
+    void setGeometricGuard(bool on) { geometricGuard_ = on; }
+    bool geometricGuard() const { return geometricGuard_; }
 
 private:
     /// f_s and both pdfs (lobe selection included) for dirGen given in frame_;
@@ -142,6 +148,7 @@ private:
     Vec3 geoNormal_;     ///< geometric normal, same side convention as frame_.n
     float cosGeoFix_ = 0.0f;  ///< dot(dirFix, geoNormal_)
     bool fromLight_ = false;
+    bool geometricGuard_ = true;  ///< see the banner
     bool valid_ = false;
     bool isDelta_ = false;
     bool black_ = false;  ///< back side of a one-sided material, or all-black lobes

@@ -66,6 +66,18 @@ enum class DepthCounting : uint8_t {
     kNonNullVertices,
 };
 
+/// Which BSDF directions survive where a shading normal disagrees with the geometric one.
+enum class ShadingNormals : uint8_t {
+    /// Geometric-normal guard (scene/bsdf.h): a reflected direction must stay on the incoming
+    /// side of the geometric surface and a transmitted one must cross it, otherwise it is
+    /// dropped (no light leaks through smooth-shaded meshes). JSON and SmallUPBP scenes.
+    kGeometricGuard,
+    /// Mitsuba 3: the lobe in the shading frame alone decides (its BSDFs never look at the
+    /// geometric normal), so at grazing hits on smooth-shaded meshes a refracted ray may stay
+    /// on the incoming side and a reflected one cross. Set by the Mitsuba XML loader.
+    kShadingOnly,
+};
+
 /// What the renderer needs from the scene file besides geometry.
 struct RenderSettings {
     int maxPathLength = 10;    ///< max number of path segments (SmallVCM semantics)
@@ -76,6 +88,7 @@ struct RenderSettings {
     bool keepHorizontalFov = false;
     MediumTransitions mediumTransitions = MediumTransitions::kPriorityStack;
     DepthCounting depthCounting = DepthCounting::kAllVertices;
+    ShadingNormals shadingNormals = ShadingNormals::kGeometricGuard;
 };
 
 struct ShapeInfo {

@@ -33,6 +33,7 @@ bool Scene::setupBsdf(Bsdf* bsdf, int materialId, const Vec2& uv, const Vec3& di
         return false;
     }
     const Material& m = materials[size_t(materialId)];
+    bsdf->setGeometricGuard(settings.shadingNormals == ShadingNormals::kGeometricGuard);
     return bsdf->setup(m, surfaceColors(m, uv), dirFix, geoNormal, shadingNormal, fromLight);
 }
 

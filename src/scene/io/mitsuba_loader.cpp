@@ -474,9 +474,10 @@ std::unique_ptr<Scene> buildFromXml(const XmlScene& xml, Diagnostics& diags,
     auto scene = std::make_unique<Scene>();
     scene->sourceFile = xml.file;
     // Mitsuba 3's volpath semantics (docs/mitsuba.md): a crossed shape sets the medium, and
-    // null-lobe events do not count towards max_depth.
+    // null-lobe events do not count towards max_depth, and no geometric-normal guard.
     scene->settings.mediumTransitions = MediumTransitions::kShapeSides;
     scene->settings.depthCounting = DepthCounting::kNonNullVertices;
+    scene->settings.shadingNormals = ShadingNormals::kShadingOnly;
     XmlReader reader(diags);
     MitsubaBuild b{reader, xml, *scene, {}, {}, {}, false};
     Builder(b).build();
