@@ -424,3 +424,14 @@ TEST(MitsubaXml, IncludeOfADeviceIsAnError) {
                             "a readable regular file)"))
         << e;
 }
+
+// Range messages print their bounds as numbers ("(0, 1e+30]"), not "(0.000000, inf]", which
+// read as if 3e38 were allowed.
+TEST(MitsubaXml, OutOfRangeMessageShowsTheBounds) {
+    std::string e = errorsOf(scene(std::string(kLight) +
+                                   "<shape type=\"sphere\"><float name=\"radius\" value=\"3e38\"/>"
+                                   "</shape>\n"));
+    EXPECT_TRUE(contains(e, "<shape type=\"sphere\">: parameter 'radius' = 3e38 is out of range "
+                            "(expected a value in (0, 1e+30])"))
+        << e;
+}

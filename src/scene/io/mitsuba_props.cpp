@@ -1,6 +1,7 @@
 // Typed, use-tracking property access for the Mitsuba XML builder (mitsuba_build.h).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "scene/io/mitsuba_build.h"
@@ -80,9 +81,10 @@ float XmlReader::getFloatIn(const XmlObject& o, const std::string& name, float d
     double v = p->number;
     bool ok = (loOpen ? v > lo : v >= lo) && (hiOpen ? v < hi : v <= hi);
     if (!ok) {
-        std::string range = std::string(loOpen ? "(" : "[") + std::to_string(lo) + ", " +
-                            (hi >= 1e30f ? std::string("inf") : std::to_string(hi)) +
-                            (hiOpen ? ")" : "]");
+        // %g: "(0, 1e+30]", not "(0.000000, inf]" (kInf is 1e30, and larger values fail).
+        char range[96];
+        std::snprintf(range, sizeof(range), "%s%g, %g%s", loOpen ? "(" : "[", double(lo),
+                      double(hi), hiOpen ? ")" : "]");
         error(p->pos, o.label() + ": parameter '" + name + "' = " + p->text +
                           " is out of range (expected a value in " + range + ")");
         return def;
