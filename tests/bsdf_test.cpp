@@ -76,10 +76,16 @@ std::vector<NamedMaterial> phongMaterials() {
     return {
         {"Phong1", phong(1), false}, {"Phong20", phong(20), false}, {"Phong500", phong(500), true}};
 }
+/// The same material with Mitsuba's separable Smith masking-shadowing (reflection).
+Material separable(Material m) {
+    m.separableMasking = true;
+    return m;
+}
 std::vector<NamedMaterial> conductorMaterials() {
     return {{"Conductor0.05", conductor(0.05f), true},
             {"Conductor0.3", conductor(0.3f), false},
-            {"Conductor0.8", conductor(0.8f), false}};
+            {"Conductor0.8", conductor(0.8f), false},
+            {"Conductor0.5Separable", separable(conductor(0.5f)), false}};
 }
 std::vector<NamedMaterial> roughGlassMaterials() {
     std::vector<NamedMaterial> r;
@@ -87,6 +93,7 @@ std::vector<NamedMaterial> roughGlassMaterials() {
         for (float alpha : {0.05f, 0.3f, 0.8f})
             r.push_back({"RoughGlass" + std::to_string(alpha) + "_ior" + std::to_string(ior),
                          roughGlass(alpha, ior), alpha < 0.1f});
+    r.push_back({"RoughGlass0.5_ior1.5Separable", separable(roughGlass(0.5f, 1.5f)), false});
     return r;
 }
 std::vector<NamedMaterial> nonDeltaMaterials() {

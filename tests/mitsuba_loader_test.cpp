@@ -414,6 +414,25 @@ TEST(MitsubaXml, NonUtf8PluginNameIsEscapedInTheMessage) {
     std::string e = errorsOf(scene(std::string(kLight) + "<shape type=\"cu\xff\xfe" "be\"/>\n"));
     EXPECT_TRUE(contains(e, "scene.xml:9:1: error: unsupported shape plugin 'cu\\xff\\xfebe'"))
         << e;
+
+TEST(MitsubaXml, ShapesWithoutBsdfGetMitsubasDefaults) {
+    // Mitsuba 3 (Shape's constructor): no BSDF gives a diffuse BSDF of reflectance 0.5, or 0
+    // when the shape carries an area emitter (an emitter does not reflect by default). A
+    // grey emitter showed up as +1% of the whole image against Mitsuba 3 in the
+    // surfaces reference scene (tests/data/mitsuba/surfaces.xml).
+    auto s = load(scene(R"(<shape type="rectangle"/>
+<shape type="rectangle"><transform name="to_world"><translate z="1"/></transform>
+  <emitter type="area"><rgb name="radiance" value="2"/></emitter></shape>
+)"));
+    ASSERT_EQ(s->shapes.size(), 2u);
+    const Material& plain = s->materials[size_t(s->shapes[0].materialId)];
+    const Material& emitter = s->materials[size_t(s->shapes[1].materialId)];
+    EXPECT_EQ(plain.type, MaterialType::Diffuse);
+    EXPECT_EQ(plain.diffuse.x, 0.5f);
+    EXPECT_FALSE(plain.twoSided);
+    EXPECT_EQ(emitter.type, MaterialType::Diffuse);
+    EXPECT_EQ(maxComponent(emitter.diffuse), 0.0f);
+    EXPECT_GE(s->shapes[1].lightId, 0);
 }
 
 // Only regular files are included: /dev/zero never ends (reading it hung and filled memory).

@@ -174,7 +174,7 @@ TEST(JsonLoader, MaterialsOfEveryTypeKeepTheirParameters) {
         "glass": {"type": "dielectric", "ior": 1.33},
         "gold": {"type": "rough_conductor", "metal": "gold", "alpha": 0.2},
         "custom": {"type": "rough_conductor", "eta": [1, 2, 3], "k": 4, "alpha": 0.5, "tint": 0.5},
-        "frosted": {"type": "rough_dielectric", "ior": 1.5, "alpha": 0.3})json";
+        "frosted": {"type": "rough_dielectric", "ior": 1.5, "alpha": 0.3, "masking": "separable"})json";
     auto scene =
         loadJsonSceneFromString(sceneWith(materials, kRect, kPoint), "scene.json", kDataDir);
     const auto& m = scene->materials;
@@ -200,6 +200,8 @@ TEST(JsonLoader, MaterialsOfEveryTypeKeepTheirParameters) {
     EXPECT_FLOAT_EQ(m[5].specular.x, 0.5f);
     EXPECT_EQ(m[6].type, MaterialType::RoughDielectric);
     EXPECT_FLOAT_EQ(m[6].alpha, 0.3f);
+    EXPECT_FALSE(m[4].separableMasking);  // default: height-correlated
+    EXPECT_TRUE(m[6].separableMasking);
 }
 
 TEST(JsonLoader, LightsOfEveryType) {
@@ -502,9 +504,13 @@ TEST(JsonLoaderErrors, MaterialParametersOutOfRange) {
         "c": {"type": "rough_conductor", "metal": "gold", "alpha": -0.1},
         "d": {"type": "phong", "diffuse_reflectance": 0.5, "glossy_reflectance": [0.2, 0.6, 0.2], "exponent": 0},
         "e": {"type": "rough_conductor", "metal": "tin", "alpha": 0.1},
-        "f": {"type": "rough_conductor", "alpha": 0.1})json",
+        "f": {"type": "rough_conductor", "alpha": 0.1},
+        "g": {"type": "rough_conductor", "metal": "gold", "alpha": 0.1, "masking": "smith"})json",
         kRect, kPoint));
-    ASSERT_EQ(d.size(), 7u);
+    ASSERT_EQ(d.size(), 8u);
+    EXPECT_EQ(d[7].where, "/materials/g/masking");
+    EXPECT_EQ(d[7].message,
+              "unknown masking 'smith' (expected \"height_correlated\" or \"separable\")");
     EXPECT_EQ(d[0].format(),
               "scene.json:4:44: error: at /materials/a/ior: expected a number > 0, got 0");
     EXPECT_EQ(d[1].message, "expected a number in (0, 1], got 0");

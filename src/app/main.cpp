@@ -229,8 +229,9 @@ int run(int argc, char** argv) {
         ->type_name("A");
     compare
         ->add_option("--variance-radius", ca.varianceRadius,
-                     "Pool the image variance over (2R+1)^2 pixels (needs --image-var; guards "
-                     "against heavy-tailed estimators; default 0: per pixel)")
+                     "Image variance of a pixel: the larger of its own and the mean over its "
+                     "(2R+1)^2 neighbourhood (needs --image-var; guards against heavy-tailed "
+                     "estimators; default 0: its own)")
         ->check(CLI::Range(0, 8))
         ->type_name("R");
 

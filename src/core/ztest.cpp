@@ -39,8 +39,8 @@ ZTestResult zTest(const Image& image, const Image* imageVariance, const Image& r
     r.tests = size_t(reference.width) * reference.height * 3;
     // 1 - (1 - alpha)^(1/m) without cancellation: -expm1(log1p(-alpha) / m).
     r.perTestLevel = -std::expm1(std::log1p(-o.alpha) / double(r.tests));
-    // Image variance of each (pixel, channel): its own or pooled over the neighbourhood
-    // (see the header), each per-pixel value floored first.
+    // Image variance of each (pixel, channel): its own, or the larger of its own and the
+    // neighbourhood mean (see the header), each per-pixel value floored first.
     auto floored = [&](int x, int y, int c) {
         return std::max(double(imageVariance->at(x, y)[c]), o.varianceFloor);
     };
@@ -78,7 +78,7 @@ ZTestResult zTest(const Image& image, const Image* imageVariance, const Image& r
                 // slightly negative value; the floor below covers it.
                 varRef = std::max(varRef, o.varianceFloor);
                 varImg = std::max(varImg, o.varianceFloor);
-                if (o.varianceRadius > 0) varImg = pooledVariance(x, y, c);
+                if (o.varianceRadius > 0) varImg = std::max(varImg, pooledVariance(x, y, c));
                 double var = varImg / o.samples;
                 if (o.referenceSamples > 0) var += varRef / o.referenceSamples;
                 const double z = var > 0 ? (v - ref) / std::sqrt(var)

@@ -20,11 +20,15 @@
 // the few pixels where the rare paths did not occur test too small and too
 // certain, so a correct image fails far more often than alpha says (measured on
 // test_homo_spectral_sigmat: see tests/mitsuba_reference_test.cpp). With
-// varianceRadius = r > 0 the image's per-sample variance of a pixel is the mean
-// of the (floored) per-pixel variances over its (2r+1)^2 neighbourhood (clipped
-// at the borders): an estimate from ~(2r+1)^2 n samples where the variance is
-// smooth in image space. It is still the image's own variance, not the
-// reference's, and the mean itself is still tested per pixel.
+// varianceRadius = r > 0 the image variance of a pixel is the larger of its own
+// and the mean of the (floored) per-pixel variances over its (2r+1)^2
+// neighbourhood (clipped at the borders). The neighbourhood mean is an estimate
+// from ~(2r+1)^2 n samples where the variance is smooth in image space; the
+// pixel's own value keeps a high-variance pixel next to low-variance ones (the
+// edge of a light seen directly) from being tested with its neighbours' smaller
+// variance. Taking the larger makes the test conservative, never more likely to
+// reject. It is still the image's own variance, not the reference's, and the
+// mean itself is still tested per pixel.
 //
 // Multiple comparisons: the family of m = pixels x 3 channel tests is held at
 // level alpha with Sidak's correction, i.e. each test is rejected when
@@ -45,7 +49,7 @@ struct ZTestOptions {
     double samples = 1;            ///< n: iterations averaged into the image (>= 2 with var)
     double referenceSamples = 0;   ///< n_ref; 0 = exact reference
     double varianceFloor = 1e-4;   ///< lower bound on per-sample variances
-    int varianceRadius = 0;        ///< image variance pooled over (2r+1)^2 pixels; 0 = per pixel
+    int varianceRadius = 0;        ///< max(own, mean over (2r+1)^2 pixels); 0 = per pixel
 };
 
 struct ZTestFailure {

@@ -265,7 +265,8 @@ Rgb Bsdf::evalRoughConductor(const Vec3& gen, float* directPdfW, float* reverseP
     const Vec3 h = normalize(fix + gen);  // h.z > 0 and fix.h = gen.h > 0 here
     const float cosFixH = dot(fix, h), cosGenH = dot(gen, h);
     const float d = ub_ggx_d(h.z, alpha);
-    const float g2 = ub_ggx_g2_correlated(fix.z, gen.z, alpha);
+    const float g2 = mat_->separableMasking ? ub_ggx_g2_separable(fix.z, gen.z, alpha)
+                                            : ub_ggx_g2_correlated(fix.z, gen.z, alpha);
     // Visible-normal density times the reflection Jacobian (Walter eq. 14).
     *directPdfW = ub_ggx_visible_pdf(fix.z, cosFixH, h.z, alpha) * ub_jacobian_reflect(cosGenH);
     *reversePdfW = ub_ggx_visible_pdf(gen.z, cosGenH, h.z, alpha) * ub_jacobian_reflect(cosFixH);
@@ -299,8 +300,14 @@ Rgb Bsdf::evalRoughDielectric(const Vec3& gen, float* directPdfW, float* reverse
         const float fresnelGen = ub_fresnel_dielectric(aGen, etaOther_ / etaFix_);
         *directPdfW = fresnelFix * visFix * ub_jacobian_reflect(aGen);
         *reversePdfW = fresnelGen * visGen * ub_jacobian_reflect(aFix);
-        const float g2 = ub_ggx_g2_correlated(cFix, cGen, alpha);
-        return colors_.specular * (fresnelFix * d * g2 / (4.0f * cFix * cGen));
+        const float g2 = mat_->separableMasking ? ub_ggx_g2_separable(cFix, cGen, alpha)
+                                                : ub_ggx_g2_correlated(cFix, cGen, alpha);
+        // fix.h = gen.h in exact arithmetic; in floats they differ by ~1e-7, which near the
+        // critical angle (inside the glass) moves F by ~1e-4 relative. The value uses F at
+        // their mean so that f(fix, gen) = f(gen, fix) exactly (reciprocity); the pdfs above
+        // keep F(fix.h), the probability the sampler used.
+        const float fresnelSym = ub_fresnel_dielectric(0.5f * (aFix + aGen), etaOther_ / etaFix_);
+        return colors_.specular * (fresnelSym * d * g2 / (4.0f * cFix * cGen));
     }
     // Refraction: gen is on the side of IOR etaGen = etaOther_. F(cos_i, eta) equals
     // F(cos_t, 1/eta); it is computed from the outside direction whichever of the two is

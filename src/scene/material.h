@@ -42,6 +42,11 @@ struct Material {
     Rgb eta{0.2f, 0.92f, 1.1f};     ///< RoughConductor: real part of the complex IOR (default: copper)
     Rgb k{3.9f, 2.45f, 2.14f};      ///< RoughConductor: imaginary part
     float alpha = 0.1f;             ///< GGX roughness (alpha = roughness^2 convention NOT used: alpha as given)
+    /// RoughConductor, RoughDielectric reflection: Smith masking-shadowing G2 separable,
+    /// G1(i) G1(o) (Mitsuba 3's choice; Walter 2007 eq. 23), instead of the default
+    /// height-correlated 1 / (1 + Lambda(i) + Lambda(o)) (Heitz 2014 eq. 99). Refraction
+    /// and RoughPlastic always use the separable form.
+    bool separableMasking = false;
     /// Two-sided: if true (default for opaque materials), the back side of a surface
     /// behaves like the front. Dielectrics ignore it: their inside is defined by the normal.
     /// ThinDielectric ignores it too: the sheet is the same from both sides.

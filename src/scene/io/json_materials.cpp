@@ -8,6 +8,17 @@ namespace ub {
 
 namespace {
 
+/// Optional "masking" of the rough GGX materials: "height_correlated" (default) or
+/// "separable" (Mitsuba 3's G1(i) G1(o)); see Material::separableMasking.
+bool readMasking(JsonReader& r, const Json& m, const std::string& ptr) {
+    const std::string v = r.getString(m, ptr, "masking", Presence::Optional);
+    if (v.empty() || v == "height_correlated") return false;
+    if (v == "separable") return true;
+    r.error(jsonPointerChild(ptr, "masking"),
+            "unknown masking '" + v + "' (expected \"height_correlated\" or \"separable\")");
+    return false;
+}
+
 /// Named metals for rough_conductor "metal": complex IOR n + ik sampled at
 /// 650 nm (R), 550 nm (G) and 450 nm (B) from measured tables (refractiveindex.info).
 /// The same numbers are listed in docs/scene-format.md.
@@ -115,9 +126,10 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         bool rough = type == "rough_dielectric";
         mat.type = rough ? MaterialType::RoughDielectric : MaterialType::Dielectric;
         keys.insert(keys.end(), {"ior", "tint"});
-        if (rough) keys.push_back("alpha");
+        if (rough) keys.insert(keys.end(), {"alpha", "masking"});
         r.checkKeys(m, ptr, keys, type + " material");
         mat.ior = r.getNumber(m, ptr, "ior", Presence::Required, NumberRange::positive(), 1.5f);
+        if (rough) mat.separableMasking = readMasking(r, m, ptr);
         colour("tint", Rgb(1.0f), &mat.specular, &mat.textures.specular);
         if (rough)
             mat.alpha = r.getNumber(m, ptr, "alpha", Presence::Required,
@@ -125,8 +137,9 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         mat.twoSided = false;  // the inside of a dielectric is defined by its normal
     } else if (type == "rough_conductor") {
         mat.type = MaterialType::RoughConductor;
-        keys.insert(keys.end(), {"metal", "eta", "k", "alpha", "tint", "two_sided"});
+        keys.insert(keys.end(), {"metal", "eta", "k", "alpha", "masking", "tint", "two_sided"});
         r.checkKeys(m, ptr, keys, "rough_conductor material");
+        mat.separableMasking = readMasking(r, m, ptr);
         const Json* metal = r.member(m, ptr, "metal", Presence::Optional, "");
         bool hasEta = m.contains("eta"), hasK = m.contains("k");
         if (metal) {

@@ -205,6 +205,7 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
     } else if (o.type == "roughconductor") {
         m.type = MaterialType::RoughConductor;
         m.alpha = readGgxAlpha(r, o);
+        m.separableMasking = true;  // Mitsuba's MicrofacetDistribution::G = G1(i) G1(o)
         if (!o.find("eta") && !o.find("k"))
             r.error(o.pos, o.label() + ": needs <rgb name=\"eta\"> and <rgb name=\"k\"> (named "
                                        "materials and 'none' are not supported)");
@@ -239,6 +240,7 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
         m.type = MaterialType::RoughDielectric;
         m.ior = readRelativeIor(r, o);
         m.alpha = readGgxAlpha(r, o);
+        m.separableMasking = true;  // Mitsuba's MicrofacetDistribution::G = G1(i) G1(o)
         m.specular = readDielectricTint(r, o);
     } else {
         r.unsupportedPlugin(o, kBsdfs);

@@ -46,12 +46,14 @@ private:
     void readShape(const XmlObject& o);
     void readEmitter(const XmlObject& o);
     int defaultMaterial();
+    int blackMaterial();
     int mediumId(const XmlObject& medium);
 
     MitsubaBuild& b_;
     XmlReader& r_;
     bool integratorSeen_ = false;
     int defaultMaterial_ = -1;
+    int blackMaterial_ = -1;
     const XmlObject* envObject_ = nullptr;
 };
 
@@ -261,6 +263,20 @@ int Builder::defaultMaterial() {
     return defaultMaterial_;
 }
 
+// Mitsuba gives a shape that carries an area emitter and no BSDF a black diffuse BSDF
+// (reflectance 0), not the grey default: an emitter does not reflect unless given a BSDF.
+int Builder::blackMaterial() {
+    if (blackMaterial_ < 0) {
+        Material m;
+        m.name = "emitter default (black diffuse)";
+        m.type = MaterialType::Diffuse;
+        m.diffuse = Rgb(0.0f);
+        m.twoSided = false;
+        blackMaterial_ = b_.scene.addMaterial(m);
+    }
+    return blackMaterial_;
+}
+
 void Builder::readShape(const XmlObject& o) {
     const size_t before = r_.errorCount();
     bool known = false;
@@ -328,13 +344,13 @@ void Builder::readShape(const XmlObject& o) {
         transformMesh(mesh, toWorld);
     }
 
+    const XmlObject* em = r_.child(o, "emitter", "");
     int materialId = -2;
     if (const XmlObject* bsdf = r_.child(o, "bsdf", "")) materialId = buildMitsubaBsdf(b_, *bsdf);
-    else materialId = defaultMaterial();
+    else materialId = em ? blackMaterial() : defaultMaterial();
 
     int lightId = -1;
     Light light;
-    const XmlObject* em = r_.child(o, "emitter", "");
     if (em) {
         if (em->type != "area") {
             r_.error(em->pos, "a shape can only carry an 'area' emitter, got '" + em->type + "'");
@@ -368,7 +384,9 @@ void Builder::readShape(const XmlObject& o) {
                                                     "invisible and is left out");
         return;
     }
-    if (materialId == -1 && em) materialId = defaultMaterial();  // null emitter: black surface
+    // A null BSDF on an emitter: Mitsuba lets rays pass through it; unibeam's area lights
+    // are opaque, so the surface is black (documented in docs/mitsuba.md).
+    if (materialId == -1 && em) materialId = blackMaterial();
     const bool imaginary = materialId == -1;  // null BSDF + medium: an index-matched boundary
     if (imaginary && em)
         r_.error(em->pos, o.label() + ": a shape with a null BSDF and a medium cannot emit");
