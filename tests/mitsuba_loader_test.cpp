@@ -414,6 +414,7 @@ TEST(MitsubaXml, NonUtf8PluginNameIsEscapedInTheMessage) {
     std::string e = errorsOf(scene(std::string(kLight) + "<shape type=\"cu\xff\xfe" "be\"/>\n"));
     EXPECT_TRUE(contains(e, "scene.xml:9:1: error: unsupported shape plugin 'cu\\xff\\xfebe'"))
         << e;
+}
 
 TEST(MitsubaXml, ShapesWithoutBsdfGetMitsubasDefaults) {
     // Mitsuba 3 (Shape's constructor): no BSDF gives a diffuse BSDF of reflectance 0.5, or 0
