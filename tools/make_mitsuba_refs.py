@@ -7,9 +7,12 @@ SCENE_ref_var.exr (per-sample variance, estimated from the spread of batch means
 var_sample = B * var(batch means of B samples)), 48x48, Mitsuba's `scalar_rgb` variant,
 and SCENE_ref.json with the Mitsuba version, sample count and batches.
 
+The scenes' inputs (textures/tiles.png, volumes/density.vol, volumes/albedo.vol) are
+written by --make-inputs, with Mitsuba's own writers.
+
 Usage (not run by the tests; the outputs are committed):
     python3 -m venv venv && venv/bin/pip install mitsuba==3.9.1 numpy
-    venv/bin/python tools/make_mitsuba_refs.py [--spp 4096] [SCENE.xml ...]
+    venv/bin/python tools/make_mitsuba_refs.py [--make-inputs] [--spp 4096] [SCENE.xml ...]
 """
 import argparse
 import json
@@ -38,14 +41,36 @@ def render_reference(path, spp, res):
     return mean, var_sample, time.time() - start
 
 
+def make_inputs(folder):
+    """A 16x16 sRGB texture and a 12^3 density grid with a 3-channel albedo grid."""
+    (folder / "textures").mkdir(exist_ok=True)
+    (folder / "volumes").mkdir(exist_ok=True)
+    x = np.linspace(0, 1, 16)
+    X, Y = np.meshgrid(x, x)
+    img = np.stack([0.2 + 0.6 * X, 0.3 + 0.5 * Y, 0.6 - 0.4 * X * Y], -1)
+    img[::4, :, :] *= 0.3
+    mi.Bitmap((img * 255).astype(np.uint8), pixel_format=mi.Bitmap.PixelFormat.RGB).write(
+        str(folder / "textures" / "tiles.png"))
+    n = 12
+    c = (np.arange(n) + 0.5) / n
+    Z, Yv, Xv = np.meshgrid(c, c, c, indexing="ij")  # VolumeGrid data is [z][y][x][channel]
+    dens = np.exp(-((Xv - 0.45) ** 2 + (Yv - 0.55) ** 2 + (Z - 0.5) ** 2) / 0.08) + 0.15 * Yv
+    mi.VolumeGrid(dens[..., None].astype(np.float32)).write(str(folder / "volumes" / "density.vol"))
+    alb = np.stack([0.95 - 0.6 * Xv, 0.4 + 0.5 * Yv, 0.9 * np.ones_like(Xv)], -1)
+    mi.VolumeGrid(alb.astype(np.float32)).write(str(folder / "volumes" / "albedo.vol"))
+
+
 def main():
     here = pathlib.Path(__file__).resolve().parent.parent / "tests" / "data" / "mitsuba"
     ap = argparse.ArgumentParser()
     ap.add_argument("--spp", type=int, default=4096)
     ap.add_argument("--res", type=int, default=48)
+    ap.add_argument("--make-inputs", action="store_true")
     ap.add_argument("scenes", nargs="*")
     args = ap.parse_args()
     mi.set_variant("scalar_rgb")
+    if args.make_inputs:
+        make_inputs(here)
     scenes = [pathlib.Path(s) for s in args.scenes] or sorted(
         p for p in here.glob("*.xml") if not p.name.startswith("include_"))
     for path in scenes:
