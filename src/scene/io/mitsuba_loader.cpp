@@ -47,6 +47,7 @@ private:
     void readEmitter(const XmlObject& o);
     int defaultMaterial();
     int blackMaterial();
+    int oneSidedDiffuse(float reflectance, const char* name, int* cachedId);
     int mediumId(const XmlObject& medium);
 
     MitsubaBuild& b_;
@@ -251,30 +252,27 @@ int Builder::mediumId(const XmlObject& med) {
     return id;
 }
 
-int Builder::defaultMaterial() {
-    if (defaultMaterial_ < 0) {
-        Material m;  // Mitsuba's default: one-sided diffuse, reflectance 0.5
-        m.name = "default diffuse";
+// Mitsuba's BSDF for a shape that names none: one-sided diffuse of reflectance 0.5, or 0
+// (black) when the shape carries an area emitter: an emitter does not reflect unless given
+// a BSDF. Each is added to the scene once, on first use.
+int Builder::oneSidedDiffuse(float reflectance, const char* name, int* cachedId) {
+    if (*cachedId < 0) {
+        Material m;
+        m.name = name;
         m.type = MaterialType::Diffuse;
-        m.diffuse = Rgb(0.5f);
+        m.diffuse = Rgb(reflectance);
         m.twoSided = false;
-        defaultMaterial_ = b_.scene.addMaterial(m);
+        *cachedId = b_.scene.addMaterial(m);
     }
-    return defaultMaterial_;
+    return *cachedId;
 }
 
-// Mitsuba gives a shape that carries an area emitter and no BSDF a black diffuse BSDF
-// (reflectance 0), not the grey default: an emitter does not reflect unless given a BSDF.
+int Builder::defaultMaterial() {
+    return oneSidedDiffuse(0.5f, "default diffuse", &defaultMaterial_);
+}
+
 int Builder::blackMaterial() {
-    if (blackMaterial_ < 0) {
-        Material m;
-        m.name = "emitter default (black diffuse)";
-        m.type = MaterialType::Diffuse;
-        m.diffuse = Rgb(0.0f);
-        m.twoSided = false;
-        blackMaterial_ = b_.scene.addMaterial(m);
-    }
-    return blackMaterial_;
+    return oneSidedDiffuse(0.0f, "emitter default (black diffuse)", &blackMaterial_);
 }
 
 void Builder::readShape(const XmlObject& o) {
