@@ -3,16 +3,16 @@
 # .ci/run, whose time is limited). Configures ./build-asan (RelWithDebInfo, UNIBEAM_SANITIZE=ON,
 # every UB finding fatal), builds the CLI and the test binary, then runs the fast tests under
 # the sanitizers with leak checking. A full build takes long (ASan objects share nothing with
-# the ccache of the Release build): on 2 cores, about an hour.
+# the ccache of the Release build): on 2 shared cores, about an hour. The run itself is short:
+# the whole suite took 4.3 minutes under ASan (the fast tests 1.1 minutes).
 #
-# Usage: scripts/sanitize.sh [GTEST_FILTER]
-#   default filter: every test but the render-heavy ones (renders are ~10x slower under ASan).
-#   scripts/sanitize.sh '*'   runs everything.
+# Usage: scripts/sanitize.sh [GTEST_FILTER]     (default: every test)
+#   scripts/sanitize.sh '-*MitsubaReference*:*Bidir*:*Vpt*:Pt.*:*Upbp*:*Vcm*'  skips renders.
 # Environment: JOBS (parallel compile jobs, default 2).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-FILTER="${1:--*MitsubaReference*:*Bidir*:*Vpt*:Pt.*:*Upbp*:*Vcm*:Cli.SigintWritesImageAndExitsZero}"
+FILTER="${1:-*}"
 JOBS="${JOBS:-2}"
 
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DUNIBEAM_SANITIZE=ON \

@@ -85,6 +85,8 @@ Bsdf makeBsdf(const Material& m, const Vec3& dirFix, bool fromLight = false) {
     b.setup(m, dirFix, kNormal, kNormal, fromLight);
     return b;
 }
+// A Bsdf keeps a pointer to its material: a temporary would dangle.
+Bsdf makeBsdf(Material&&, const Vec3&, bool = false) = delete;
 
 struct Config {
     std::shared_ptr<const NamedMaterial> m;

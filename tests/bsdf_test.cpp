@@ -116,6 +116,8 @@ Bsdf makeBsdf(const Material& m, const Vec3& dirFix, bool fromLight, const Vec3&
     b.setup(m, dirFix, ng, ns, fromLight);
     return b;
 }
+// A Bsdf keeps a pointer to its material: a temporary would dangle (ASan found one).
+Bsdf makeBsdf(Material&&, const Vec3&, bool, const Vec3& = kNormal, const Vec3& = kNormal) = delete;
 
 struct Config {
     std::shared_ptr<const NamedMaterial> m;
@@ -472,7 +474,8 @@ TEST(Bsdf, DielectricFresnelSelectionSnellAndRadianceScaling) {
 // From the dense side beyond the critical angle (41.8 deg for 1.5) every sample reflects
 // with weight 1.
 TEST(Bsdf, DielectricTotalInternalReflection) {
-    Bsdf b = makeBsdf(glass(1.5f), directionAt(kNormal, 60.0f, -1.0f), false);
+    const Material m = glass(1.5f);  // outlives b, which points to it
+    Bsdf b = makeBsdf(m, directionAt(kNormal, 60.0f, -1.0f), false);
     Rng rng(1, 1);
     for (int i = 0; i < 1000; ++i) {
         Vec3 dir;
