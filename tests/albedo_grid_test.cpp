@@ -293,8 +293,8 @@ TEST(AlbedoGrid, TwoHalvesMatchTwoHomogeneousMedia) {
 // means |z| < 3.9 per channel (bounds and standard errors as TwoHalvesMatchTwoHomogeneousMedia).
 TEST(AlbedoGrid, MitsubaAlbedoVolSceneVbptAgreesWithVpt) {
     const std::string dir =
-        std::string(UNIBEAM_SHARED_DIR) + "/scenes/mitsuba/tests/scenes/participating_media";
-    if (!fs::is_directory(dir)) GTEST_SKIP() << "shared scenes not present";
+        std::string(UNIBEAM_MITSUBA_MEDIA_DIR);
+    ASSERT_TRUE(fs::is_directory(dir)) << "test data not found: " << dir;
     const std::string toWorld = R"(<transform name="to_world">
         <scale x="1.5" y="1.5" z="1.5"/><translate x="-0.75" y="-0.75" z="-0.75"/></transform>)";
     const std::string xml = R"(<scene version="3.0.0">

@@ -153,8 +153,8 @@ TEST(MitsubaAlbedo, SharedTestAlbedoVolMatchesTheFile) {
     // The RGB albedo.vol of Mitsuba's participating-media tests (16^3 x 3): at voxel centres
     // the trilinear lookup returns the stored values.
     const std::string dir =
-        std::string(UNIBEAM_SHARED_DIR) + "/scenes/mitsuba/tests/scenes/participating_media";
-    if (!fs::is_directory(dir)) GTEST_SKIP() << "shared scenes not present";
+        std::string(UNIBEAM_MITSUBA_MEDIA_DIR);
+    ASSERT_TRUE(fs::is_directory(dir)) << "test data not found: " << dir;
     auto s = loadXml(xmlScene(heterogeneous(gridVolume("sigma_t", "textures/sigmat.vol"),
                                             gridVolume("albedo", "textures/albedo.vol"))),
                      dir);

@@ -247,7 +247,7 @@ TEST(BidirEngine, RadiusFollowsProgressiveSchedule) {
 }
 
 // The stored light vertices carry the partials of [TR (31)-(36)]: with vcm both connection
-// and merging are on, so dVM = dVC / eta at every vertex (shared/notes/mis.md Sec. 2.3).
+// and merging are on, so dVM = dVC / eta at every vertex (Georgiev et al. 2012, tech. report Sec. 3).
 TEST(BidirEngine, StoredLightVerticesKeepMergeToConnectRatio) {
     auto scene = loadCornell("cornell-small-light.json", 16);
     RenderOptions opt = bidirOptions("vcm", 3);

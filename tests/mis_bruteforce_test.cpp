@@ -1,7 +1,7 @@
 // The recursive MIS weights of kernels/shared/ub_mis.h (Georgiev et al. 2012,
 // tech. report "Implementing VCM") against weights computed from the explicit
 // area pdfs of every technique that could have sampled a path
-// (tests/support/mis_path.h, shared/notes/mis.md Sec. 4).
+// (tests/support/mis_path.h, docs/mis.md, "Brute-force weights").
 //
 // Tolerance: the recursion runs in float, the reference in double. Each weight
 // is a ratio of sums of products of < 20 positive factors, each rounded with

@@ -361,10 +361,9 @@ TEST(MitsubaXml, MediaOnShapesBecomeBoundaries) {
 }
 
 TEST(MitsubaXml, SharedTestScenesLoad) {
-    // Every Mitsuba scene in ../shared loads without errors (the reference test renders them).
-    const std::string dir = std::string(UNIBEAM_SHARED_DIR) +
-                            "/scenes/mitsuba/tests/scenes/participating_media";
-    if (!fs::is_directory(dir)) GTEST_SKIP() << "shared scenes not present";
+    // Every Mitsuba scene of tests/data/mitsuba-data loads without errors (the reference test renders them).
+    const std::string dir = std::string(UNIBEAM_MITSUBA_MEDIA_DIR);
+    ASSERT_TRUE(fs::is_directory(dir)) << "test data not found: " << dir;
     int n = 0;
     for (const auto& e : fs::directory_iterator(dir)) {
         if (e.path().extension() != ".xml") continue;
@@ -438,7 +437,7 @@ TEST(MitsubaXml, ShapesWithoutBsdfGetMitsubasDefaults) {
 
 // Only regular files are included: /dev/zero never ends (reading it hung and filled memory).
 TEST(MitsubaXml, IncludeOfADeviceIsAnError) {
-    if (!fs::exists("/dev/zero")) GTEST_SKIP() << "no /dev/zero";
+    ASSERT_TRUE(fs::exists("/dev/zero")) << "/dev/zero not found";
     std::string e = errorsOf(scene("<include filename=\"/dev/zero\"/>\n" + std::string(kLight)));
     EXPECT_TRUE(contains(e, "scene.xml:8:1: error: cannot open the included file '/dev/zero' (not "
                             "a readable regular file)"))

@@ -1,5 +1,5 @@
 // Cross-renderer check (correctness ladder, step 4): Mitsuba 3's participating-
-// media test scenes (../shared/scenes/mitsuba, refs rendered by Mitsuba 3's
+// media test scenes (tests/data/mitsuba-data, refs rendered by Mitsuba 3's
 // `rgb` variant at 48x48) rendered by unibeam's `vpt` and `vbpt` pass the
 // per-pixel z-test of core/ztest.h against the reference mean and variance.
 //
@@ -33,8 +33,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kDir =
-    std::string(UNIBEAM_SHARED_DIR) + "/scenes/mitsuba/tests/scenes/participating_media";
+const std::string kDir = UNIBEAM_MITSUBA_MEDIA_DIR;
 
 struct RefCase {
     const char* scene;  ///< file in kDir
@@ -118,12 +117,12 @@ class MitsubaReference : public ::testing::TestWithParam<RefCase> {};
 }  // namespace
 
 TEST_P(MitsubaReference, VptPassesPerPixelZTest) {
-    if (!fs::is_directory(kDir)) FAIL() << "shared Mitsuba scenes not found at " << kDir;
+    if (!fs::is_directory(kDir)) FAIL() << "Mitsuba test scenes not found at " << kDir;
     expectPasses(renderAndTest(GetParam(), "vpt", GetParam().iterations));
 }
 
 TEST_P(MitsubaReference, VbptPassesPerPixelZTest) {
-    if (!fs::is_directory(kDir)) FAIL() << "shared Mitsuba scenes not found at " << kDir;
+    if (!fs::is_directory(kDir)) FAIL() << "Mitsuba test scenes not found at " << kDir;
     const RefCase& c = GetParam();
     expectPasses(renderAndTest(c, "vbpt", c.vbptIterations > 0 ? c.vbptIterations
                                                                 : c.iterations));

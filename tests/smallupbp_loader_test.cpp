@@ -1,5 +1,5 @@
 // SmallUPBP scenes (.obj + .mtl + .obj.aux): the three paper/gpuupbp scenes in
-// shared/scenes/smallupbp load with the counts and camera of their files and render
+// scenes/smallupbp load with the counts and camera of their files and render
 // finite images with vpt; every class of bad input gives its message with
 // file:line:column; the environment-map frame reproduces SmallUPBP's lookup.
 #include "scene/io/smallupbp_loader.h"
@@ -21,8 +21,7 @@ using namespace ub;
 
 namespace {
 
-const std::string kSharedScenes = std::string(UNIBEAM_SHARED_DIR) + "/scenes/smallupbp";
-const std::string kUnpacked = UNIBEAM_SMALLUPBP_DIR;  // bunny, mirrorballs (tests/CMakeLists.txt)
+const std::string kScenes = std::string(UNIBEAM_SCENES_DIR) + "/smallupbp";
 
 bool contains(const std::string& s, const std::string& part) {
     return s.find(part) != std::string::npos;
@@ -146,7 +145,7 @@ const ShapeInfo* shapeNamed(const Scene& s, const std::string& name) {
 // ---- the three scenes -----------------------------------------------------------
 
 TEST(SmallUpbpScenes, CandleLoadsAsWritten) {
-    const std::string path = kSharedScenes + "/candle/candle.obj";
+    const std::string path = kScenes + "/candle/candle.obj";
     ASSERT_TRUE(fs::is_regular_file(path)) << path;
     std::vector<Diagnostic> w;
     auto scene = loadScene(path, &w);
@@ -180,8 +179,8 @@ TEST(SmallUpbpScenes, CandleLoadsAsWritten) {
 }
 
 TEST(SmallUpbpScenes, MirrorballsLoadsAsWritten) {
-    const std::string path = kUnpacked + "/mirrorballs/mirrorballs.obj";
-    ASSERT_TRUE(fs::is_regular_file(path)) << path << " (unpacked by the build)";
+    const std::string path = kScenes + "/mirrorballs/mirrorballs.obj";
+    ASSERT_TRUE(fs::is_regular_file(path)) << path;
     std::vector<Diagnostic> w;
     auto scene = loadScene(path, &w);
     EXPECT_EQ(scene->materials.size(), 9u);
@@ -209,8 +208,8 @@ TEST(SmallUpbpScenes, MirrorballsLoadsAsWritten) {
 }
 
 TEST(SmallUpbpScenes, BunnyLoadsAsWritten) {
-    const std::string path = kUnpacked + "/bunny/bunny.obj";
-    ASSERT_TRUE(fs::is_regular_file(path)) << path << " (unpacked by the build)";
+    const std::string path = kScenes + "/bunny/bunny.obj";
+    ASSERT_TRUE(fs::is_regular_file(path)) << path;
     std::vector<Diagnostic> w;
     auto scene = loadScene(path, &w);
     EXPECT_EQ(scene->materials.size(), 9u);

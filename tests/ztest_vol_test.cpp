@@ -213,9 +213,8 @@ TEST(VolFile, HeaderValidationMessages) {
 }
 
 TEST(VolFile, SharedSceneGridReads) {
-    std::string path = std::string(UNIBEAM_SHARED_DIR) +
-                       "/scenes/mitsuba/tests/scenes/participating_media/textures/sigmat.vol";
-    if (!fs::exists(path)) GTEST_SKIP() << "shared scenes not present";
+    std::string path = std::string(UNIBEAM_MITSUBA_MEDIA_DIR) + "/textures/sigmat.vol";
+    ASSERT_TRUE(fs::is_regular_file(path)) << "test data not found: " << path;
     VolGrid v = readVolFile(path);
     EXPECT_EQ(v.nx, 16);
     EXPECT_EQ(v.channels, 1);

@@ -36,7 +36,7 @@
  * "Metropolis Light Transport for Participating Media"; Krivanek et al. 2014,
  * UPBP, Sec. 4), every area pdf of a vertex becomes a volume pdf there, and
  * every vertex pdf gains the distance-sampling pdf of the segment that led to
- * it (shared/notes/mis.md Sec. 1):
+ * it (docs/mis.md, "Notation"):
  *   p(x_i) = p_W(x_{i-1}) * D_i * T_i / d_i^2,
  * with D_i = |cos| at a surface vertex and 1 at a medium vertex, and T_i the
  * free-flight pdf of the segment chain from x_{i-1} (scene/medium_trace.h):
@@ -58,7 +58,7 @@
  * vertex where the sampling would happen. "dir" pdfs sample the direction in
  * which the subpath is being extended; "rev" pdfs sample the opposite way.
  * Light pdfs (directPdfA, emissionPdfW) include the light selection
- * probability. See shared/notes/mis.md for a derivation-level summary.
+ * probability. See docs/mis.md for a derivation-level summary.
  */
 #ifndef UB_MIS_H
 #define UB_MIS_H
@@ -148,7 +148,7 @@ UB_INLINE ub_mis_partials ub_mis_init_camera(ub_mis_constants c, float cameraPdf
  * sampled the other way, from the new vertex back to the previous one (stopping there if
  * it is a medium vertex). The forward pdf completes p(x_i) in dVCM = 1/p(x_i) and in the
  * ratio p(x_{i-1} from x_i) / p(x_i) that dVC and dVM carry; the reverse pdf belongs to
- * that ratio's numerator (shared/notes/mis.md Sec. 1, a_i and b_{i-1}). */
+ * that ratio's numerator (docs/mis.md, "Notation", a_i and b_{i-1}). */
 UB_INLINE ub_mis_partials ub_mis_at_hit_media(ub_mis_constants c, ub_mis_partials p, float dist,
                                               float cosFix, int applyDistSqr, float distPdfFwd,
                                               float distPdfRev) {

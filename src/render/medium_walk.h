@@ -8,7 +8,7 @@
 // segment) visits the segments in order and either stops in segment k at
 // distance t, making a medium vertex x_i, or passes them all and x_i is the real
 // hit. With P_j the pass probability of segment j and p_k(t) the scatter density
-// of segment k (Novak et al. 2018, Sec. 5.1; shared/notes/mis.md Sec. 1):
+// of segment k (Novak et al. 2018, Sec. 5.1; docs/mis.md, "Notation"):
 //   forward  (x_{i-1} -> x_i):  prod_{j<k} P_j * p_k(t)   medium vertex
 //                               prod_j P_j                surface / escape
 //   reverse  (x_i -> x_{i-1}):  the same product over the segments between the

@@ -4,7 +4,7 @@
 // ways to compute the MIS weight of every technique that could have produced it:
 //
 //  * bruteForceWeights: from explicit area pdfs of every technique (Veach 1997,
-//    Ch. 10; shared/notes/mis.md Sec. 4), in double precision:
+//    Ch. 10; docs/mis.md, "Brute-force weights"), in double precision:
 //      connection s (s light vertices): P_s = (prod_{j<s} a~_j) (prod_{j>=s} b_j),
 //      merging at x_i:                  M_i = (prod_{j<=i} a_j) (prod_{j>=i} b_j) eta,
 //    with a~_0 = a_0^NEE for s = 1, eta = N_L pi r^2, counts n = 1 (connections),
@@ -16,8 +16,8 @@
 // specular), and each segment x_{i-1} x_i carries the free-flight pdfs of both
 // directions, distFwd[i] (from x_{i-1}, stopping at x_i if it is a medium vertex,
 // passing otherwise) and distRev[i] (from x_i, stopping at or passing x_{i-1}); then
-// a_i gains distFwd[i] and b_{i-1} gains distRev[i] (ub_mis.h, MEDIA; notes/mis.md
-// Sec. 1). Merging (surface photon mapping) is not a technique at medium vertices.
+// a_i gains distFwd[i] and b_{i-1} gains distRev[i] (ub_mis.h, MEDIA; docs/mis.md,
+// "Notation"). Merging (surface photon mapping) is not a technique at medium vertices.
 //
 // Only tests use this file.
 #pragma once
