@@ -72,7 +72,9 @@ void transmittanceLoop(benchmark::State& state, const ub::Medium& m) {
     state.SetItemsProcessed(state.iterations());
 }
 
-void BM_TransmittanceSmokeVdb(benchmark::State& state) { transmittanceLoop(state, smoke()); }
+void BM_TransmittanceSmokeVdb(benchmark::State& state) {
+    transmittanceLoop(state, smoke());
+}
 void BM_TransmittanceHomogeneous(benchmark::State& state) {
     transmittanceLoop(state, homogeneous());
 }

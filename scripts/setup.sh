@@ -11,7 +11,7 @@ PACKAGES=(
   libopenvdb-dev libnanovdb-dev libboost-iostreams-dev
   ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd clinfo
   nlohmann-json3-dev libcli11-dev libtinyobjloader-dev libassimp-dev libpugixml-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev clang-format
 )
 
 missing=()

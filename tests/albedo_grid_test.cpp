@@ -292,8 +292,7 @@ TEST(AlbedoGrid, TwoHalvesMatchTwoHomogeneousMedia) {
 // 24x24 pixels, blocks of 4x4: 108 z-tests, Sidak family-wise level 1e-3 (|z| < 4.4), image
 // means |z| < 3.9 per channel (bounds and standard errors as TwoHalvesMatchTwoHomogeneousMedia).
 TEST(AlbedoGrid, MitsubaAlbedoVolSceneVbptAgreesWithVpt) {
-    const std::string dir =
-        std::string(UNIBEAM_MITSUBA_MEDIA_DIR);
+    const std::string dir = std::string(UNIBEAM_MITSUBA_MEDIA_DIR);
     ASSERT_TRUE(fs::is_directory(dir)) << "test data not found: " << dir;
     const std::string toWorld = R"(<transform name="to_world">
         <scale x="1.5" y="1.5" z="1.5"/><translate x="-0.75" y="-0.75" z="-0.75"/></transform>)";

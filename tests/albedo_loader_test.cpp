@@ -152,8 +152,7 @@ TEST(MitsubaAlbedo, VolAlbedoGridHasItsOwnTransformAndFilter) {
 TEST(MitsubaAlbedo, SharedTestAlbedoVolMatchesTheFile) {
     // The RGB albedo.vol of Mitsuba's participating-media tests (16^3 x 3): at voxel centres
     // the trilinear lookup returns the stored values.
-    const std::string dir =
-        std::string(UNIBEAM_MITSUBA_MEDIA_DIR);
+    const std::string dir = std::string(UNIBEAM_MITSUBA_MEDIA_DIR);
     ASSERT_TRUE(fs::is_directory(dir)) << "test data not found: " << dir;
     auto s = loadXml(xmlScene(heterogeneous(gridVolume("sigma_t", "textures/sigmat.vol"),
                                             gridVolume("albedo", "textures/albedo.vol"))),
@@ -176,12 +175,12 @@ TEST(MitsubaAlbedo, ConstantSigmaTWithAnAlbedoGrid) {
     // (inside and outside the grid's one voxel), sigma_s = albedo(x) sigma_t.
     ScratchDir dir;
     writeVolFiles(dir);
-    auto s = loadXml(xmlScene(heterogeneous(
-                         "<float name=\"sigma_t\" value=\"2\"/><float name=\"scale\" "
-                         "value=\"1.5\"/>",
-                         gridVolume("albedo", "albedo.vol",
-                                    "<string name=\"filter_type\" value=\"nearest\"/>"))),
-                     dir.path.string());
+    auto s = loadXml(
+        xmlScene(heterogeneous("<float name=\"sigma_t\" value=\"2\"/><float name=\"scale\" "
+                               "value=\"1.5\"/>",
+                               gridVolume("albedo", "albedo.vol",
+                                          "<string name=\"filter_type\" value=\"nearest\"/>"))),
+        dir.path.string());
     const Medium& m = s->media[0];
     ASSERT_EQ(m.type, MediumType::kGrid);
     ASSERT_TRUE(m.albedoGrid);

@@ -247,7 +247,8 @@ TEST(BidirEngine, RadiusFollowsProgressiveSchedule) {
 }
 
 // The stored light vertices carry the partials of [TR (31)-(36)]: with vcm both connection
-// and merging are on, so dVM = dVC / eta at every vertex (Georgiev et al. 2012, tech. report Sec. 3).
+// and merging are on, so dVM = dVC / eta at every vertex (Georgiev et al. 2012, tech. report Sec.
+// 3).
 TEST(BidirEngine, StoredLightVerticesKeepMergeToConnectRatio) {
     auto scene = loadCornell("cornell-small-light.json", 16);
     RenderOptions opt = bidirOptions("vcm", 3);
@@ -283,8 +284,8 @@ TEST(BidirEngine, EnvironmentLightAgreesWithPt) {
         Agreement g = compare(s, ref);
         std::printf("[ bidir    ] %s vs pt on cornell-background 32x32: %s\n", name,
                     g.report.c_str());
-        EXPECT_GT(g.sidakMinP, 1e-3) << name << " block " << g.worstBlock << " channel "
-                                     << g.worstChannel;
+        EXPECT_GT(g.sidakMinP, 1e-3)
+            << name << " block " << g.worstBlock << " channel " << g.worstChannel;
         for (int c = 0; c < 3; ++c) {
             EXPECT_LT(std::fabs(g.meanZ[c]), 3.9) << name << " channel " << c;
             EXPECT_LT(s.imageStdErr(c), 0.0125 * ref.imageMean(c)) << name;

@@ -182,7 +182,8 @@ TEST(Cli, BadFlagsExitTwoWithMessage) {
         {{"render", kScene, "--radius", "-0.1", "-o", out}, "--radius"},
         {{"render", kScene, "--alpha", "1.5", "-o", out}, "--alpha"},
         // NaN or overflowing exposures made every PNG pixel garbage; a billion threads hung TBB.
-        {{"render", kScene, "--exposure", "nan", "-o", out}, "--exposure: expected a number in [-64, 64], got 'nan'"},
+        {{"render", kScene, "--exposure", "nan", "-o", out},
+         "--exposure: expected a number in [-64, 64], got 'nan'"},
         {{"render", kScene, "--exposure", "1e999", "-o", out}, "--exposure"},
         {{"render", kScene, "--threads", "999999999", "-o", out},
          "--threads: expected an integer in [1, 4096], got '999999999'"},

@@ -5,6 +5,8 @@
 // The reference values here never call the tracker under test: pieces of a
 // ray through a dense voxel block are found by brute force (every crossing of
 // a cell-boundary plane, sorted), and optical depth is summed over them.
+#include "scene/medium.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,7 +14,6 @@
 #include <vector>
 
 #include "core/rng.h"
-#include "scene/medium.h"
 #include "scene/vdb_grid.h"
 #include "tests/support/chi2.h"
 
@@ -208,8 +209,8 @@ TEST(Medium, ConstantGridMatchesHomogeneous) {
 // d/dt T_c = -sigma_t,c T_c; pass mass (1/3) sum_c T_c(tMax). tauRef(t) is the RGB optical
 // depth of the reference. Returns the p-value.
 template <typename TauRef>
-double freeFlightChi2(const Medium& m, const Vec3& o, const Vec3& dir, float tMax,
-                      TauRef&& tauRef, int samples, uint64_t seed) {
+double freeFlightChi2(const Medium& m, const Vec3& o, const Vec3& dir, float tMax, TauRef&& tauRef,
+                      int samples, uint64_t seed) {
     const int nBins = 40;
     std::vector<double> observed(nBins + 1, 0.0), expected(nBins + 1, 0.0);
     Rng rng(seed, 0);
@@ -224,7 +225,8 @@ double freeFlightChi2(const Medium& m, const Vec3& o, const Vec3& dir, float tMa
                3.0;
     };
     for (int b = 0; b < nBins; ++b)
-        expected[b] = samples * (avgT(double(tMax) * b / nBins) - avgT(double(tMax) * (b + 1) / nBins));
+        expected[b] =
+            samples * (avgT(double(tMax) * b / nBins) - avgT(double(tMax) * (b + 1) / nBins));
     expected[nBins] = samples * avgT(tMax);
     double stat = 0, pooledE = 0, pooledO = 0;
     int dof = 0;
@@ -281,8 +283,10 @@ TEST(Medium, FreeFlightChiSquareInGrid) {
         if (s.t - it->ta < 1e-5 || it->tb - s.t < 1e-5) continue;
         double pdfRef = scale * it->density * std::exp(-refOpticalDepth(pieces, s.t, scale));
         EXPECT_NEAR(s.pdf, pdfRef, 1e-4 * pdfRef) << "t = " << s.t;
-        EXPECT_NEAR(s.weight.x, 0.7 * std::exp(-refOpticalDepth(pieces, s.t, scale)) *
-                                    scale * it->density / pdfRef, 1e-4);
+        EXPECT_NEAR(
+            s.weight.x,
+            0.7 * std::exp(-refOpticalDepth(pieces, s.t, scale)) * scale * it->density / pdfRef,
+            1e-4);
         ++checked;
     }
     EXPECT_GT(checked, 1000);
@@ -337,8 +341,8 @@ TEST(Medium, ColouredSamplingUnbiased) {
         Rng rng(77, caseIndex++);
         double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
         for (int i = 0; i < n; ++i) {
-            FreeFlightSample s = sampleFreeFlight(m, Vec3(0.0f), Vec3(0, 1, 0), L, rng.uniform(),
-                                                  rng.uniform());
+            FreeFlightSample s =
+                sampleFreeFlight(m, Vec3(0.0f), Vec3(0, 1, 0), L, rng.uniform(), rng.uniform());
             for (int c = 0; c < 3; ++c) {
                 double x = s.weight[c] * (s.scattered ? double(s.t) : 1.0);
                 sum[c] += x;
@@ -347,9 +351,9 @@ TEST(Medium, ColouredSamplingUnbiased) {
         }
         for (int c = 0; c < 3; ++c) {
             double st = double(cs.sigmaA[c]) + cs.sigmaS[c], ss = cs.sigmaS[c];
-            double analytic = st > 0 ? ss / (st * st) * (1 - std::exp(-st * L) * (1 + st * L)) +
-                                           std::exp(-st * L)
-                                     : 1.0;
+            double analytic =
+                st > 0 ? ss / (st * st) * (1 - std::exp(-st * L) * (1 + st * L)) + std::exp(-st * L)
+                       : 1.0;
             double mean = sum[c] / n, var = std::max(0.0, sum2[c] / n - mean * mean);
             EXPECT_NEAR(mean, analytic, 4 * std::sqrt(var / n) + 1e-7)
                 << "case " << caseIndex - 1 << " channel " << c;

@@ -2,6 +2,8 @@
 // the density interpolates voxel centres with clamp-to-edge, the exact optical
 // depth agrees with numerical quadrature of the density, and free-flight
 // sampling inverts it.
+#include "scene/medium_trilinear.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,7 +11,6 @@
 #include <random>
 
 #include "scene/medium.h"
-#include "scene/medium_trilinear.h"
 
 using namespace ub;
 

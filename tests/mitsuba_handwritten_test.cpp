@@ -1,8 +1,8 @@
 // Cross-renderer check of the Mitsuba XML subset on scenes written by hand for it
 // (tests/data/mitsuba): BSDFs, textures, lights and media features (albedo grids, HG phase,
-// media inside glass) that Mitsuba's own participating-media test scenes do not use. The references were rendered by Mitsuba 3 itself
-// (tools/make_mitsuba_refs.py, scalar_rgb, 4096 samples per pixel; *_ref.json records the
-// version), never by unibeam.
+// media inside glass) that Mitsuba's own participating-media test scenes do not use. The references
+// were rendered by Mitsuba 3 itself (tools/make_mitsuba_refs.py, scalar_rgb, 4096 samples per
+// pixel; *_ref.json records the version), never by unibeam.
 //
 // Each render passes (i) the per-pixel z-test at alpha = 0.01 Sidak-corrected over
 // 48 x 48 x 3 tests, image variance pooled over 3x3 pixels (core/ztest.h), and (ii) the
@@ -33,7 +33,9 @@ struct HandCase {
     int iterations;         ///< a few seconds on two cores
 };
 
-void PrintTo(const HandCase& c, std::ostream* os) { *os << c.scene << " " << c.algorithm; }
+void PrintTo(const HandCase& c, std::ostream* os) {
+    *os << c.scene << " " << c.algorithm;
+}
 
 std::string caseName(const ::testing::TestParamInfo<HandCase>& info) {
     std::string s = std::string(info.param.scene) + "_" + info.param.algorithm;
@@ -48,8 +50,8 @@ std::string caseName(const ::testing::TestParamInfo<HandCase>& info) {
 // finds them by light tracing (measured: bpt +1% over the image, z = 19-27, max per-pixel
 // |z| 45 under the glass sphere). That is the reference missing light, not unibeam adding it.
 const HandCase kCases[] = {
-    {"surfaces", "pt", 512},   {"surfaces", "bpt", 256}, {"lights", "pt", 512},
-    {"media", "vpt", 256},     {"media", "vbpt", 128},
+    {"surfaces", "pt", 512}, {"surfaces", "bpt", 256}, {"lights", "pt", 512},
+    {"media", "vpt", 256},   {"media", "vbpt", 128},
 };
 
 class MitsubaHandWritten : public ::testing::TestWithParam<HandCase> {};
@@ -68,7 +70,8 @@ TEST_P(MitsubaHandWritten, MatchesMitsuba3Reference) {
     test::printReferenceCheck(std::string(c.scene) + " " + c.algorithm, check);
     EXPECT_TRUE(check.perPixel.passed) << "min p-value " << check.perPixel.minPValue;
     for (int ch = 0; ch < 3; ++ch)
-        EXPECT_LT(std::fabs(check.meanZ[ch]), kMeanZBound) << "channel " << "RGB"[ch];
+        EXPECT_LT(std::fabs(check.meanZ[ch]), kMeanZBound) << "channel "
+                                                           << "RGB"[ch];
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, MitsubaHandWritten, ::testing::ValuesIn(kCases), caseName);

@@ -3,13 +3,14 @@
 // transform order, camera, materials, emitters) and bad input gives the
 // documented message at the right file:line:column. Line/column numbers in the
 // expectations were counted by hand in the test texts.
+#include "scene/io/mitsuba_loader.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 
-#include "scene/io/mitsuba_loader.h"
 #include "scene/io/mitsuba_spectra.h"
 #include "scene/io/scene_loader.h"
 #include "scene/texture.h"
@@ -86,8 +87,10 @@ TEST(MitsubaXml, UndefinedParameterIsAnErrorWithPosition) {
   <integrator type="$algo"/>
 </scene>
 )");
-    EXPECT_TRUE(contains(e, "scene.xml:2:3: error: attribute 'type' uses the undefined parameter "
-                            "'$algo'")) << e;
+    EXPECT_TRUE(contains(e,
+                         "scene.xml:2:3: error: attribute 'type' uses the undefined parameter "
+                         "'$algo'"))
+        << e;
 }
 
 TEST(MitsubaXml, DefineOfUnknownParameterIsAnError) {
@@ -118,7 +121,8 @@ TEST(MitsubaXml, IncludeAndPathResolveFiles) {
     EXPECT_FLOAT_EQ(s->lights[0].radiance.x, 2.0f);
     ASSERT_EQ(s->shapes.size(), 1u);
 
-    std::string e = errorsOf(scene("<include filename=\"nope.xml\"/>\n" + std::string(kLight)), dir);
+    std::string e =
+        errorsOf(scene("<include filename=\"nope.xml\"/>\n" + std::string(kLight)), dir);
     EXPECT_TRUE(contains(e, "scene.xml:8:1: error: included file 'nope.xml' not found")) << e;
 }
 
@@ -134,8 +138,8 @@ TEST(MitsubaXml, RefsAttachObjectsAndUnknownIdsAreErrors) {
     EXPECT_FLOAT_EQ(m.diffuse.x, 0.8f);
     EXPECT_FALSE(m.twoSided);  // Mitsuba's diffuse is one-sided
 
-    std::string e = errorsOf(scene(std::string(kLight) +
-                                   "<shape type=\"cube\">\n  <ref id=\"blue\"/></shape>\n"));
+    std::string e = errorsOf(
+        scene(std::string(kLight) + "<shape type=\"cube\">\n  <ref id=\"blue\"/></shape>\n"));
     EXPECT_TRUE(contains(e, "scene.xml:10:3: error: <ref id=\"blue\">: no object with this id"))
         << e;
 }
@@ -154,11 +158,12 @@ TEST(MitsubaXml, TransformsComposeInMitsubaOrder) {
     EXPECT_NEAR(t->shapes[0].bounds.lo.x, 4.0f, 1e-5f);
     EXPECT_NEAR(t->shapes[0].bounds.hi.x, 8.0f, 1e-5f);
     // rotate 90 degrees about z maps +x to +y; matrix gives a translation by (0, 0, 7).
-    auto r = load(scene(std::string(kLight) +
-                        "<shape type=\"sphere\"><point name=\"center\" x=\"1\" y=\"0\" z=\"0\"/>"
-                        "<float name=\"radius\" value=\"0.5\"/><transform name=\"to_world\">"
-                        "<rotate z=\"1\" angle=\"90\"/>"
-                        "<matrix value=\"1 0 0 0 0 1 0 0 0 0 1 7 0 0 0 1\"/></transform></shape>\n"));
+    auto r =
+        load(scene(std::string(kLight) +
+                   "<shape type=\"sphere\"><point name=\"center\" x=\"1\" y=\"0\" z=\"0\"/>"
+                   "<float name=\"radius\" value=\"0.5\"/><transform name=\"to_world\">"
+                   "<rotate z=\"1\" angle=\"90\"/>"
+                   "<matrix value=\"1 0 0 0 0 1 0 0 0 0 1 7 0 0 0 1\"/></transform></shape>\n"));
     EXPECT_NEAR(r->shapes[0].bounds.center().x, 0.0f, 1e-5f);
     EXPECT_NEAR(r->shapes[0].bounds.center().y, 1.0f, 1e-5f);
     EXPECT_NEAR(r->shapes[0].bounds.center().z, 7.0f, 1e-5f);
@@ -169,7 +174,8 @@ TEST(MitsubaXml, SensorFieldOfViewAxes) {
         std::string text = "<scene version=\"3.0.0\">\n<sensor type=\"perspective\">" + sensorBody +
                            "<film type=\"hdrfilm\"><integer name=\"width\" value=\"64\"/>"
                            "<integer name=\"height\" value=\"32\"/><rfilter type=\"box\"/></film>"
-                           "</sensor>\n" + kLight + "</scene>\n";
+                           "</sensor>\n" +
+                           kLight + "</scene>\n";
         return double(load(text)->camera.fovYDeg());
     };
     const double d2r = M_PI / 180.0;
@@ -203,15 +209,19 @@ TEST(MitsubaXml, NamedIorsAndDielectrics) {
     std::string e = errorsOf(scene(std::string(kLight) +
                                    "<shape type=\"sphere\"><bsdf type=\"dielectric\">\n"
                                    "  <string name=\"int_ior\" value=\"glas\"/></bsdf></shape>\n"));
-    EXPECT_TRUE(contains(e, "scene.xml:10:3: error: <bsdf type=\"dielectric\">: unknown IOR name "
-                            "'glas' in 'int_ior' (known: vacuum, helium")) << e;
+    EXPECT_TRUE(contains(e,
+                         "scene.xml:10:3: error: <bsdf type=\"dielectric\">: unknown IOR name "
+                         "'glas' in 'int_ior' (known: vacuum, helium"))
+        << e;
 }
 
 TEST(MitsubaXml, UnsupportedPluginNamesFileLineAndPlugin) {
-    std::string e = errorsOf(scene(std::string(kLight) +
-                                   "<shape type=\"sphere\">\n  <bsdf type=\"hair\"/></shape>\n"));
-    EXPECT_TRUE(contains(e, "scene.xml:10:3: error: unsupported bsdf plugin 'hair' (supported: "
-                            "diffuse, conductor")) << e;
+    std::string e = errorsOf(
+        scene(std::string(kLight) + "<shape type=\"sphere\">\n  <bsdf type=\"hair\"/></shape>\n"));
+    EXPECT_TRUE(contains(e,
+                         "scene.xml:10:3: error: unsupported bsdf plugin 'hair' (supported: "
+                         "diffuse, conductor"))
+        << e;
     std::string s = errorsOf(scene(std::string(kLight) + "<shape type=\"disk\"/>\n"));
     EXPECT_TRUE(contains(s, "scene.xml:9:1: error: unsupported shape plugin 'disk'")) << s;
 }
@@ -220,21 +230,29 @@ TEST(MitsubaXml, UnsupportedParameterIsAnError) {
     std::string e = errorsOf(scene(std::string(kLight) +
                                    "<shape type=\"sphere\"><bsdf type=\"diffuse\">\n"
                                    "  <float name=\"roughness\" value=\"0.3\"/></bsdf></shape>\n"));
-    EXPECT_TRUE(contains(e, "scene.xml:10:3: error: <bsdf type=\"diffuse\">: unsupported "
-                            "parameter 'roughness' (<float>)")) << e;
+    EXPECT_TRUE(contains(e,
+                         "scene.xml:10:3: error: <bsdf type=\"diffuse\">: unsupported "
+                         "parameter 'roughness' (<float>)"))
+        << e;
 }
 
 TEST(MitsubaXml, WrongPropertyTypeAndBadNumbers) {
-    std::string e = errorsOf(scene(std::string(kLight) +
-                                   "<shape type=\"sphere\">\n  <string name=\"radius\" value=\"2\"/>"
-                                   "</shape>\n"));
-    EXPECT_TRUE(contains(e, "scene.xml:10:3: error: <shape type=\"sphere\">: parameter 'radius' "
-                            "must be a <float>, got <string>")) << e;
-    std::string f = errorsOf(scene(std::string(kLight) +
-                                   "<shape type=\"sphere\">\n  <float name=\"radius\" value=\"2x\"/>"
-                                   "</shape>\n"));
-    EXPECT_TRUE(contains(f, "scene.xml:10:3: error: <float> property 'radius': expected a finite "
-                            "number, got '2x'")) << f;
+    std::string e =
+        errorsOf(scene(std::string(kLight) +
+                       "<shape type=\"sphere\">\n  <string name=\"radius\" value=\"2\"/>"
+                       "</shape>\n"));
+    EXPECT_TRUE(contains(e,
+                         "scene.xml:10:3: error: <shape type=\"sphere\">: parameter 'radius' "
+                         "must be a <float>, got <string>"))
+        << e;
+    std::string f =
+        errorsOf(scene(std::string(kLight) +
+                       "<shape type=\"sphere\">\n  <float name=\"radius\" value=\"2x\"/>"
+                       "</shape>\n"));
+    EXPECT_TRUE(contains(f,
+                         "scene.xml:10:3: error: <float> property 'radius': expected a finite "
+                         "number, got '2x'"))
+        << f;
 }
 
 TEST(MitsubaXml, EmittersAndMaxDepth) {
@@ -260,8 +278,10 @@ TEST(MitsubaXml, RoughConductorNeedsGgx) {
                                    "<shape type=\"sphere\">\n  <bsdf type=\"roughconductor\">"
                                    "<rgb name=\"eta\" value=\"0.2\"/><rgb name=\"k\" value=\"3\"/>"
                                    "</bsdf></shape>\n"));
-    EXPECT_TRUE(contains(e, "scene.xml:10:3: error: <bsdf type=\"roughconductor\">: microfacet "
-                            "distribution 'beckmann' (Mitsuba's default) is not supported")) << e;
+    EXPECT_TRUE(contains(e,
+                         "scene.xml:10:3: error: <bsdf type=\"roughconductor\">: microfacet "
+                         "distribution 'beckmann' (Mitsuba's default) is not supported"))
+        << e;
 }
 
 TEST(MitsubaXml, SceneLoaderDispatchesXmlAndRejectsDefinesForJson) {
@@ -349,10 +369,9 @@ TEST(MitsubaXml, MediaOnShapesBecomeBoundaries) {
     EXPECT_EQ(s->settings.shadingNormals, ShadingNormals::kShadingOnly);
 
     // An exterior medium alone also makes a boundary (entering: vacuum, leaving: fog).
-    auto ext = load(scene(std::string(kLight) +
-                          "<medium id=\"f\" type=\"homogeneous\"/>\n"
-                          "<shape type=\"sphere\"><bsdf type=\"null\"/>\n"
-                          "  <ref id=\"f\" name=\"exterior\"/></shape>\n"));
+    auto ext = load(scene(std::string(kLight) + "<medium id=\"f\" type=\"homogeneous\"/>\n"
+                                                "<shape type=\"sphere\"><bsdf type=\"null\"/>\n"
+                                                "  <ref id=\"f\" name=\"exterior\"/></shape>\n"));
     ASSERT_EQ(ext->shapes.size(), 1u);
     EXPECT_TRUE(ext->shapes[0].isMediumBoundary);
     EXPECT_TRUE(ext->shapes[0].imaginary);
@@ -361,7 +380,8 @@ TEST(MitsubaXml, MediaOnShapesBecomeBoundaries) {
 }
 
 TEST(MitsubaXml, SharedTestScenesLoad) {
-    // Every Mitsuba scene of tests/data/mitsuba-data loads without errors (the reference test renders them).
+    // Every Mitsuba scene of tests/data/mitsuba-data loads without errors (the reference test
+    // renders them).
     const std::string dir = std::string(UNIBEAM_MITSUBA_MEDIA_DIR);
     ASSERT_TRUE(fs::is_directory(dir)) << "test data not found: " << dir;
     int n = 0;
@@ -382,15 +402,20 @@ TEST(MitsubaXml, SharedTestScenesLoad) {
 // hang); the cycle is an error at the first repeated file, and mutual includes are found too.
 TEST(MitsubaXml, IncludeCyclesAreErrorsNotHangs) {
     std::string dir = scratchDir("cycle");
-    writeFile(dir + "/self.xml", "<scene version=\"3.0.0\">\n<include filename=\"self.xml\"/>\n"
-                                 "<include filename=\"self.xml\"/>\n</scene>\n");
-    writeFile(dir + "/a.xml", "<scene version=\"3.0.0\">\n<include filename=\"b.xml\"/>\n</scene>\n");
-    writeFile(dir + "/b.xml", "<scene version=\"3.0.0\">\n\n<include filename=\"a.xml\"/>\n</scene>\n");
-    std::string e = errorsOf(scene("<include filename=\"self.xml\"/>\n" + std::string(kLight)), dir);
+    writeFile(dir + "/self.xml",
+              "<scene version=\"3.0.0\">\n<include filename=\"self.xml\"/>\n"
+              "<include filename=\"self.xml\"/>\n</scene>\n");
+    writeFile(dir + "/a.xml",
+              "<scene version=\"3.0.0\">\n<include filename=\"b.xml\"/>\n</scene>\n");
+    writeFile(dir + "/b.xml",
+              "<scene version=\"3.0.0\">\n\n<include filename=\"a.xml\"/>\n</scene>\n");
+    std::string e =
+        errorsOf(scene("<include filename=\"self.xml\"/>\n" + std::string(kLight)), dir);
     EXPECT_TRUE(contains(e, "self.xml:2:1: error: include cycle: '")) << e;
     EXPECT_TRUE(contains(e, "self.xml:3:1: error: include cycle: '")) << e;
-    EXPECT_TRUE(contains(e, "is already being read (it includes itself, directly or through "
-                            "other files)"))
+    EXPECT_TRUE(contains(e,
+                         "is already being read (it includes itself, directly or through "
+                         "other files)"))
         << e;
     e = errorsOf(scene("<include filename=\"a.xml\"/>\n" + std::string(kLight)), dir);
     EXPECT_TRUE(contains(e, "b.xml:3:1: error: include cycle: '")) << e;
@@ -404,13 +429,15 @@ TEST(MitsubaXml, DeepObjectNestingIsAnErrorNotACrash) {
     for (int i = 0; i < 20000; ++i) body += "</bsdf>";
     body += "</shape>\n";
     std::string e = errorsOf(scene(std::string(kLight) + body));
-    EXPECT_TRUE(contains(e, "error: <bsdf> is nested more than 64 objects deep")) << e.substr(0, 500);
+    EXPECT_TRUE(contains(e, "error: <bsdf> is nested more than 64 objects deep"))
+        << e.substr(0, 500);
 }
 
 // Bytes that are not UTF-8 and control characters in a quoted token are printed escaped, never
 // raw onto the terminal.
 TEST(MitsubaXml, NonUtf8PluginNameIsEscapedInTheMessage) {
-    std::string e = errorsOf(scene(std::string(kLight) + "<shape type=\"cu\xff\xfe" "be\"/>\n"));
+    std::string e = errorsOf(scene(std::string(kLight) + "<shape type=\"cu\xff\xfe"
+                                                         "be\"/>\n"));
     EXPECT_TRUE(contains(e, "scene.xml:9:1: error: unsupported shape plugin 'cu\\xff\\xfebe'"))
         << e;
 }
@@ -439,8 +466,9 @@ TEST(MitsubaXml, ShapesWithoutBsdfGetMitsubasDefaults) {
 TEST(MitsubaXml, IncludeOfADeviceIsAnError) {
     ASSERT_TRUE(fs::exists("/dev/zero")) << "/dev/zero not found";
     std::string e = errorsOf(scene("<include filename=\"/dev/zero\"/>\n" + std::string(kLight)));
-    EXPECT_TRUE(contains(e, "scene.xml:8:1: error: cannot open the included file '/dev/zero' (not "
-                            "a readable regular file)"))
+    EXPECT_TRUE(contains(e,
+                         "scene.xml:8:1: error: cannot open the included file '/dev/zero' (not "
+                         "a readable regular file)"))
         << e;
 }
 
@@ -450,7 +478,8 @@ TEST(MitsubaXml, OutOfRangeMessageShowsTheBounds) {
     std::string e = errorsOf(scene(std::string(kLight) +
                                    "<shape type=\"sphere\"><float name=\"radius\" value=\"3e38\"/>"
                                    "</shape>\n"));
-    EXPECT_TRUE(contains(e, "<shape type=\"sphere\">: parameter 'radius' = 3e38 is out of range "
-                            "(expected a value in (0, 1e+30])"))
+    EXPECT_TRUE(contains(e,
+                         "<shape type=\"sphere\">: parameter 'radius' = 3e38 is out of range "
+                         "(expected a value in (0, 1e+30])"))
         << e;
 }

@@ -44,13 +44,14 @@ struct RefCase {
 };
 
 // gtest prints a parameter that has no PrintTo as a byte dump in every test name line.
-void PrintTo(const RefCase& c, std::ostream* os) { *os << c.ref; }
+void PrintTo(const RefCase& c, std::ostream* os) {
+    *os << c.ref;
+}
 
 /// Renders the case with `algorithm` and runs the per-pixel and image-mean z-tests
 /// (tests/support/reference_render.h) against Mitsuba's reference, whose own error uses
 /// Mitsuba's reference sample count.
-test::ReferenceCheck renderAndTest(const RefCase& c, const std::string& algorithm,
-                                   int iterations) {
+test::ReferenceCheck renderAndTest(const RefCase& c, const std::string& algorithm, int iterations) {
     const std::string refPath = kDir + "/refs/" + c.ref + "_ref_rgb.exr";
     const std::string varPath = kDir + "/refs/" + c.ref + "_ref_rgb_var.exr";
     EXPECT_TRUE(fs::exists(refPath)) << "missing reference " << refPath;
@@ -69,7 +70,8 @@ void expectPasses(const test::ReferenceCheck& check) {
     EXPECT_TRUE(check.perPixel.passed) << "min p-value " << check.perPixel.minPValue
                                        << ", failing pixels " << check.perPixel.failingPixels;
     for (int c = 0; c < 3; ++c)
-        EXPECT_LT(std::fabs(check.meanZ[c]), 3.9) << "image mean, channel " << "RGB"[c];
+        EXPECT_LT(std::fabs(check.meanZ[c]), 3.9) << "image mean, channel "
+                                                  << "RGB"[c];
 }
 
 // The image variance is pooled over 3x3 pixels (ZTestOptions::varianceRadius, core/ztest.h):
@@ -124,8 +126,7 @@ TEST_P(MitsubaReference, VptPassesPerPixelZTest) {
 TEST_P(MitsubaReference, VbptPassesPerPixelZTest) {
     if (!fs::is_directory(kDir)) FAIL() << "Mitsuba test scenes not found at " << kDir;
     const RefCase& c = GetParam();
-    expectPasses(renderAndTest(c, "vbpt", c.vbptIterations > 0 ? c.vbptIterations
-                                                                : c.iterations));
+    expectPasses(renderAndTest(c, "vbpt", c.vbptIterations > 0 ? c.vbptIterations : c.iterations));
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, MitsubaReference, ::testing::ValuesIn(kCases), caseName);

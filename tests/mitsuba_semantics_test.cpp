@@ -72,8 +72,8 @@ TEST(MediumTransitions, LeavingAnOverlappedShapeGivesItsExteriorNotTheOtherShape
     // stack, 2 with Mitsuba's rule, 2 + 0.5 with b's exterior medium on [2, 3].
     auto shadow = [](const Scene& s) {
         const Vec3 from(-3.0f, 0.0f, 0.0f), to(3.0f, 0.0f, 0.0f);
-        MediumShadow sh = s.shadowTransmittance(from, Vec3(0.0f), s.mediumStackAt(from), to,
-                                                Vec3(0.0f));
+        MediumShadow sh =
+            s.shadowTransmittance(from, Vec3(0.0f), s.mediumStackAt(from), to, Vec3(0.0f));
         EXPECT_FALSE(sh.blocked);
         return sh.transmittance.x;
     };
@@ -94,7 +94,8 @@ TEST(MediumTransitions, ShapeSidesSetTheMediumOfTheOutgoingSideOnReflection) {
     // A path inside b in vacuum (it left a there) reflects off b's inner wall at x = 2:
     // Mitsuba sets the interior medium of b for the reflected direction; the stack keeps
     // what it had (reflection stays on the same side).
-    for (MediumTransitions mode : {MediumTransitions::kPriorityStack, MediumTransitions::kShapeSides}) {
+    for (MediumTransitions mode :
+         {MediumTransitions::kPriorityStack, MediumTransitions::kShapeSides}) {
         auto s = overlapScene(mode, false);
         Ray ray;
         ray.org = Vec3(1.5f, 0.0f, 0.0f);
@@ -188,10 +189,11 @@ TEST(DepthCounting, ThinSheetTransmissionIsNotAVertex) {
             const int maxLength = run == 0 ? 1 : 2;
             BlockStats st = renderThin(s, algorithm, maxLength);
             for (int c = 0; c < 3; ++c) {
-                std::printf("[ depth    ] %s %s max %d: channel %d mean %.5f expected %.5f "
-                            "stderr %.5f\n",
-                            algorithm, run == 0 ? "non-null" : "all", maxLength, c,
-                            st.imageMean(c), expected * le[c], st.imageStdErr(c));
+                std::printf(
+                    "[ depth    ] %s %s max %d: channel %d mean %.5f expected %.5f "
+                    "stderr %.5f\n",
+                    algorithm, run == 0 ? "non-null" : "all", maxLength, c, st.imageMean(c),
+                    expected * le[c], st.imageStdErr(c));
                 EXPECT_NEAR(st.imageMean(c), expected * le[c], 5.0 * st.imageStdErr(c))
                     << algorithm << " run " << run;
                 EXPECT_GT(st.imageStdErr(c), 0.0) << algorithm;

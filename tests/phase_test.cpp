@@ -15,8 +15,12 @@ namespace {
 const float kGs[] = {-0.9f, 0.0f, 0.6f, 0.9f};
 constexpr int kGCount = 4;
 
-ub_float3 toF3(const Vec3& v) { return ub_make_float3(v.x, v.y, v.z); }
-Vec3 toVec3(const ub_float3& v) { return {v.x, v.y, v.z}; }
+ub_float3 toF3(const Vec3& v) {
+    return ub_make_float3(v.x, v.y, v.z);
+}
+Vec3 toVec3(const ub_float3& v) {
+    return {v.x, v.y, v.z};
+}
 
 // 2 pi * integral over cosTheta in [-1, 1] of p(cosTheta) must be 1. Composite
 // midpoint rule in double over the float eval with 2^20 cells; for g = +-0.9 the
@@ -60,8 +64,8 @@ TEST(HenyeyGreenstein, SamplingChiSquare) {
         };
         test::Chi2Result r = test::chi2TestSphere(sample, pdf, 1000000, 20, 40, 64);
         ASSERT_TRUE(r.message.empty()) << r.message;
-        EXPECT_GT(r.pValue, alpha) << "g = " << g << " chi2 = " << r.statistic
-                                   << " dof = " << r.dof;
+        EXPECT_GT(r.pValue, alpha)
+            << "g = " << g << " chi2 = " << r.statistic << " dof = " << r.dof;
     }
 }
 

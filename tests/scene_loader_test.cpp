@@ -601,16 +601,17 @@ TEST(JsonLoaderErrors, UnknownEnvMapFilterListsTheFilters) {
                   R"json({"type": "envmap", "file": "sky.exr", "filter": "bilinar"})json"),
         tmp.path.string());
     EXPECT_TRUE(contains(e, "scene.json:5:")) << e;
-    EXPECT_TRUE(contains(e, "error: at /lights/0/filter: unknown environment map filter "
-                            "'bilinar' (did you mean 'bilinear'?); valid filters: "))
+    EXPECT_TRUE(contains(e,
+                         "error: at /lights/0/filter: unknown environment map filter "
+                         "'bilinar' (did you mean 'bilinear'?); valid filters: "))
         << e;
-    e = onlyError(sceneWith(kWhite, kRect,
-                            R"json({"type": "envmap", "file": "sky.exr", "filter": ""})json"),
-                  tmp.path.string());
+    e = onlyError(
+        sceneWith(kWhite, kRect, R"json({"type": "envmap", "file": "sky.exr", "filter": ""})json"),
+        tmp.path.string());
     EXPECT_TRUE(contains(e, "at /lights/0/filter: expected a non-empty string")) << e;
-    e = onlyError(sceneWith(kWhite, kRect,
-                            R"json({"type": "envmap", "file": "sky.exr", "filter": 1})json"),
-                  tmp.path.string());
+    e = onlyError(
+        sceneWith(kWhite, kRect, R"json({"type": "envmap", "file": "sky.exr", "filter": 1})json"),
+        tmp.path.string());
     EXPECT_TRUE(contains(e, "at /lights/0/filter")) << e;
 }
 
@@ -810,8 +811,8 @@ std::string pngChunk(const std::string& type, const std::string& data) {
 /// (not even compressed) image data: a reader has to stop at the header.
 std::string pngHeaderOnly(uint32_t width, uint32_t height) {
     return std::string("\x89PNG\r\n\x1a\n", 8) +
-           pngChunk("IHDR", bigEndian(width) + bigEndian(height) +
-                                std::string("\x08\x02\0\0\0", 5)) +
+           pngChunk("IHDR",
+                    bigEndian(width) + bigEndian(height) + std::string("\x08\x02\0\0\0", 5)) +
            pngChunk("IDAT", "xxxx") + pngChunk("IEND", "");
 }
 
@@ -828,16 +829,18 @@ TEST(JsonLoaderErrors, ImageHeaderWithAbsurdSizeIsAnError) {
         ADD_FAILURE() << "readPng accepted a 200000 x 200000 image";
     } catch (const InputError& e) {
         EXPECT_EQ(std::string(e.what()),
-                  png + ": error: PNG image of 200000 x 200000 pixels is too large (expected at "
-                        "most 65536 pixels on a side and 268435456 pixels in all)");
+                  png +
+                      ": error: PNG image of 200000 x 200000 pixels is too large (expected at "
+                      "most 65536 pixels on a side and 268435456 pixels in all)");
     }
-    std::string e = onlyError(
-        sceneWith(std::string(kWhite) + R"json(, "t": {"type": "diffuse", "reflectance":
+    std::string e =
+        onlyError(sceneWith(std::string(kWhite) + R"json(, "t": {"type": "diffuse", "reflectance":
                   {"type": "bitmap", "file": "huge.png"}})json",
-                  kRect, kPoint),
-        tmp.path.string());
-    EXPECT_TRUE(contains(e, "cannot read bitmap 'huge.png': PNG image of 200000 x 200000 pixels "
-                            "is too large"))
+                            kRect, kPoint),
+                  tmp.path.string());
+    EXPECT_TRUE(contains(e,
+                         "cannot read bitmap 'huge.png': PNG image of 200000 x 200000 pixels "
+                         "is too large"))
         << e;
 
     // An OpenEXR file whose data window claims 1e6 x 1e6 pixels (readExr computed the window
@@ -874,9 +877,8 @@ TEST(JsonLoaderErrors, ImageHeaderWithAbsurdSizeIsAnError) {
 // Messages quote what the file holds; control characters, bytes that are not UTF-8 and
 // megabytes of text are printed escaped and cut, never raw (a NUL cut the message short).
 TEST(JsonLoaderErrors, QuotedTextIsPrintedEscapedAndCut) {
-    std::string e = onlyError(sceneWith(kWhite,
-                                        R"json({"type": "cube", "material": "wh\u0000ite\u001b[31m"})json",
-                                        kPoint));
+    std::string e = onlyError(sceneWith(
+        kWhite, R"json({"type": "cube", "material": "wh\u0000ite\u001b[31m"})json", kPoint));
     EXPECT_TRUE(contains(e, "unknown material 'wh\\x00ite\\x1b[31m'")) << e;
     Diagnostic d{"f.obj", 3, 7, "", "bad token '\xff\xfe" + std::string(10000, '1') + "'"};
     const std::string f = d.format();
@@ -885,5 +887,6 @@ TEST(JsonLoaderErrors, QuotedTextIsPrintedEscapedAndCut) {
     EXPECT_TRUE(contains(f, "... (")) << f;
     EXPECT_EQ(f.substr(f.size() - 11), "more bytes)");
     // Well-formed UTF-8 stays as it is.
-    EXPECT_EQ((Diagnostic{"é.json", 1, 2, "", "ü ≥ 𝄞\tok"}.format()), "é.json:1:2: error: ü ≥ 𝄞\tok");
+    EXPECT_EQ((Diagnostic{"é.json", 1, 2, "", "ü ≥ 𝄞\tok"}.format()),
+              "é.json:1:2: error: ü ≥ 𝄞\tok");
 }

@@ -2,19 +2,19 @@
 // exactly, and every kind of bad .vdb input is an ub::InputError that names the
 // file and the grid and says what is wrong. The bad files are created here
 // (OpenVDB is included for the grid types the library refuses to write).
+#include "scene/vdb_grid.h"
+
 #include <gtest/gtest.h>
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
-#include <openvdb/openvdb.h>
-#include <openvdb/io/File.h>
-
 #include "core/error.h"
 #include "core/rng.h"
-#include "scene/vdb_grid.h"
 
 namespace ub {
 namespace {
@@ -22,7 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 
 class TempDir {
-public:
+  public:
     TempDir() {
         path_ = fs::temp_directory_path() /
                 ("unibeam_vdb_test_" + std::to_string(::getpid()) + "_" +
@@ -35,7 +35,7 @@ public:
     }
     std::string file(const std::string& name) const { return (path_ / name).string(); }
 
-private:
+  private:
     fs::path path_;
 };
 

@@ -46,8 +46,8 @@ void noisyImage(int w, int h, int n, float mu, float sigma, uint32_t seed, Image
 
 /// Image of `n` iterations of a heavy-tailed estimator: each sample is `value` with
 /// probability `hit`, else 0 (mean value*hit), and its per-sample variance estimate.
-void heavyTailedImage(int w, int h, int n, double hit, double value, uint32_t seed,
-                      Image* mean, Image* var) {
+void heavyTailedImage(int w, int h, int n, double hit, double value, uint32_t seed, Image* mean,
+                      Image* var) {
     std::mt19937 rng(seed);
     std::binomial_distribution<int> hits(n, hit);
     *mean = Image(w, h);
@@ -132,8 +132,10 @@ TEST(ZTest, PooledVarianceKeepsAlphaForHeavyTailsAndStillFindsBias) {
         heavyTailedImage(24, 24, 1024, 0.03, 100.0, seed + 100, &biased, &biasedVar);
         biasFound += !zTest(biased, &biasedVar, ref, refVar, pooled).passed;
     }
-    std::printf("[ ztest    ] heavy tails, 20 seeds: per-pixel rejects %d, pooled %d, "
-                "pooled finds the bias %d\n", rejectPerPixel, rejectPooled, biasFound);
+    std::printf(
+        "[ ztest    ] heavy tails, 20 seeds: per-pixel rejects %d, pooled %d, "
+        "pooled finds the bias %d\n",
+        rejectPerPixel, rejectPooled, biasFound);
     EXPECT_GE(rejectPerPixel, 10);
     EXPECT_LE(rejectPooled, 2);
     EXPECT_EQ(biasFound, 20);
@@ -204,11 +206,13 @@ TEST(VolFile, HeaderValidationMessages) {
     std::string shortFile = volError("short", volBytes(2, 2, 2, 1, std::vector<float>(7)));
     EXPECT_NE(shortFile.find("announces 2 x 2 x 2 x 1 float32 values (80 bytes with the header), "
                              "but the file has 76 bytes"),
-              std::string::npos) << shortFile;
+              std::string::npos)
+        << shortFile;
     std::vector<float> nan(8, 1.0f);
     nan[5] = NAN;
-    EXPECT_NE(volError("nan", volBytes(2, 2, 2, 1, nan)).find("non-finite value at voxel (1, 0, 1)"),
-              std::string::npos);
+    EXPECT_NE(
+        volError("nan", volBytes(2, 2, 2, 1, nan)).find("non-finite value at voxel (1, 0, 1)"),
+        std::string::npos);
     EXPECT_NE(volError("tiny", "VOL").find("shorter than the 48-byte header"), std::string::npos);
 }
 
@@ -233,16 +237,16 @@ TEST(VolFile, AbsurdHeadersAreErrorsBeforeAllocation) {
               std::string::npos)
         << billion;
     const int32_t big = 2147483647;
-    EXPECT_NE(volError("overflow", volBytes(big, big, big, 3, {})).find(
-                  "more than 2^32 values (a corrupt header?)"),
+    EXPECT_NE(volError("overflow", volBytes(big, big, big, 3, {}))
+                  .find("more than 2^32 values (a corrupt header?)"),
               std::string::npos);
-    EXPECT_NE(volError("negative", volBytes(4, -1, 4, 1, {})).find(
-                  "resolution 4 x -1 x 4 (expected positive sizes)"),
+    EXPECT_NE(volError("negative", volBytes(4, -1, 4, 1, {}))
+                  .find("resolution 4 x -1 x 4 (expected positive sizes)"),
               std::string::npos);
     std::vector<float> inf(8, 1.0f);
     inf[7] = INFINITY;
-    EXPECT_NE(volError("inf", volBytes(2, 2, 2, 1, inf)).find(
-                  "non-finite value at voxel (1, 1, 1), channel 0"),
+    EXPECT_NE(volError("inf", volBytes(2, 2, 2, 1, inf))
+                  .find("non-finite value at voxel (1, 1, 1), channel 0"),
               std::string::npos);
     std::string badBox = volBytes(2, 2, 2, 1, std::vector<float>(8, 1.0f));
     const float nan = NAN;

@@ -34,7 +34,9 @@ float latticeValue(int x, int y, int z) {
     return float(h >> 40) * 0x1p-24f;
 }
 
-float smooth(float t) { return t * t * (3.0f - 2.0f * t); }
+float smooth(float t) {
+    return t * t * (3.0f - 2.0f * t);
+}
 
 float valueNoise(float x, float y, float z) {
     int ix = int(std::floor(x)), iy = int(std::floor(y)), iz = int(std::floor(z));
@@ -76,7 +78,8 @@ float plumeDensity(float x, float y, float z) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc > 2 || (argc == 2 && (std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help"))) {
+    if (argc > 2 ||
+        (argc == 2 && (std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help"))) {
         std::fprintf(stderr, "usage: %s [output.vdb]\n", argv[0]);
         return argc > 2 ? 2 : 0;
     }
@@ -100,8 +103,8 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s\n", e.what());
         return 1;
     }
-    size_t active = std::count_if(dense.values.begin(), dense.values.end(),
-                                  [](float v) { return v > 0; });
+    size_t active =
+        std::count_if(dense.values.begin(), dense.values.end(), [](float v) { return v > 0; });
     std::printf("wrote %s: grid 'density', %dx%dx%d voxels, %zu active\n", out.c_str(), n, n, n,
                 active);
     return 0;

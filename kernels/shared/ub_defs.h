@@ -51,7 +51,11 @@ typedef uint32_t ub_uint;
 #define UB_PI 3.14159265358979323846f
 #define UB_INV_PI 0.31830988618379067154f
 
-UB_INLINE float ub_clampf(float x, float lo, float hi) { return ub_fmin(ub_fmax(x, lo), hi); }
-UB_INLINE float ub_sqr(float x) { return x * x; }
+UB_INLINE float ub_clampf(float x, float lo, float hi) {
+    return ub_fmin(ub_fmax(x, lo), hi);
+}
+UB_INLINE float ub_sqr(float x) {
+    return x * x;
+}
 
 #endif /* UB_DEFS_H */

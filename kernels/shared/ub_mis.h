@@ -232,9 +232,8 @@ UB_INLINE float ub_mis_weight_nee_media(ub_mis_constants c, ub_mis_partials e, f
     float wLight = ub_mis(c, bsdfDirPdfW * passProb / (lightPickProb * directPdfW));
     /* Partial camera subpath weight [TR (45)]: the light emitted towards z; the pick
      * probability cancels in the ratio emissionPdfW / directPdfW */
-    float wCamera =
-        ub_mis(c, emissionPdfW * cosToLight * distPdfToZ / (directPdfW * cosAtLight)) *
-        (c.vmWeightFactor + e.dVCM + e.dVC * ub_mis(c, bsdfRevPdfW));
+    float wCamera = ub_mis(c, emissionPdfW * cosToLight * distPdfToZ / (directPdfW * cosAtLight)) *
+                    (c.vmWeightFactor + e.dVCM + e.dVC * ub_mis(c, bsdfRevPdfW));
     return 1.0f / (wLight + 1.0f + wCamera); /* [TR (37)] */
 }
 

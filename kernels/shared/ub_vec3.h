@@ -34,13 +34,21 @@ UB_INLINE ub_float3 ub_f3_mul(ub_float3 a, ub_float3 b) {
 UB_INLINE ub_float3 ub_f3_scale(ub_float3 a, float s) {
     return ub_make_float3(a.x * s, a.y * s, a.z * s);
 }
-UB_INLINE ub_float3 ub_f3_neg(ub_float3 a) { return ub_make_float3(-a.x, -a.y, -a.z); }
-UB_INLINE float ub_f3_dot(ub_float3 a, ub_float3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+UB_INLINE ub_float3 ub_f3_neg(ub_float3 a) {
+    return ub_make_float3(-a.x, -a.y, -a.z);
+}
+UB_INLINE float ub_f3_dot(ub_float3 a, ub_float3 b) {
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 UB_INLINE ub_float3 ub_f3_cross(ub_float3 a, ub_float3 b) {
     return ub_make_float3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
-UB_INLINE float ub_f3_length(ub_float3 a) { return ub_sqrt(ub_f3_dot(a, a)); }
-UB_INLINE ub_float3 ub_f3_normalize(ub_float3 a) { return ub_f3_scale(a, 1.0f / ub_f3_length(a)); }
+UB_INLINE float ub_f3_length(ub_float3 a) {
+    return ub_sqrt(ub_f3_dot(a, a));
+}
+UB_INLINE ub_float3 ub_f3_normalize(ub_float3 a) {
+    return ub_f3_scale(a, 1.0f / ub_f3_length(a));
+}
 
 /* Orthonormal basis (s, t) completing the unit vector n to a right-handed
  * frame (s, t, n); Duff et al. 2017, "Building an Orthonormal Basis,

@@ -43,15 +43,14 @@ struct CompareArgs {
     double samples = 0;           ///< --spp: iterations averaged into IMAGE
     double referenceSamples = 0;  ///< --ref-spp (0: exact reference)
     double alpha = 0.01;
-    int varianceRadius = 0;       ///< --variance-radius: pool the image variance (needs --image-var)
+    int varianceRadius = 0;  ///< --variance-radius: pool the image variance (needs --image-var)
 };
 
 /// Default number of iterations when neither -t nor -i is given.
 constexpr int kDefaultIterations = 16;
 
 int runRender(const RenderArgs& args);
-int runInfo(const std::string& scenePath,
-            const std::map<std::string, std::string>& defines = {});
+int runInfo(const std::string& scenePath, const std::map<std::string, std::string>& defines = {});
 /// `unibeam compare --ztest`: 0 pass, 1 fail, 2 bad input (UsageError / InputError).
 int runCompareZTest(const CompareArgs& args);
 /// Parses the values of -D flags ("name=value"); throws UsageError on a malformed one.

@@ -18,8 +18,10 @@ std::map<std::string, std::string> parseDefines(const std::vector<std::string>& 
         bool ok = eq != std::string::npos && !name.empty();
         for (char c : name) ok = ok && (std::isalnum(static_cast<unsigned char>(c)) || c == '_');
         if (!ok)
-            throw UsageError("-D: expected NAME=VALUE with a name of letters, digits and '_', "
-                             "got '" + v + "'");
+            throw UsageError(
+                "-D: expected NAME=VALUE with a name of letters, digits and '_', "
+                "got '" +
+                v + "'");
         if (out.count(name)) throw UsageError("-D: parameter '" + name + "' is given twice");
         out[name] = v.substr(eq + 1);
     }

@@ -109,7 +109,10 @@ int run(int argc, char** argv) {
     std::string seedText, maxLengthText;
     float radius = 0, alpha = 0;
     CLI::App* render = app.add_subcommand("render", "Render a scene progressively");
-    render->add_option("scene", ra.scene, "Scene file: unibeam .json, Mitsuba 3 .xml, or SmallUPBP .obj (with its .obj.aux)")
+    render
+        ->add_option(
+            "scene", ra.scene,
+            "Scene file: unibeam .json, Mitsuba 3 .xml, or SmallUPBP .obj (with its .obj.aux)")
         ->required()
         ->type_name("SCENE");
     render
@@ -138,12 +141,15 @@ int run(int argc, char** argv) {
                      "current directory unless only --png is given")
         ->type_name("FILE.exr");
     render->add_option("--png", ra.pngPath, "Also write an 8-bit sRGB PNG")->type_name("FILE.png");
-    render->add_option("--exposure", ra.exposure,
-                       "PNG exposure in stops, in [-64, 64] (PNG = 2^EV x image)")
+    render
+        ->add_option("--exposure", ra.exposure,
+                     "PNG exposure in stops, in [-64, 64] (PNG = 2^EV x image)")
         ->check(finiteReal(64.0))
         ->type_name("EV");
     // Bounded: TBB stalls when told to allow a billion threads.
-    render->add_option("--threads", ra.threads, "Number of threads, in [1, 4096] (default: all cores)")
+    render
+        ->add_option("--threads", ra.threads,
+                     "Number of threads, in [1, 4096] (default: all cores)")
         ->check(integerUpTo(4096))
         ->type_name("N");
     render->add_option("--seed", seedText, "Random seed (non-negative integer; default: scene)")
@@ -286,8 +292,9 @@ int run(int argc, char** argv) {
         for (const auto& d : e.diagnostics()) std::fprintf(stderr, "%s\n", d.format().c_str());
         return kExitBadInput;
     } catch (const std::bad_alloc&) {
-        std::fprintf(stderr, "unibeam: error: out of memory (a smaller --resolution, a smaller "
-                             "scene or fewer --threads need less)\n");
+        std::fprintf(stderr,
+                     "unibeam: error: out of memory (a smaller --resolution, a smaller "
+                     "scene or fewer --threads need less)\n");
         return kExitFailure;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "unibeam: error: %s\n", e.what());

@@ -154,8 +154,9 @@ int runRender(const RenderArgs& args) {
             throw UsageError("--variance: needs at least 2 iterations, rendered " +
                              std::to_string(result.iterations));
         ImageMetadata vmeta = meta;
-        vmeta["content"] = "per-pixel sample variance of one iteration (divide by iterations "
-                           "for the variance of the mean image)";
+        vmeta["content"] =
+            "per-pixel sample variance of one iteration (divide by iterations "
+            "for the variance of the mean image)";
         writeExr(args.variancePath, result.variance, vmeta);
         std::fprintf(stderr, "unibeam: wrote %s\n", args.variancePath.c_str());
     }

@@ -11,38 +11,45 @@
 namespace ub {
 
 struct Diagnostic {
-    std::string file;     ///< file the problem is in
-    int line = 0;         ///< 1-based line, 0 if unknown
-    int column = 0;       ///< 1-based column, 0 if unknown
-    std::string where;    ///< JSON path (e.g. "/shapes/2/material") or object name
-    std::string message;  ///< what is wrong and what was expected
-    bool warning = false; ///< warnings are printed but do not fail loading
+    std::string file;      ///< file the problem is in
+    int line = 0;          ///< 1-based line, 0 if unknown
+    int column = 0;        ///< 1-based column, 0 if unknown
+    std::string where;     ///< JSON path (e.g. "/shapes/2/material") or object name
+    std::string message;   ///< what is wrong and what was expected
+    bool warning = false;  ///< warnings are printed but do not fail loading
     /// "file:line:col: error: at /path: message"
     std::string format() const;
 };
 
 class InputError : public std::runtime_error {
-public:
+  public:
     explicit InputError(std::vector<Diagnostic> d);
     InputError(const std::string& file, const std::string& message);
     const std::vector<Diagnostic>& diagnostics() const { return diags_; }
 
-private:
+  private:
     std::vector<Diagnostic> diags_;
 };
 
 /// Accumulates diagnostics; throwIfErrors() throws InputError if any error was added.
 class Diagnostics {
-public:
-    void error(Diagnostic d) { d.warning = false; list_.push_back(std::move(d)); ++errors_; }
-    void warning(Diagnostic d) { d.warning = true; list_.push_back(std::move(d)); }
+  public:
+    void error(Diagnostic d) {
+        d.warning = false;
+        list_.push_back(std::move(d));
+        ++errors_;
+    }
+    void warning(Diagnostic d) {
+        d.warning = true;
+        list_.push_back(std::move(d));
+    }
     bool hasErrors() const { return errors_ > 0; }
     const std::vector<Diagnostic>& all() const { return list_; }
     /// Warnings only (to print after a successful load).
     std::vector<Diagnostic> warnings() const;
     void throwIfErrors() const;
 
-private:
+  private:
     std::vector<Diagnostic> list_;
     int errors_ = 0;
 };

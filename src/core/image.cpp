@@ -1,7 +1,5 @@
 #include "core/image.h"
 
-#include <png.h>
-
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
@@ -9,6 +7,8 @@
 #include <ImfOutputFile.h>
 #include <ImfStandardAttributes.h>
 #include <ImfStringAttribute.h>
+#include <png.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -54,7 +54,8 @@ Image readExr(const std::string& path, ImageMetadata* metadata) {
         const Imf::Header& h = file.header();
         Imath::Box2i dw = h.dataWindow();
         // In 64 bits: a corrupt window (min -2^31, max 2^31-1) overflows int.
-        const int64_t w64 = int64_t(dw.max.x) - dw.min.x + 1, h64 = int64_t(dw.max.y) - dw.min.y + 1;
+        const int64_t w64 = int64_t(dw.max.x) - dw.min.x + 1,
+                      h64 = int64_t(dw.max.y) - dw.min.y + 1;
         if (w64 <= 0 || h64 <= 0) throw InputError(path, "OpenEXR image has an empty data window");
         checkImageSize(path, "OpenEXR", w64, h64);
         const int w = int(w64), ht = int(h64);
@@ -87,7 +88,8 @@ Image readExr(const std::string& path, ImageMetadata* metadata) {
             }
         }
         for (const auto& p : img.pixels)
-            if (!isFinite(p)) throw InputError(path, "OpenEXR image contains non-finite pixel values");
+            if (!isFinite(p))
+                throw InputError(path, "OpenEXR image contains non-finite pixel values");
         return img;
     } catch (const InputError&) {
         throw;
@@ -134,7 +136,8 @@ void pngWarning(png_structp, png_const_charp) {}
 }  // namespace
 
 Image readPng(const std::string& path, bool linearize) {
-    if (!std::filesystem::is_regular_file(path)) throw InputError(path, "image file does not exist");
+    if (!std::filesystem::is_regular_file(path))
+        throw InputError(path, "image file does not exist");
     FILE* fp = std::fopen(path.c_str(), "rb");
     if (!fp) throw InputError(path, "cannot open the PNG image");
     unsigned char sig[8] = {};

@@ -35,7 +35,8 @@ Image readExr(const std::string& path, ImageMetadata* metadata = nullptr);
 Image readPng(const std::string& path, bool linearize = true);
 /// The sRGB transfer function (IEC 61966-2-1): encoded value in [0,1] -> linear.
 float srgbToLinear(float encoded);
-/// Writes 32-bit float RGB with the given string attributes. Throws std::runtime_error on I/O failure.
+/// Writes 32-bit float RGB with the given string attributes. Throws std::runtime_error on I/O
+/// failure.
 void writeExr(const std::string& path, const Image& img, const ImageMetadata& metadata = {});
 /// Writes an 8-bit sRGB PNG of img * 2^exposure (clamped). Throws std::runtime_error on failure.
 void writePng(const std::string& path, const Image& img, float exposure = 0.0f);

@@ -19,7 +19,7 @@ inline uint64_t mix64(uint64_t x) {
 }
 
 class Rng {
-public:
+  public:
     Rng() { seed(0, 0); }
     Rng(uint64_t seedValue, uint64_t stream) { seed(seedValue, stream); }
     /// Stream for path `index` of iteration `iteration` of a render seeded by `seed`.
@@ -43,10 +43,17 @@ public:
     }
     /// Uniform float in [0, 1).
     float uniform() { return float(nextU32() >> 8) * 0x1p-24f; }
-    Vec2 uniform2() { float a = uniform(); return {a, uniform()}; }
-    Vec3 uniform3() { float a = uniform(); float b = uniform(); return {a, b, uniform()}; }
+    Vec2 uniform2() {
+        float a = uniform();
+        return {a, uniform()};
+    }
+    Vec3 uniform3() {
+        float a = uniform();
+        float b = uniform();
+        return {a, b, uniform()};
+    }
 
-private:
+  private:
     uint64_t state_, inc_;
 };
 

@@ -16,7 +16,9 @@ inline Vec3 sampleCosineHemisphere(const Vec2& u, float* pdfW = nullptr) {
     if (pdfW) *pdfW = z * kInvPi;
     return {r * std::cos(phi), r * std::sin(phi), z};
 }
-inline float cosineHemispherePdfW(const Vec3& local) { return std::max(0.0f, local.z) * kInvPi; }
+inline float cosineHemispherePdfW(const Vec3& local) {
+    return std::max(0.0f, local.z) * kInvPi;
+}
 
 /// Uniform direction on the unit sphere; pdf = 1/(4 pi).
 inline Vec3 sampleUniformSphere(const Vec2& u, float* pdfW = nullptr) {
@@ -26,7 +28,9 @@ inline Vec3 sampleUniformSphere(const Vec2& u, float* pdfW = nullptr) {
     if (pdfW) *pdfW = 0.25f * kInvPi;
     return {r * std::cos(phi), r * std::sin(phi), z};
 }
-inline float uniformSpherePdfW() { return 0.25f * kInvPi; }
+inline float uniformSpherePdfW() {
+    return 0.25f * kInvPi;
+}
 
 /// Direction inside the cone cos(theta) >= cosThetaMax around +z, uniform in solid angle.
 inline Vec3 sampleUniformCone(const Vec2& u, float cosThetaMax) {
@@ -59,7 +63,7 @@ inline Vec2 sampleUniformTriangle(const Vec2& u) {
 
 /// Piecewise-constant 1D distribution over n bins on [0,1).
 class Distribution1D {
-public:
+  public:
     Distribution1D() = default;
     explicit Distribution1D(const std::vector<float>& f);
     /// Continuous sample in [0,1); pdf is the density in [0,1) measure.
@@ -71,21 +75,21 @@ public:
     int count() const { return int(func_.size()); }
     float integral() const { return funcInt_; }
 
-private:
+  private:
     std::vector<float> func_, cdf_;
     float funcInt_ = 0;
 };
 
 /// Piecewise-constant 2D distribution on [0,1)^2 (marginal in v, conditional in u).
 class Distribution2D {
-public:
+  public:
     Distribution2D() = default;
     /// f has nv rows of nu values, row-major.
     Distribution2D(const std::vector<float>& f, int nu, int nv);
     Vec2 sampleContinuous(const Vec2& u, float* pdf) const;
     float pdf(const Vec2& p) const;
 
-private:
+  private:
     std::vector<Distribution1D> conditional_;
     Distribution1D marginal_;
 };

@@ -28,53 +28,119 @@ struct Vec3 {
     float operator[](int i) const { return (&x)[i]; }
     float& operator[](int i) { return (&x)[i]; }
     Vec3 operator-() const { return {-x, -y, -z}; }
-    Vec3& operator+=(const Vec3& b) { x += b.x; y += b.y; z += b.z; return *this; }
-    Vec3& operator-=(const Vec3& b) { x -= b.x; y -= b.y; z -= b.z; return *this; }
-    Vec3& operator*=(const Vec3& b) { x *= b.x; y *= b.y; z *= b.z; return *this; }
-    Vec3& operator*=(float s) { x *= s; y *= s; z *= s; return *this; }
-    Vec3& operator/=(float s) { float inv = 1.0f / s; x *= inv; y *= inv; z *= inv; return *this; }
+    Vec3& operator+=(const Vec3& b) {
+        x += b.x;
+        y += b.y;
+        z += b.z;
+        return *this;
+    }
+    Vec3& operator-=(const Vec3& b) {
+        x -= b.x;
+        y -= b.y;
+        z -= b.z;
+        return *this;
+    }
+    Vec3& operator*=(const Vec3& b) {
+        x *= b.x;
+        y *= b.y;
+        z *= b.z;
+        return *this;
+    }
+    Vec3& operator*=(float s) {
+        x *= s;
+        y *= s;
+        z *= s;
+        return *this;
+    }
+    Vec3& operator/=(float s) {
+        float inv = 1.0f / s;
+        x *= inv;
+        y *= inv;
+        z *= inv;
+        return *this;
+    }
 };
 
 using Rgb = Vec3;
 
-inline Vec3 operator+(Vec3 a, const Vec3& b) { return a += b; }
-inline Vec3 operator-(Vec3 a, const Vec3& b) { return a -= b; }
-inline Vec3 operator*(Vec3 a, const Vec3& b) { return a *= b; }
-inline Vec3 operator/(const Vec3& a, const Vec3& b) { return {a.x / b.x, a.y / b.y, a.z / b.z}; }
-inline Vec3 operator*(Vec3 a, float s) { return a *= s; }
-inline Vec3 operator*(float s, Vec3 a) { return a *= s; }
-inline Vec3 operator/(Vec3 a, float s) { return a /= s; }
+inline Vec3 operator+(Vec3 a, const Vec3& b) {
+    return a += b;
+}
+inline Vec3 operator-(Vec3 a, const Vec3& b) {
+    return a -= b;
+}
+inline Vec3 operator*(Vec3 a, const Vec3& b) {
+    return a *= b;
+}
+inline Vec3 operator/(const Vec3& a, const Vec3& b) {
+    return {a.x / b.x, a.y / b.y, a.z / b.z};
+}
+inline Vec3 operator*(Vec3 a, float s) {
+    return a *= s;
+}
+inline Vec3 operator*(float s, Vec3 a) {
+    return a *= s;
+}
+inline Vec3 operator/(Vec3 a, float s) {
+    return a /= s;
+}
 
-inline float dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline float dot(const Vec3& a, const Vec3& b) {
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 inline Vec3 cross(const Vec3& a, const Vec3& b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-inline float lengthSqr(const Vec3& a) { return dot(a, a); }
-inline float length(const Vec3& a) { return std::sqrt(dot(a, a)); }
-inline Vec3 normalize(const Vec3& a) { return a / length(a); }
+inline float lengthSqr(const Vec3& a) {
+    return dot(a, a);
+}
+inline float length(const Vec3& a) {
+    return std::sqrt(dot(a, a));
+}
+inline Vec3 normalize(const Vec3& a) {
+    return a / length(a);
+}
 inline Vec3 vmin(const Vec3& a, const Vec3& b) {
     return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)};
 }
 inline Vec3 vmax(const Vec3& a, const Vec3& b) {
     return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)};
 }
-inline float maxComponent(const Vec3& a) { return std::max(a.x, std::max(a.y, a.z)); }
-inline float minComponent(const Vec3& a) { return std::min(a.x, std::min(a.y, a.z)); }
-inline float average(const Vec3& a) { return (a.x + a.y + a.z) * (1.0f / 3.0f); }
+inline float maxComponent(const Vec3& a) {
+    return std::max(a.x, std::max(a.y, a.z));
+}
+inline float minComponent(const Vec3& a) {
+    return std::min(a.x, std::min(a.y, a.z));
+}
+inline float average(const Vec3& a) {
+    return (a.x + a.y + a.z) * (1.0f / 3.0f);
+}
 /// Rec. 709 luminance of a linear RGB value.
-inline float luminance(const Rgb& c) { return 0.212671f * c.x + 0.715160f * c.y + 0.072169f * c.z; }
-inline bool isBlack(const Rgb& c) { return c.x == 0 && c.y == 0 && c.z == 0; }
+inline float luminance(const Rgb& c) {
+    return 0.212671f * c.x + 0.715160f * c.y + 0.072169f * c.z;
+}
+inline bool isBlack(const Rgb& c) {
+    return c.x == 0 && c.y == 0 && c.z == 0;
+}
 inline bool isFinite(const Vec3& a) {
     return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }
-inline Vec3 reflect(const Vec3& dir, const Vec3& n) { return 2.0f * dot(dir, n) * n - dir; }
+inline Vec3 reflect(const Vec3& dir, const Vec3& n) {
+    return 2.0f * dot(dir, n) * n - dir;
+}
 
 /// Axis-aligned bounding box.
 struct Bounds3 {
     Vec3 lo{kInf, kInf, kInf};
     Vec3 hi{-kInf, -kInf, -kInf};
-    void extend(const Vec3& p) { lo = vmin(lo, p); hi = vmax(hi, p); }
-    void extend(const Bounds3& b) { lo = vmin(lo, b.lo); hi = vmax(hi, b.hi); }
+    void extend(const Vec3& p) {
+        lo = vmin(lo, p);
+        hi = vmax(hi, p);
+    }
+    void extend(const Bounds3& b) {
+        lo = vmin(lo, b.lo);
+        hi = vmax(hi, b.hi);
+    }
     bool empty() const { return lo.x > hi.x; }
     Vec3 center() const { return 0.5f * (lo + hi); }
 };

@@ -10,15 +10,16 @@
 
 namespace ub {
 
-double zTestPValue(double z) { return std::erfc(std::fabs(z) / std::sqrt(2.0)); }
+double zTestPValue(double z) {
+    return std::erfc(std::fabs(z) / std::sqrt(2.0));
+}
 
 ZTestResult zTest(const Image& image, const Image* imageVariance, const Image& reference,
                   const Image& referenceVariance, const ZTestOptions& o) {
     auto fail = [](const std::string& msg) { throw InputError("", "z-test: " + msg); };
     if (!(o.alpha > 0.0 && o.alpha < 1.0)) fail("alpha must lie in (0, 1)");
     if (!(o.samples >= 1.0)) fail("the image must average at least 1 iteration");
-    if (imageVariance && !(o.samples >= 2.0))
-        fail("an image variance needs at least 2 iterations");
+    if (imageVariance && !(o.samples >= 2.0)) fail("an image variance needs at least 2 iterations");
     if (!(o.referenceSamples >= 0.0)) fail("reference sample count must be >= 0");
     if (!(o.varianceFloor >= 0.0)) fail("variance floor must be >= 0");
     if (o.varianceRadius < 0) fail("variance radius must be >= 0");
@@ -81,8 +82,7 @@ ZTestResult zTest(const Image& image, const Image* imageVariance, const Image& r
                 if (o.varianceRadius > 0) varImg = std::max(varImg, pooledVariance(x, y, c));
                 double var = varImg / o.samples;
                 if (o.referenceSamples > 0) var += varRef / o.referenceSamples;
-                const double z = var > 0 ? (v - ref) / std::sqrt(var)
-                                         : (v == ref ? 0.0 : INFINITY);
+                const double z = var > 0 ? (v - ref) / std::sqrt(var) : (v == ref ? 0.0 : INFINITY);
                 const double p = zTestPValue(z);
                 r.maxAbsZ = std::max(r.maxAbsZ, std::fabs(z));
                 if (p < r.minPValue || (x == 0 && y == 0 && c == 0)) {
@@ -109,14 +109,16 @@ std::string describeZTest(const ZTestResult& r, const ZTestOptions& o) {
        << " Sidak-corrected over " << r.tests << " pixel-channel tests (per-test level "
        << r.perTestLevel << "), " << o.samples << " image iterations";
     os << "\n  min p-value " << r.minPValue << " at pixel (" << r.minX << ", " << r.minY
-       << ") channel " << "RGB"[r.minChannel] << ", max |z| " << r.maxAbsZ;
+       << ") channel "
+       << "RGB"[r.minChannel] << ", max |z| " << r.maxAbsZ;
     os << "\n  failing pixels: " << r.failingPixels << " (" << r.failures.size()
        << " pixel-channels)";
     const size_t shown = std::min<size_t>(r.failures.size(), 10);
     for (size_t i = 0; i < shown; ++i) {
         const ZTestFailure& f = r.failures[i];
-        os << "\n    (" << f.x << ", " << f.y << ") " << "RGB"[f.channel] << ": image " << f.value
-           << ", reference " << f.reference << ", z " << f.z << ", p " << f.pValue;
+        os << "\n    (" << f.x << ", " << f.y << ") "
+           << "RGB"[f.channel] << ": image " << f.value << ", reference " << f.reference << ", z "
+           << f.z << ", p " << f.pValue;
     }
     return os.str();
 }

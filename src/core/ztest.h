@@ -45,11 +45,11 @@
 namespace ub {
 
 struct ZTestOptions {
-    double alpha = 0.01;           ///< family-wise significance level, in (0, 1)
-    double samples = 1;            ///< n: iterations averaged into the image (>= 2 with var)
-    double referenceSamples = 0;   ///< n_ref; 0 = exact reference
-    double varianceFloor = 1e-4;   ///< lower bound on per-sample variances
-    int varianceRadius = 0;        ///< max(own, mean over (2r+1)^2 pixels); 0 = per pixel
+    double alpha = 0.01;          ///< family-wise significance level, in (0, 1)
+    double samples = 1;           ///< n: iterations averaged into the image (>= 2 with var)
+    double referenceSamples = 0;  ///< n_ref; 0 = exact reference
+    double varianceFloor = 1e-4;  ///< lower bound on per-sample variances
+    int varianceRadius = 0;       ///< max(own, mean over (2r+1)^2 pixels); 0 = per pixel
 };
 
 struct ZTestFailure {
@@ -59,8 +59,8 @@ struct ZTestFailure {
 
 struct ZTestResult {
     bool passed = false;
-    size_t tests = 0;             ///< m = pixels x channels
-    double perTestLevel = 0;      ///< Sidak-corrected level 1 - (1 - alpha)^(1/m)
+    size_t tests = 0;         ///< m = pixels x channels
+    double perTestLevel = 0;  ///< Sidak-corrected level 1 - (1 - alpha)^(1/m)
     double minPValue = 1;
     int minX = 0, minY = 0, minChannel = 0;
     double maxAbsZ = 0;

@@ -21,18 +21,18 @@ enum class MisHeuristic { Power, Balance };
 
 struct RenderOptions {
     std::string algorithm = "pt";
-    int maxPathLength = 10;         ///< segments (SmallVCM semantics), from scene or CLI
+    int maxPathLength = 10;  ///< segments (SmallVCM semantics), from scene or CLI
     int minPathLength = 0;
     uint64_t seed = 1;
     MisHeuristic heuristic = MisHeuristic::Power;
     /// Merging radius: if radiusIsRelative, multiplied by the scene bounding sphere radius.
     float radius = 0.003f;
     bool radiusIsRelative = true;
-    float alpha = 0.75f;            ///< progressive radius reduction exponent
+    float alpha = 0.75f;  ///< progressive radius reduction exponent
 };
 
 class Integrator {
-public:
+  public:
     virtual ~Integrator() = default;
     /// Renders iteration `iteration` (0-based) into `out` (width x height of the camera),
     /// overwriting it with this iteration's estimate (one sample per pixel).

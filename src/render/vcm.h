@@ -156,7 +156,7 @@ class VertexCM : public Integrator {
     RenderOptions options_;
     Algorithm algorithm_;
     bool useVC_ = false, useVM_ = false, lightTraceOnly_ = false, ppm_ = false;
-    bool useMedia_ = false;                 ///< vlt/vbpt on a scene with media
+    bool useMedia_ = false;  ///< vlt/vbpt on a scene with media
     /// DepthCounting::kNonNullVertices: null-lobe vertices do not count towards the length.
     bool nullNotCounted_ = false;
     std::vector<MediumStack> lightStacks_;  ///< media where each light's subpaths start

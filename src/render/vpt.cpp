@@ -58,8 +58,7 @@ Rgb VolPathTracer::tracePixel(int x, int y, int iteration) const {
     const int minLength = options_.minPathLength;
     const int lightCount = int(scene_.lights.size());
     // Mitsuba's depth: a null-lobe event (thin-sheet transmission) is not a vertex.
-    const bool nullNotCounted =
-        scene_.settings.depthCounting == DepthCounting::kNonNullVertices;
+    const bool nullNotCounted = scene_.settings.depthCounting == DepthCounting::kNonNullVertices;
 
     Rng rng = Rng::forPath(options_.seed, uint64_t(iteration),
                            uint64_t(y) * uint64_t(camera.width()) + uint64_t(x));

@@ -59,15 +59,15 @@ void prepareMaterial(Material& m);
 enum BsdfEvent : uint32_t {
     kEventNone = 0,
     kEventDiffuse = 1,
-    kEventGlossy = 2,    ///< Phong lobe, GGX reflection or GGX transmission (rough dielectric:
-                         ///< the side of dirGen w.r.t. the geometric normal tells which)
-    kEventReflect = 4,   ///< specular (delta) reflection
-    kEventRefract = 8,   ///< specular (delta) refraction
+    kEventGlossy = 2,   ///< Phong lobe, GGX reflection or GGX transmission (rough dielectric:
+                        ///< the side of dirGen w.r.t. the geometric normal tells which)
+    kEventReflect = 4,  ///< specular (delta) reflection
+    kEventRefract = 8,  ///< specular (delta) refraction
     kEventSpecular = kEventReflect | kEventRefract,
 };
 
 class Bsdf {
-public:
+  public:
     Bsdf() = default;
     /// Sets up the BSDF at a hit. dirFix = -incoming ray direction (unit).
     /// geoNormal/shadingNormal: unit normals as stored on the surface (not flipped).
@@ -116,7 +116,7 @@ public:
     void setGeometricGuard(bool on) { geometricGuard_ = on; }
     bool geometricGuard() const { return geometricGuard_; }
 
-private:
+  private:
     /// f_s and both pdfs (lobe selection included) for dirGen given in frame_;
     /// cosGeoGen = dot(dirGen, geoNormal_). Applies the geometric guard and the
     /// fromLight shading-normal factor. Non-delta materials only.
@@ -142,10 +142,10 @@ private:
                     uint32_t* sampledEvent) const;
 
     const Material* mat_ = nullptr;
-    SurfaceColors colors_;  ///< RGB parameters at this point (textures resolved)
-    Frame frame_;        ///< shading frame (normal possibly flipped, see above)
-    Vec3 localDirFix_;   ///< dirFix in frame_
-    Vec3 geoNormal_;     ///< geometric normal, same side convention as frame_.n
+    SurfaceColors colors_;    ///< RGB parameters at this point (textures resolved)
+    Frame frame_;             ///< shading frame (normal possibly flipped, see above)
+    Vec3 localDirFix_;        ///< dirFix in frame_
+    Vec3 geoNormal_;          ///< geometric normal, same side convention as frame_.n
     float cosGeoFix_ = 0.0f;  ///< dot(dirFix, geoNormal_)
     bool fromLight_ = false;
     bool geometricGuard_ = true;  ///< see the banner

@@ -14,13 +14,13 @@ namespace ub {
 
 struct Ray {
     Vec3 org;
-    Vec3 dir;          ///< unit length
+    Vec3 dir;  ///< unit length
     float tMin = 0.0f;
     float tMax = kInf;
 };
 
 class Camera {
-public:
+  public:
     /// fovYDeg: vertical field of view in degrees, in (0, 180).
     /// lensRadius 0 means pinhole; focusDistance must be > 0 when lensRadius > 0.
     void setup(const Vec3& position, const Vec3& target, const Vec3& up, float fovYDeg, int width,
@@ -52,7 +52,7 @@ public:
     /// Distance of the unit-pixel-area image plane from the eye.
     float imagePlaneDist() const { return imagePlaneDist_; }
 
-private:
+  private:
     Vec3 position_, forward_, up_, right_;
     float fovYDeg_ = 45.0f, imagePlaneDist_ = 1.0f;
     float lensRadius_ = 0.0f, focusDistance_ = 1.0f;

@@ -236,8 +236,8 @@ void Light::prepare() {
             if (!isRotation(envToWorld))
                 throwLightError(*this, "environment map transform must be a rotation");
             if (envFilter != EnvFilter::Nearest && envFilter != EnvFilter::Bilinear)
-                throwLightError(*this, "unknown environment map filter " +
-                                           std::to_string(uint32_t(envFilter)));
+                throwLightError(
+                    *this, "unknown environment map filter " + std::to_string(uint32_t(envFilter)));
             worldToEnv = envToWorld.inverse();
             const Image& img = *envMap;
             for (int y = 0; y < img.height; ++y)
@@ -248,8 +248,8 @@ void Light::prepare() {
                                                    ") is negative or not finite");
             envLatLong = std::make_shared<LatLongMap>(envMap, radiance, envFilter);
             // Aliasing pointer: envDistribution lives as long as envLatLong.
-            envDistribution = std::shared_ptr<const Distribution2D>(
-                envLatLong, &envLatLong->cellDistribution());
+            envDistribution =
+                std::shared_ptr<const Distribution2D>(envLatLong, &envLatLong->cellDistribution());
             break;
         }
         default:

@@ -74,20 +74,21 @@ struct Light {
     Rgb radiance{0, 0, 0};   ///< Area: Le; ConstantEnv: Le; EnvMap: scale; Directional: irradiance
     Rgb intensity{0, 0, 0};  ///< Point
     Vec3 position{0, 0, 0};  ///< Point
-    Vec3 direction{0, 0, -1};///< Directional: direction light travels (unit)
-    bool twoSided = false;   ///< Area: emits from both sides
+    Vec3 direction{0, 0, -1};  ///< Directional: direction light travels (unit)
+    bool twoSided = false;     ///< Area: emits from both sides
     // ---- Spot (Mitsuba 3's `spot`): intensity(theta) = intensity * falloff(theta) with
     // theta the angle to `direction`: 1 inside beamWidthDeg, a linear ramp in theta down to
     // 0 at cutoffAngleDeg, 0 beyond. Mitsuba's defaults: cutoff 20, beam width 3/4 cutoff.
     float cutoffAngleDeg = 20.0f;  ///< Spot: half-angle of the lit cone, in (0, 180]
     float beamWidthDeg = 15.0f;    ///< Spot: half-angle of full intensity, in [0, cutoff]
-    float cosCutoff = 0.0f, cosBeamWidth = 0.0f;  ///< Spot: set by prepare()
+    float cosCutoff = 0.0f, cosBeamWidth = 0.0f;      ///< Spot: set by prepare()
     float cutoffRad = 0.0f, invTransitionRad = 0.0f;  ///< Spot: set by prepare() (0: no ramp)
 
     // ---- Area light geometry (world space) ----
-    std::vector<Vec3> triangles;  ///< 3 vertices per triangle (emits on the side of (p1-p0)x(p2-p0))
+    std::vector<Vec3>
+        triangles;  ///< 3 vertices per triangle (emits on the side of (p1-p0)x(p2-p0))
     Distribution1D triangleDistribution;  ///< by area
-    bool isSphere = false;        ///< Area light is a sphere (center=position, sphereRadius)
+    bool isSphere = false;  ///< Area light is a sphere (center=position, sphereRadius)
     float sphereRadius = 0.0f;
     float totalArea = 0.0f;
 
@@ -96,10 +97,10 @@ struct Light {
     EnvFilter envFilter = EnvFilter::Nearest;  ///< lookup (Mitsuba and JSON loaders: Bilinear)
     std::shared_ptr<const LatLongMap> envLatLong;  ///< set by prepare(): lookup and sampling
     std::shared_ptr<const Distribution2D> envDistribution;  ///< set by prepare(): its cells
-    Transform envToWorld;                      ///< rotation of the map (identity by default)
-    Transform worldToEnv;                      ///< set by prepare()
+    Transform envToWorld;  ///< rotation of the map (identity by default)
+    Transform worldToEnv;  ///< set by prepare()
 
-    bool prepared = false;                    ///< set by prepare()
+    bool prepared = false;  ///< set by prepare()
 
     /// Precomputes triangle distribution / area / env-map distribution and normalizes
     /// `direction`. Must be called after filling the fields (calling it again is

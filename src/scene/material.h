@@ -11,13 +11,15 @@
 namespace ub {
 
 enum class MaterialType : uint32_t {
-    Diffuse = 0,         ///< Lambertian, reflectance `diffuse`
-    Phong = 1,           ///< SmallVCM model: Lambert `diffuse` + modified Phong lobe `glossy`, `exponent`
-    Mirror = 2,          ///< perfect specular reflection scaled by `specular`
-    Dielectric = 3,      ///< smooth glass: Fresnel reflection + refraction, `ior`, tint `specular`
-    RoughConductor = 4,  ///< GGX microfacet conductor: `eta`, `k` (RGB), roughness `alpha`, tint `specular`
-    RoughDielectric = 5, ///< GGX microfacet dielectric (Walter et al. 2007): `ior`, `alpha`, tint `specular`
-    Plastic = 6,         ///< Mitsuba 3 `plastic`: smooth coating (`ior` = int/ext) over Lambert `diffuse`
+    Diffuse = 0,  ///< Lambertian, reflectance `diffuse`
+    Phong = 1,    ///< SmallVCM model: Lambert `diffuse` + modified Phong lobe `glossy`, `exponent`
+    Mirror = 2,   ///< perfect specular reflection scaled by `specular`
+    Dielectric = 3,  ///< smooth glass: Fresnel reflection + refraction, `ior`, tint `specular`
+    RoughConductor =
+        4,  ///< GGX microfacet conductor: `eta`, `k` (RGB), roughness `alpha`, tint `specular`
+    RoughDielectric =
+        5,  ///< GGX microfacet dielectric (Walter et al. 2007): `ior`, `alpha`, tint `specular`
+    Plastic = 6,  ///< Mitsuba 3 `plastic`: smooth coating (`ior` = int/ext) over Lambert `diffuse`
     RoughPlastic = 7,    ///< Mitsuba 3 `roughplastic`: GGX coating (`alpha`) over Lambert `diffuse`
     ThinDielectric = 8,  ///< Mitsuba 3 `thindielectric`: delta reflection `specular` + straight
                          ///< transmission `transmittance`; `ior` of the sheet
@@ -39,9 +41,10 @@ struct Material {
     float exponent = 1.0f;          ///< Phong exponent (> 0)
     Rgb specular{1, 1, 1};          ///< Mirror / Dielectric / Rough* tint
     float ior = 1.5f;               ///< Dielectric, RoughDielectric: interior / exterior IOR
-    Rgb eta{0.2f, 0.92f, 1.1f};     ///< RoughConductor: real part of the complex IOR (default: copper)
-    Rgb k{3.9f, 2.45f, 2.14f};      ///< RoughConductor: imaginary part
-    float alpha = 0.1f;             ///< GGX roughness (alpha = roughness^2 convention NOT used: alpha as given)
+    Rgb eta{0.2f, 0.92f, 1.1f};  ///< RoughConductor: real part of the complex IOR (default: copper)
+    Rgb k{3.9f, 2.45f, 2.14f};   ///< RoughConductor: imaginary part
+    float alpha =
+        0.1f;  ///< GGX roughness (alpha = roughness^2 convention NOT used: alpha as given)
     /// RoughConductor, RoughDielectric reflection: Smith masking-shadowing G2 separable,
     /// G1(i) G1(o) (Mitsuba 3's choice; Walter 2007 eq. 23), instead of the default
     /// height-correlated 1 / (1 + Lambda(i) + Lambda(o)) (Heitz 2014 eq. 99). Refraction
@@ -51,11 +54,11 @@ struct Material {
     /// behaves like the front. Dielectrics ignore it: their inside is defined by the normal.
     /// ThinDielectric ignores it too: the sheet is the same from both sides.
     bool twoSided = true;
-    Rgb transmittance{1, 1, 1};     ///< ThinDielectric: tint of the transmitted light
+    Rgb transmittance{1, 1, 1};  ///< ThinDielectric: tint of the transmitted light
     /// Plastic, RoughPlastic: Mitsuba's `nonlinear` (base albedo inside the internal
     /// scattering sum, darker and more saturated colours); false keeps texture colours.
     bool nonlinear = false;
-    MaterialTextures textures;      ///< textured parameters (Scene::setupBsdf looks them up)
+    MaterialTextures textures;  ///< textured parameters (Scene::setupBsdf looks them up)
 
     // ---- derived data, filled by prepareMaterial() (scene/bsdf.h) ----
     /// Plastic: Fdr of the coating seen from inside (fit); RoughPlastic: Mitsuba 3's

@@ -1,13 +1,13 @@
 // Regular tracking through homogeneous and NanoVDB grid media (see medium.h).
 #include "scene/medium.h"
 
-#include "scene/albedo_grid.h"
-#include "scene/medium_trilinear.h"
-
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include "scene/albedo_grid.h"
+#include "scene/medium_trilinear.h"
 
 namespace ub {
 
@@ -22,7 +22,9 @@ void checkG(float g) {
         throw std::invalid_argument("medium: HG g must lie in (-1, 1), got " + std::to_string(g));
 }
 
-Rgb expNeg(const Rgb& tau) { return {std::exp(-tau.x), std::exp(-tau.y), std::exp(-tau.z)}; }
+Rgb expNeg(const Rgb& tau) {
+    return {std::exp(-tau.x), std::exp(-tau.y), std::exp(-tau.z)};
+}
 
 /// Leaf nodes of the default NanoVDB float tree are 8^3 voxels; a voxel whose block has no
 /// leaf has the value of the enclosing tile (or the background) over the whole block.
@@ -32,8 +34,7 @@ constexpr int kLeafDim = 8;
 /// coefficients covering [0, tMax] in order, until visit returns false. Zero-length pieces
 /// are skipped. Returns false if a visit stopped the walk.
 template <typename Visit>
-bool forEachPiece(const Medium& m, const Vec3& origin, const Vec3& dir, float tMax,
-                  Visit&& visit) {
+bool forEachPiece(const Medium& m, const Vec3& origin, const Vec3& dir, float tMax, Visit&& visit) {
     if (!(tMax > 0.0f)) return true;
     if (m.type == MediumType::kHomogeneous) return visit(0.0f, tMax, m.sigmaA + m.sigmaS, m.sigmaS);
 
@@ -117,8 +118,9 @@ bool forEachPiece(const Medium& m, const Vec3& origin, const Vec3& dir, float tM
 
 Medium Medium::homogeneous(const Rgb& sigmaA, const Rgb& sigmaS, float g, const Rgb& Le) {
     if (!isFiniteNonNegative(sigmaA) || !isFiniteNonNegative(sigmaS) || !isFiniteNonNegative(Le))
-        throw std::invalid_argument("homogeneous medium: sigma_a, sigma_s and Le must be finite "
-                                    "and >= 0");
+        throw std::invalid_argument(
+            "homogeneous medium: sigma_a, sigma_s and Le must be finite "
+            "and >= 0");
     checkG(g);
     Medium m;
     m.type = MediumType::kHomogeneous;
@@ -137,8 +139,7 @@ Medium Medium::heterogeneous(std::shared_ptr<const VdbGrid> grid, float densityS
     if (!isFiniteNonNegative(albedo) || maxComponent(albedo) > 1.0f)
         throw std::invalid_argument("grid medium: albedo must lie in [0, 1]");
     checkG(g);
-    Transform cellToWorld =
-        localToWorld * grid->indexToLocal() * Transform::translate(Vec3(-0.5f));
+    Transform cellToWorld = localToWorld * grid->indexToLocal() * Transform::translate(Vec3(-0.5f));
     if (!(std::fabs(cellToWorld.determinant3()) > 0.0f))
         throw std::invalid_argument("grid medium: singular transform");
     Medium m;
@@ -259,8 +260,8 @@ MediumSegment evalMediumSegment(const Medium& m, const Vec3& origin, const Vec3&
     return seg;
 }
 
-FreeFlightSample sampleFreeFlight(const Medium& m, const Vec3& origin, const Vec3& dir,
-                                  float tMax, float uChannel, float uDistance) {
+FreeFlightSample sampleFreeFlight(const Medium& m, const Vec3& origin, const Vec3& dir, float tMax,
+                                  float uChannel, float uDistance) {
     if (m.type == MediumType::kGrid && m.filter == GridFilter::kTrilinear)
         return trilinearFreeFlight(m, origin, dir, tMax, uChannel, uDistance);
     const int c = std::min(2, int(uChannel * 3.0f));
@@ -301,8 +302,8 @@ FreeFlightSample sampleFreeFlight(const Medium& m, const Vec3& origin, const Vec
     seg.length = s.t;
     s.pdf = s.scattered ? seg.pdfScatterFwdL() : seg.probPass();
     if (s.pdf > 0.0f)
-        s.weight = s.scattered ? seg.transmittance * seg.sigmaS1 / s.pdf
-                               : seg.transmittance / s.pdf;
+        s.weight =
+            s.scattered ? seg.transmittance * seg.sigmaS1 / s.pdf : seg.transmittance / s.pdf;
     return s;
 }
 

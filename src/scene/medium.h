@@ -99,7 +99,7 @@ struct Medium {
     Rgb albedo{1.0f};           ///< sigma_s / sigma_t, each channel in [0, 1]
     /// Spatially varying albedo replacing `albedo` where set (null: the constant albedo).
     std::shared_ptr<const AlbedoGrid> albedoGrid;
-    Transform localToWorld;     ///< grid-local space -> world
+    Transform localToWorld;  ///< grid-local space -> world
     // Derived by heterogeneous(); do not set by hand.
     Transform worldToCell;  ///< world -> cell space (index space + 1/2: voxel v covers [v, v+1))
     Bounds3 worldBounds;    ///< world bounds of the grid's active voxels (background outside)
@@ -154,8 +154,7 @@ struct MediumSegment {
 };
 
 /// Evaluates the segment by regular tracking (exact for the piecewise-constant grid).
-MediumSegment evalMediumSegment(const Medium& m, const Vec3& origin, const Vec3& dir,
-                                float length);
+MediumSegment evalMediumSegment(const Medium& m, const Vec3& origin, const Vec3& dir, float length);
 /// Transmittance only (the cheaper query, for shadow rays and photon beams).
 Rgb transmittance(const Medium& m, const Vec3& origin, const Vec3& dir, float length);
 
@@ -171,7 +170,7 @@ struct FreeFlightSample {
 };
 
 /// uChannel picks the colour channel, uDistance the distance; both uniform in [0, 1).
-FreeFlightSample sampleFreeFlight(const Medium& m, const Vec3& origin, const Vec3& dir,
-                                  float tMax, float uChannel, float uDistance);
+FreeFlightSample sampleFreeFlight(const Medium& m, const Vec3& origin, const Vec3& dir, float tMax,
+                                  float uChannel, float uDistance);
 
 }  // namespace ub

@@ -76,8 +76,7 @@ Cubic cellCubic(DualGrid& g, const int k[3], const double q0[3], const double D[
 /// Calls visit(t0, t1, cubic) for consecutive pieces covering [0, tMax] (zero density
 /// outside the domain box) until visit returns false.
 template <typename Visit>
-void forEachCubic(const Medium& m, const Vec3& origin, const Vec3& dir, float tMax,
-                  Visit&& visit) {
+void forEachCubic(const Medium& m, const Vec3& origin, const Vec3& dir, float tMax, Visit&& visit) {
     if (!(tMax > 0.0f)) return;
     const Vec3 Pc = m.worldToCell.point(origin), Dc = m.worldToCell.vector(dir);
     double P[3], D[3], lo[3], hi[3];
@@ -115,8 +114,10 @@ void forEachCubic(const Medium& m, const Vec3& origin, const Vec3& dir, float tM
             double q = P[a] + D[a] * probe;
             k[a] = int(std::floor(q));
             k[a] = std::clamp(k[a], m.domainLo[a] - 1, m.domainHi[a]);
-            if (D[a] > 0) tNext = std::min(tNext, (k[a] + 1 - P[a]) / D[a]);
-            else if (D[a] < 0) tNext = std::min(tNext, (k[a] - P[a]) / D[a]);
+            if (D[a] > 0)
+                tNext = std::min(tNext, (k[a] + 1 - P[a]) / D[a]);
+            else if (D[a] < 0)
+                tNext = std::min(tNext, (k[a] - P[a]) / D[a]);
         }
         if (!(tNext > t)) tNext = std::min(tExit, t + 1e-9 * std::max(1.0, std::fabs(t)));
         double q0[3];
@@ -127,7 +128,9 @@ void forEachCubic(const Medium& m, const Vec3& origin, const Vec3& dir, float tM
     if (tExit < tMax) visit(tExit, double(tMax), zero);
 }
 
-Rgb expNeg(const Rgb& tau) { return {std::exp(-tau.x), std::exp(-tau.y), std::exp(-tau.z)}; }
+Rgb expNeg(const Rgb& tau) {
+    return {std::exp(-tau.x), std::exp(-tau.y), std::exp(-tau.z)};
+}
 
 /// Solves F(s) = target for s in [0, L], F(s) = scale * integral of c over [0, s]
 /// (non-decreasing): Newton steps kept inside a shrinking bracket, bisection otherwise.
@@ -137,8 +140,10 @@ double invertCubic(const Cubic& c, double scale, double L, double target) {
     double s = FL > 0 ? L * std::clamp(target / FL, 0.0, 1.0) : 0.5 * L;
     for (int it = 0; it < 100; ++it) {
         double f = scale * c.integral(s) - target;
-        if (f < 0) a = s;
-        else b = s;
+        if (f < 0)
+            a = s;
+        else
+            b = s;
         if (std::fabs(f) <= 1e-12 * std::max(target, 1e-30) || b - a <= 1e-12 * L) break;
         double d = scale * c.eval(s);
         double sn = d > 0 ? s - f / d : -1.0;
@@ -171,8 +176,7 @@ Rgb trilinearTransmittance(const Medium& m, const Vec3& origin, const Vec3& dir,
     return expNeg(Rgb(float(m.densityScale * std::max(0.0, tau))));
 }
 
-MediumSegment trilinearSegment(const Medium& m, const Vec3& origin, const Vec3& dir,
-                               float length) {
+MediumSegment trilinearSegment(const Medium& m, const Vec3& origin, const Vec3& dir, float length) {
     MediumSegment seg;
     seg.length = length;
     double tau = 0.0, d0 = 0.0, d1 = 0.0;
@@ -229,8 +233,8 @@ FreeFlightSample trilinearFreeFlight(const Medium& m, const Vec3& origin, const 
     seg.transmittance = expNeg(Rgb(float(std::max(0.0, tau))));
     s.pdf = s.scattered ? seg.pdfScatterFwdL() : seg.probPass();
     if (s.pdf > 0.0f)
-        s.weight = s.scattered ? seg.transmittance * seg.sigmaS1 / s.pdf
-                               : seg.transmittance / s.pdf;
+        s.weight =
+            s.scattered ? seg.transmittance * seg.sigmaS1 / s.pdf : seg.transmittance / s.pdf;
     return s;
 }
 

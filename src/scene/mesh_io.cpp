@@ -341,9 +341,8 @@ bool checkPlyCounts(const std::string& path, Reporter& rep) {
             std::string count;
             ls >> e.name >> count;
             e.line = lineNo;
-            const bool digits =
-                !count.empty() && count.size() <= 19 &&
-                count.find_first_not_of("0123456789") == std::string::npos;
+            const bool digits = !count.empty() && count.size() <= 19 &&
+                                count.find_first_not_of("0123456789") == std::string::npos;
             if (!digits) {
                 rep.error("PLY element '" + e.name + "' has count '" + count +
                               "' (expected a non-negative integer)",

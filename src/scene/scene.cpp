@@ -239,8 +239,8 @@ Scene::Scene() : impl_(std::make_unique<Impl>()) {
 Scene::~Scene() = default;
 
 int Scene::addMaterial(const Material& m) {
-    for (int t : {m.textures.diffuse, m.textures.glossy, m.textures.specular,
-                  m.textures.transmittance})
+    for (int t :
+         {m.textures.diffuse, m.textures.glossy, m.textures.specular, m.textures.transmittance})
         if (t >= int(textures.size()))
             throw std::logic_error("Scene::addMaterial: material '" + m.name +
                                    "' refers to texture " + std::to_string(t) +
@@ -406,10 +406,9 @@ void Scene::commit() {
                 Diagnostic d;
                 d.file = sourceFile;
                 d.where = i.shapeId >= 0 ? "shape '" + shapes[size_t(i.shapeId)].name + "'"
-                                         : (i.mediumId >= 0 ? "medium '" +
-                                                                  mediumNames[size_t(i.mediumId)] +
-                                                                  "'"
-                                                            : std::string());
+                                         : (i.mediumId >= 0
+                                                ? "medium '" + mediumNames[size_t(i.mediumId)] + "'"
+                                                : std::string());
                 d.message = i.message;
                 diags.push_back(d);
             }

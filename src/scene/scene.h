@@ -25,23 +25,24 @@ struct SurfaceColors;
 /// Triangle mesh in world space (loaders apply transforms before adding).
 struct TriangleMesh {
     std::vector<Vec3> positions;
-    std::vector<Vec3> normals;          ///< optional per-vertex shading normals (empty or = positions.size())
-    std::vector<Vec2> uvs;              ///< optional per-vertex uvs
-    std::vector<uint32_t> indices;      ///< 3 per triangle
+    std::vector<Vec3>
+        normals;            ///< optional per-vertex shading normals (empty or = positions.size())
+    std::vector<Vec2> uvs;  ///< optional per-vertex uvs
+    std::vector<uint32_t> indices;  ///< 3 per triangle
     size_t triangleCount() const { return indices.size() / 3; }
 };
 
 /// Surface interaction returned by Scene::intersect.
 struct Hit {
-    float dist = kInf;         ///< ray parameter of the hit (ray.dir is unit: distance)
+    float dist = kInf;  ///< ray parameter of the hit (ray.dir is unit: distance)
     Vec3 pos;
-    Vec3 geoNormal;            ///< unit geometric normal as defined by the shape (front side)
-    Vec3 shadingNormal;        ///< unit shading normal, in the same hemisphere as geoNormal
+    Vec3 geoNormal;      ///< unit geometric normal as defined by the shape (front side)
+    Vec3 shadingNormal;  ///< unit shading normal, in the same hemisphere as geoNormal
     Vec2 uv;
     uint32_t shapeId = 0;
     uint32_t primId = 0;
     int materialId = -1;
-    int lightId = -1;          ///< index into Scene::lights if the shape is emissive, else -1
+    int lightId = -1;  ///< index into Scene::lights if the shape is emissive, else -1
 };
 
 /// How the medium of a path changes where it crosses a medium boundary.
@@ -80,8 +81,8 @@ enum class ShadingNormals : uint8_t {
 
 /// What the renderer needs from the scene file besides geometry.
 struct RenderSettings {
-    int maxPathLength = 10;    ///< max number of path segments (SmallVCM semantics)
-    int minPathLength = 0;     ///< paths with fewer segments do not contribute
+    int maxPathLength = 10;  ///< max number of path segments (SmallVCM semantics)
+    int minPathLength = 0;   ///< paths with fewer segments do not contribute
     uint64_t seed = 1;
     /// --resolution keeps the horizontal field of view instead of the vertical one
     /// (SmallUPBP scenes: its -r keeps CAMERA_FOV, a horizontal angle).
@@ -104,11 +105,11 @@ struct ShapeInfo {
     /// Medium outside the shape (-1 = vacuum); MediumTransitions::kShapeSides only.
     int exteriorMediumId = -1;
     int mediumPriority = 0;
-    bool imaginary = false;     ///< changes the medium only: never scatters nor emits
+    bool imaginary = false;  ///< changes the medium only: never scatters nor emits
 };
 
 class Scene {
-public:
+  public:
     Scene();
     ~Scene();
     Scene(const Scene&) = delete;
@@ -210,17 +211,18 @@ public:
     std::vector<Material> materials;
     std::vector<Light> lights;
     std::vector<Texture> textures;  ///< referenced by Material::textures
-    int backgroundLightId = -1;   ///< environment light hit by escaping rays, or -1
-    SceneSphere sceneSphere;      ///< bounding sphere of the geometry only (as SmallVCM; the camera may lie outside)
+    int backgroundLightId = -1;     ///< environment light hit by escaping rays, or -1
+    SceneSphere sceneSphere;  ///< bounding sphere of the geometry only (as SmallVCM; the camera may
+                              ///< lie outside)
     Bounds3 bounds;
     std::vector<ShapeInfo> shapes;
-    std::string sourceFile;       ///< path the scene was loaded from
+    std::string sourceFile;  ///< path the scene was loaded from
     std::vector<Medium> media;
     std::vector<std::string> mediumNames;  ///< parallel to media
-    int globalMediumId = -1;      ///< medium outside every boundary (-1 = vacuum)
-    MediumStack cameraMediumStack;  ///< set by commit(): media at the camera position
+    int globalMediumId = -1;               ///< medium outside every boundary (-1 = vacuum)
+    MediumStack cameraMediumStack;         ///< set by commit(): media at the camera position
 
-private:
+  private:
     MediumStack mediumStackAtShapeSides(const Vec3& p) const;
 
     struct Impl;

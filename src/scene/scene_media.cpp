@@ -190,9 +190,10 @@ std::vector<MediumIssue> Scene::mediumIssues() const {
         if (sh.exteriorMediumId >= 0 &&
             settings.mediumTransitions != MediumTransitions::kShapeSides)
             add(int(s), -1,
-                name + " has an exterior medium, which only Mitsuba's medium transitions use "
-                       "(the priority stack derives the outside medium from the boundaries "
-                       "around the shape)");
+                name +
+                    " has an exterior medium, which only Mitsuba's medium transitions use "
+                    "(the priority stack derives the outside medium from the boundaries "
+                    "around the shape)");
         if (sh.imaginary && sh.lightId >= 0)
             add(int(s), -1, name + " is an imaginary medium boundary and cannot emit light");
         if (!sh.isSphere) {
@@ -425,8 +426,7 @@ namespace {
 /// again: the crossing's origin offset moves the ray off the line by ~eps, and keeping the
 /// old direction and remaining length would, at grazing angles to a surface at the target
 /// (an area light), reach that surface before the target (the end offset is ~eps as well).
-MediumShadow walkShadow(const Scene& scene, Vec3 from, Vec3 dir, float maxDist,
-                        MediumStack stack) {
+MediumShadow walkShadow(const Scene& scene, Vec3 from, Vec3 dir, float maxDist, MediumStack stack) {
     ChainPdfs chain;
     const bool finite = maxDist < kInf;
     const Vec3 target = finite ? from + dir * maxDist : Vec3(0.0f);

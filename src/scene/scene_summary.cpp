@@ -1,10 +1,10 @@
 #include "scene/scene_summary.h"
 
-#include "scene/albedo_grid.h"
-
 #include <cstdio>
 #include <map>
 #include <sstream>
+
+#include "scene/albedo_grid.h"
 
 namespace ub {
 
@@ -127,9 +127,9 @@ std::string describeScene(const Scene& scene) {
                 os << ", intensity " << vec(l.intensity) << " at " << vec(l.position);
                 break;
             case LightType::Spot:
-                os << ", intensity " << vec(l.intensity) << " at " << vec(l.position)
-                   << " towards " << vec(l.direction) << ", cutoff " << num(l.cutoffAngleDeg)
-                   << " deg, beam " << num(l.beamWidthDeg) << " deg";
+                os << ", intensity " << vec(l.intensity) << " at " << vec(l.position) << " towards "
+                   << vec(l.direction) << ", cutoff " << num(l.cutoffAngleDeg) << " deg, beam "
+                   << num(l.beamWidthDeg) << " deg";
                 break;
             case LightType::Directional:
                 os << ", irradiance " << vec(l.radiance) << " towards " << vec(l.direction);

@@ -2,15 +2,15 @@
 // unit of the library that includes OpenVDB (its headers are slow to compile).
 #include "scene/vdb_grid.h"
 
+#include <nanovdb/util/OpenToNanoVDB.h>
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+
 #include <cmath>
 #include <filesystem>
 #include <limits>
 #include <mutex>
 #include <sstream>
-
-#include <openvdb/openvdb.h>
-#include <openvdb/io/File.h>
-#include <nanovdb/util/OpenToNanoVDB.h>
 
 #include "core/error.h"
 
@@ -23,7 +23,9 @@ void initOpenVdb() {
     std::call_once(once, [] { openvdb::initialize(); });
 }
 
-std::string quoted(const std::string& s) { return "'" + s + "'"; }
+std::string quoted(const std::string& s) {
+    return "'" + s + "'";
+}
 
 }  // namespace
 
@@ -59,9 +61,12 @@ struct VdbGridBuilder {
                 const std::string& q = check.quantity;
                 const bool vowel =
                     !q.empty() && std::string("aeiou").find(q[0]) != std::string::npos;
-                if (!std::isfinite(v)) os << "has a non-finite " << q << " " << v;
-                else if (v < 0) os << "has a negative " << q << " " << v;
-                else os << "has " << (vowel ? "an " : "a ") << q << " " << v;
+                if (!std::isfinite(v))
+                    os << "has a non-finite " << q << " " << v;
+                else if (v < 0)
+                    os << "has a negative " << q << " " << v;
+                else
+                    os << "has " << (vowel ? "an " : "a ") << q << " " << v;
                 if (background)
                     os << " as its background value";
                 else
@@ -118,8 +123,8 @@ openvdb::GridBase::Ptr readNamedGrid(const std::string& path, const std::string&
     openvdb::GridBase::ConstPtr meta;
     std::string present;
     for (const openvdb::GridBase::Ptr& g : *metadata) {
-        present += (present.empty() ? "" : ", ") + quoted(g->getName()) + " (" +
-                   g->valueType() + ")";
+        present +=
+            (present.empty() ? "" : ", ") + quoted(g->getName()) + " (" + g->valueType() + ")";
         if (g->getName() == gridName && !meta) meta = g;
     }
     if (!meta)
@@ -146,8 +151,10 @@ openvdb::FloatGrid::Ptr vec3Channel(const openvdb::Vec3SGrid& vec, int c) {
     for (auto it = vec.cbeginValueAll(); it; ++it) {
         const float v = (*it)[c];
         if (it.isVoxelValue()) {
-            if (it.isValueOn()) acc.setValueOn(it.getCoord(), v);
-            else acc.setValueOff(it.getCoord(), v);
+            if (it.isValueOn())
+                acc.setValueOn(it.getCoord(), v);
+            else
+                acc.setValueOff(it.getCoord(), v);
         } else {
             out->tree().fill(it.getBoundingBox(), v, it.isValueOn());
         }
@@ -157,8 +164,7 @@ openvdb::FloatGrid::Ptr vec3Channel(const openvdb::Vec3SGrid& vec, int c) {
 
 }  // namespace
 
-std::shared_ptr<const VdbGrid> VdbGrid::load(const std::string& path,
-                                             const std::string& gridName) {
+std::shared_ptr<const VdbGrid> VdbGrid::load(const std::string& path, const std::string& gridName) {
     auto fail = [&](const std::string& what) {
         throw InputError(path, "cannot load grid " + quoted(gridName) + ": " + what);
     };
@@ -187,9 +193,8 @@ std::vector<std::shared_ptr<const VdbGrid>> VdbGrid::loadChannels(const std::str
             out.push_back(VdbGridBuilder::build(*vec3Channel(*vec, c), path, gridName, check));
         return out;
     }
-    fail("grid holds values of type " + quoted(base->valueType()) + " (grid type " +
-         base->type() + "), expected a float (1 channel) or vec3s (3 channels) " + quantity +
-         " grid");
+    fail("grid holds values of type " + quoted(base->valueType()) + " (grid type " + base->type() +
+         "), expected a float (1 channel) or vec3s (3 channels) " + quantity + " grid");
     return {};
 }
 
@@ -224,8 +229,7 @@ openvdb::FloatGrid::Ptr denseToOpenVdb(const DenseFloatGrid& dense, const std::s
 openvdb::GridBase::Ptr denseToOpenVdb(const DenseVdbGrid& g, const std::string& path) {
     if (g.channels.size() == 1) return denseToOpenVdb(g.channels[0], g.name);
     if (g.channels.size() != 3)
-        throw InputError(path, "grid " + quoted(g.name) + ": " +
-                                   std::to_string(g.channels.size()) +
+        throw InputError(path, "grid " + quoted(g.name) + ": " + std::to_string(g.channels.size()) +
                                    " channels (a VDB grid is written with 1 or 3)");
     const DenseFloatGrid& c0 = g.channels[0];
     for (const DenseFloatGrid& c : g.channels)
@@ -254,8 +258,9 @@ std::shared_ptr<const VdbGrid> VdbGrid::fromDense(const DenseFloatGrid& dense,
                                                   const std::string& label) {
     initOpenVdb();
     if (dense.values.size() != size_t(dense.nx) * dense.ny * dense.nz)
-        throw InputError(label, "grid " + quoted(gridName) + ": dense value count does not "
-                                "match its dimensions");
+        throw InputError(label, "grid " + quoted(gridName) +
+                                    ": dense value count does not "
+                                    "match its dimensions");
     return VdbGridBuilder::build(*denseToOpenVdb(dense, gridName), label, gridName);
 }
 
@@ -274,8 +279,9 @@ std::shared_ptr<const VdbGrid> VdbGrid::fromDenseChecked(const DenseFloatGrid& d
                                                          float maxAllowed) {
     initOpenVdb();
     if (dense.values.size() != size_t(dense.nx) * dense.ny * dense.nz)
-        throw InputError(label, "grid " + quoted(gridName) + ": dense value count does not "
-                                "match its dimensions");
+        throw InputError(label, "grid " + quoted(gridName) +
+                                    ": dense value count does not "
+                                    "match its dimensions");
     return VdbGridBuilder::build(*denseToOpenVdb(dense, gridName, /*allActive=*/true), label,
                                  gridName, ValueCheck{quantity, maxAllowed});
 }

@@ -14,13 +14,13 @@
 // value (0 for fog volumes).
 #pragma once
 
+#include <nanovdb/NanoVDB.h>
+#include <nanovdb/util/GridHandle.h>
+
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <nanovdb/NanoVDB.h>
-#include <nanovdb/util/GridHandle.h>
 
 #include "core/vec.h"
 
@@ -44,7 +44,7 @@ struct DenseFloatGrid {
 
 /// A float density grid in NanoVDB form (immutable after construction).
 class VdbGrid {
-public:
+  public:
     /// Reads grid `gridName` from the OpenVDB file `path`. Throws ub::InputError naming the
     /// file and the grid if the file is missing, is not a VDB file, has no grid of that name
     /// (the message lists the grids present), holds a grid of another value type than float,
@@ -93,7 +93,7 @@ public:
     VdbGrid(const VdbGrid&) = delete;
     VdbGrid& operator=(const VdbGrid&) = delete;
 
-private:
+  private:
     VdbGrid() = default;
     friend struct VdbGridBuilder;
 

@@ -31,7 +31,9 @@ float readF32(const unsigned char* p) {
 }  // namespace
 
 VolGrid readVolFile(const std::string& path) {
-    auto fail = [&](const std::string& what) { throw InputError(path, "invalid .vol file: " + what); };
+    auto fail = [&](const std::string& what) {
+        throw InputError(path, "invalid .vol file: " + what);
+    };
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec))
         throw InputError(path, "cannot open the .vol file (not found or not a file)");
@@ -94,8 +96,7 @@ VolGrid readVolFile(const std::string& path) {
             size_t x = voxel % size_t(v.nx), y = (voxel / size_t(v.nx)) % size_t(v.ny),
                    z = voxel / (size_t(v.nx) * size_t(v.ny));
             fail("non-finite value at voxel (" + std::to_string(x) + ", " + std::to_string(y) +
-                 ", " + std::to_string(z) + "), channel " +
-                 std::to_string(i % size_t(v.channels)));
+                 ", " + std::to_string(z) + "), channel " + std::to_string(i % size_t(v.channels)));
         }
         v.values[i] = f;
     }

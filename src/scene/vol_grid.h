@@ -21,8 +21,8 @@ namespace ub {
 
 struct VolGrid {
     int nx = 0, ny = 0, nz = 0, channels = 0;
-    Vec3 bboxMin, bboxMax;     ///< from the header (used only with use_grid_bbox)
-    std::vector<float> values; ///< nx * ny * nz * channels
+    Vec3 bboxMin, bboxMax;      ///< from the header (used only with use_grid_bbox)
+    std::vector<float> values;  ///< nx * ny * nz * channels
     float at(int x, int y, int z, int c) const {
         return values[((size_t(z) * ny + y) * nx + x) * channels + c];
     }

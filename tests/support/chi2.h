@@ -59,9 +59,8 @@ struct Chi2Result {
 /// pdf(dir): solid-angle density of sample(), for dir on the unit sphere.
 /// Directions are expressed in the frame in which (theta, phi) are binned (+z pole).
 inline Chi2Result chi2TestSphere(const std::function<Vec3()>& sample,
-                                 const std::function<double(const Vec3&)>& pdf,
-                                 int sampleCount, int thetaBins = 20, int phiBins = 40,
-                                 int integrationRes = 8) {
+                                 const std::function<double(const Vec3&)>& pdf, int sampleCount,
+                                 int thetaBins = 20, int phiBins = 40, int integrationRes = 8) {
     const int nb = thetaBins * phiBins;
     std::vector<double> observed(nb, 0.0), expected(nb, 0.0);
     for (int i = 0; i < sampleCount; ++i) {

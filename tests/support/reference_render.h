@@ -32,8 +32,8 @@ struct ReferenceCheck {
 /// Renders `scene` with `algorithm` for `iterations` (seed 1, the scene's path length) and
 /// tests it against ref/refVar (per-sample variance of a reference of refSamples samples).
 inline ReferenceCheck renderAgainstReference(const Scene& scene, const std::string& algorithm,
-                                             int iterations, const Image& ref,
-                                             const Image& refVar, double refSamples) {
+                                             int iterations, const Image& ref, const Image& refVar,
+                                             double refSamples) {
     RenderOptions o;
     o.algorithm = algorithm;
     o.maxPathLength = scene.settings.maxPathLength;
@@ -69,10 +69,11 @@ inline ReferenceCheck renderAgainstReference(const Scene& scene, const std::stri
 }
 
 inline void printReferenceCheck(const std::string& label, const ReferenceCheck& c) {
-    std::printf("[ reference] %s: %s\n  image mean z (R, G, B) %.2f %.2f %.2f, relative "
-                "difference %.4f %.4f %.4f\n",
-                label.c_str(), describeZTest(c.perPixel, c.options).c_str(), c.meanZ[0],
-                c.meanZ[1], c.meanZ[2], c.meanRelDiff[0], c.meanRelDiff[1], c.meanRelDiff[2]);
+    std::printf(
+        "[ reference] %s: %s\n  image mean z (R, G, B) %.2f %.2f %.2f, relative "
+        "difference %.4f %.4f %.4f\n",
+        label.c_str(), describeZTest(c.perPixel, c.options).c_str(), c.meanZ[0], c.meanZ[1],
+        c.meanZ[2], c.meanRelDiff[0], c.meanRelDiff[1], c.meanRelDiff[2]);
 }
 
 }  // namespace ub::test

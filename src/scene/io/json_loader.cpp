@@ -21,8 +21,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kLightTypes = {"point", "spot", "directional", "constant",
-                                              "envmap"};
+const std::vector<std::string> kLightTypes = {"point", "spot", "directional", "constant", "envmap"};
 
 /// nlohmann messages start with "[json.exception.parse_error.101] parse error at line 3,
 /// column 14: "; we print our own position, so keep only what follows.
@@ -289,10 +288,10 @@ void readJsonLights(JsonReader& r, const Json& lights, JsonSceneParts& parts) {
 void readRoot(JsonReader& r, const Json& root, JsonSceneParts& parts) {
     if (!r.isObject(root, "", "a scene object with \"camera\", \"materials\", \"shapes\" ..."))
         return;
-    r.checkKeys(root, "",
-                {"description", "camera", "settings", "materials", "media", "medium", "shapes",
-                 "lights"},
-                "the scene");
+    r.checkKeys(
+        root, "",
+        {"description", "camera", "settings", "materials", "media", "medium", "shapes", "lights"},
+        "the scene");
     if (const Json* d = r.member(root, "", "description", Presence::Optional, ""))
         r.string(*d, "/description", true);
     if (const Json* c = r.member(root, "", "camera", Presence::Required,
@@ -369,7 +368,7 @@ std::unique_ptr<Scene> buildScene(JsonSceneParts& parts, const std::string& file
     }
     // Media set-up errors (open boundary meshes, conflicting priorities), at the shape.
     for (const MediumIssue& issue : scene->mediumIssues()) {
-        std::string ptr = issue.shapeId >= 0 ? parts.shapes[size_t(issue.shapeId)].ptr
+        std::string ptr = issue.shapeId >= 0    ? parts.shapes[size_t(issue.shapeId)].ptr
                           : issue.mediumId >= 0 ? parts.mediumPtrs[size_t(issue.mediumId)]
                                                 : std::string("/shapes");
         reader.error(ptr, issue.message);

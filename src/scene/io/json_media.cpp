@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <map>
 
-#include "scene/io/json_scene_parts.h"
 #include "scene/albedo_grid.h"
+#include "scene/io/json_scene_parts.h"
 #include "scene/vdb_grid.h"
 
 namespace ub {
@@ -78,10 +78,9 @@ bool loadVdbFile(JsonReader& r, const JsonSceneParts& parts, const std::string& 
             return true;
         } catch (const InputError& e) {
             for (const Diagnostic& d : e.diagnostics()) {
-                const bool gridProblem = d.message.find("no grid of that name") !=
-                                             std::string::npos ||
-                                         d.message.find("grid holds values of type") !=
-                                             std::string::npos;
+                const bool gridProblem =
+                    d.message.find("no grid of that name") != std::string::npos ||
+                    d.message.find("grid holds values of type") != std::string::npos;
                 r.error(gridProblem ? gridPtr : filePtr,
                         "cannot use VDB file '" + file + "': " + d.message);
             }
@@ -103,8 +102,9 @@ void readHeterogeneous(JsonReader& r, const Json& v, const std::string& ptr, Jso
         r.getNumber(v, ptr, "density_scale", Presence::Optional, NumberRange::nonNegative(), 1.0f);
     const bool albedoGrid = v.contains("albedo_grid") || v.contains("albedo_file");
     if (albedoGrid && v.contains("albedo"))
-        r.error(ptr, "give either a constant \"albedo\" or an albedo grid (\"albedo_grid\", "
-                     "\"albedo_file\"), not both");
+        r.error(ptr,
+                "give either a constant \"albedo\" or an albedo grid (\"albedo_grid\", "
+                "\"albedo_file\"), not both");
     Rgb albedo =
         r.getRgb(v, ptr, "albedo", Presence::Optional, NumberRange::closed(0.0, 1.0), Rgb(1.0f));
     GridFilter albedoFilter = GridFilter::kNearest;
@@ -146,10 +146,9 @@ void readHeterogeneous(JsonReader& r, const Json& v, const std::string& ptr, Jso
             albedoFilePtr = jsonPointerChild(ptr, "albedo_file");
         }
         if (!albedoFile.empty() && !albedoGridName.empty())
-            loadVdbFile(r, parts, albedoFile, albedoFilePtr, gridPtr,
-                        [&](const std::string& path) {
-                            albedoChannels = loadVdbAlbedoChannels(path, albedoGridName);
-                        });
+            loadVdbFile(r, parts, albedoFile, albedoFilePtr, gridPtr, [&](const std::string& path) {
+                albedoChannels = loadVdbAlbedoChannels(path, albedoGridName);
+            });
     }
     if (r.errorCount() != before || !grid) return;
     try {
@@ -161,8 +160,7 @@ void readHeterogeneous(JsonReader& r, const Json& v, const std::string& ptr, Jso
     } catch (const std::invalid_argument& e) {
         r.error(ptr, e.what());
     } catch (const InputError& e) {
-        for (const Diagnostic& d : e.diagnostics())
-            r.error(gridPtr, d.message);
+        for (const Diagnostic& d : e.diagnostics()) r.error(gridPtr, d.message);
     }
 }
 

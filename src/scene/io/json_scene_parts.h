@@ -33,7 +33,7 @@ struct JsonShapeDesc {
     float radius = 0.0f;  ///< spheres, world space
     int materialId = -1;  ///< index into JsonSceneParts::materials
     int lightIndex = -1;  ///< index into JsonSceneParts::lights, or -1
-    std::string ptr;  ///< JSON pointer of the shape, for messages after reading
+    std::string ptr;      ///< JSON pointer of the shape, for messages after reading
     // Medium boundary ("interior_medium", "priority", "imaginary").
     bool isMediumBoundary = false;
     int interiorMedium = -1;  ///< index into JsonSceneParts::media, -1 = vacuum
@@ -47,9 +47,9 @@ struct JsonSceneParts {
     JsonCameraDesc camera;
     RenderSettings settings;
     std::vector<Material> materials;
-    std::vector<Texture> textures;           ///< Material::textures index these (and Scene's)
+    std::vector<Texture> textures;  ///< Material::textures index these (and Scene's)
     std::map<std::string, std::shared_ptr<const Image>> bitmapCache;  ///< by path (+ "|raw")
-    std::map<std::string, int> materialIds;  ///< by name
+    std::map<std::string, int> materialIds;                           ///< by name
     std::vector<std::string> materialNames;  ///< in file order, for messages
     std::vector<JsonShapeDesc> shapes;
     std::vector<Light> lights;

@@ -161,9 +161,15 @@ void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
     std::string typePtr = jsonPointerChild(ptr, "type");
     std::string type = r.string(*typeJson, typePtr);
     if (type.empty()) return;
-    std::vector<std::string> keys = {"type",      "name",     "material",
-                                     "transform", "emission", "emission_two_sided",
-                                     "interior_medium", "priority", "imaginary"};
+    std::vector<std::string> keys = {"type",
+                                     "name",
+                                     "material",
+                                     "transform",
+                                     "emission",
+                                     "emission_two_sided",
+                                     "interior_medium",
+                                     "priority",
+                                     "imaginary"};
     if (type == "obj" || type == "ply") {
         keys.push_back("file");
     } else if (type == "sphere") {
@@ -200,8 +206,8 @@ void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
     shape.ptr = ptr;
     shape.imaginary = r.getBool(v, ptr, "imaginary", false);
     if (const Json* im = r.member(v, ptr, "interior_medium", Presence::Optional, "")) {
-        shape.isMediumBoundary = readJsonMediumRef(
-            r, *im, jsonPointerChild(ptr, "interior_medium"), parts, &shape.interiorMedium);
+        shape.isMediumBoundary = readJsonMediumRef(r, *im, jsonPointerChild(ptr, "interior_medium"),
+                                                   parts, &shape.interiorMedium);
     }
     shape.priority =
         int(r.getInteger(v, ptr, "priority", Presence::Optional, -1000000, 1000000, 0));
@@ -225,10 +231,10 @@ void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
     // Material: required, except on emitters (which are then black) and imaginary shapes.
     if (shape.imaginary) {
         // no material: the surface is never a path vertex
-    } else if (const Json* mj = r.member(
-                   v, ptr, "material",
-                   v.contains("emission") ? Presence::Optional : Presence::Required,
-                   "the name of a material defined in \"materials\"")) {
+    } else if (const Json* mj =
+                   r.member(v, ptr, "material",
+                            v.contains("emission") ? Presence::Optional : Presence::Required,
+                            "the name of a material defined in \"materials\"")) {
         std::string mPtr = jsonPointerChild(ptr, "material");
         std::string name = r.string(*mj, mPtr);
         auto it = parts.materialIds.find(name);

@@ -3,21 +3,20 @@
 #include <cmath>
 
 #include "core/image.h"
-#include "scene/texture.h"
-
 #include "scene/io/mitsuba_build.h"
+#include "scene/texture.h"
 
 namespace ub {
 
 namespace {
 
 const std::vector<std::string> kBsdfs = {
-    "diffuse",         "conductor",      "roughconductor", "dielectric", "roughdielectric",
-    "thindielectric",  "plastic",        "roughplastic",   "null",       "twosided"};
+    "diffuse",        "conductor", "roughconductor", "dielectric", "roughdielectric",
+    "thindielectric", "plastic",   "roughplastic",   "null",       "twosided"};
 const std::vector<std::string> kTextures = {"checkerboard", "bitmap"};
 
-constexpr float kAirIor = 1.000277f;  // Mitsuba's default ext_ior ("air")
-constexpr float kBk7Ior = 1.5046f;    // Mitsuba's default int_ior ("bk7")
+constexpr float kAirIor = 1.000277f;        // Mitsuba's default ext_ior ("air")
+constexpr float kBk7Ior = 1.5046f;          // Mitsuba's default int_ior ("bk7")
 constexpr float kPolypropyleneIor = 1.49f;  // Mitsuba's default int_ior of plastics
 
 /// A <texture> -> index into Scene::textures (cached per object); -1 on an error.
@@ -36,12 +35,12 @@ int buildTexture(MitsubaBuild& b, const XmlObject& t) {
         tex.type = TextureType::Bitmap;
         std::string filter = r.getString(t, "filter_type", "bilinear");
         if (filter != "bilinear")
-            r.error(t.find("filter_type")->pos, t.label() + ": filter_type '" + filter +
-                                                    "' is not supported (only bilinear)");
+            r.error(t.find("filter_type")->pos,
+                    t.label() + ": filter_type '" + filter + "' is not supported (only bilinear)");
         std::string wrap = r.getString(t, "wrap_mode", "repeat");
         if (wrap != "repeat")
-            r.error(t.find("wrap_mode")->pos, t.label() + ": wrap_mode '" + wrap +
-                                                  "' is not supported (only repeat)");
+            r.error(t.find("wrap_mode")->pos,
+                    t.label() + ": wrap_mode '" + wrap + "' is not supported (only repeat)");
         const bool raw = r.getBool(t, "raw", false);
         std::string file = r.getString(t, "filename", "");
         if (file.empty()) {
@@ -50,10 +49,13 @@ int buildTexture(MitsubaBuild& b, const XmlObject& t) {
             std::string ext = path.size() > 4 ? path.substr(path.size() - 4) : "";
             for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
             try {
-                if (ext == ".exr") tex.image = std::make_shared<Image>(readExr(path));
-                else if (ext == ".png") tex.image = std::make_shared<Image>(readPng(path, !raw));
-                else r.error(t.find("filename")->pos, t.label() + ": '" + file +
-                                                          "' is not a .png or .exr file");
+                if (ext == ".exr")
+                    tex.image = std::make_shared<Image>(readExr(path));
+                else if (ext == ".png")
+                    tex.image = std::make_shared<Image>(readPng(path, !raw));
+                else
+                    r.error(t.find("filename")->pos,
+                            t.label() + ": '" + file + "' is not a .png or .exr file");
             } catch (const InputError& e) {
                 for (const Diagnostic& d : e.diagnostics())
                     r.error(t.find("filename")->pos, t.label() + ": " + d.format());
@@ -71,7 +73,8 @@ int buildTexture(MitsubaBuild& b, const XmlObject& t) {
         try {
             id = b.scene.addTexture(tex);
         } catch (const InputError& e) {
-            for (const Diagnostic& d : e.diagnostics()) r.error(t.pos, t.label() + ": " + d.message);
+            for (const Diagnostic& d : e.diagnostics())
+                r.error(t.pos, t.label() + ": " + d.message);
         }
     }
     b.textureIds[&t] = id;
@@ -104,8 +107,10 @@ float readGgxAlpha(XmlReader& r, const XmlObject& o) {
     if (o.find("alpha_u") || o.find("alpha_v")) {
         float au = r.getFloatIn(o, "alpha_u", 0.1f, 0.0f, 1.0f, true);
         float av = r.getFloatIn(o, "alpha_v", 0.1f, 0.0f, 1.0f, true);
-        if (o.find("alpha")) r.error(o.find("alpha")->pos, o.label() + ": give either 'alpha' or "
-                                                           "'alpha_u'/'alpha_v', not both");
+        if (o.find("alpha"))
+            r.error(o.find("alpha")->pos, o.label() +
+                                              ": give either 'alpha' or "
+                                              "'alpha_u'/'alpha_v', not both");
         if (au != av)
             r.error(o.find("alpha_u") ? o.find("alpha_u")->pos : o.pos,
                     o.label() + ": anisotropic roughness (alpha_u != alpha_v) is not supported");
@@ -120,9 +125,10 @@ Rgb readDielectricTint(XmlReader& r, const XmlObject& o) {
     Rgb st = r.getColor(o, "specular_transmittance", Rgb(1.0f), ColorUse::Reflectance);
     if (sr.x != st.x || sr.y != st.y || sr.z != st.z) {
         const XmlProperty* p = o.find("specular_transmittance");
-        r.error(p ? p->pos : o.pos, o.label() + ": different specular_reflectance and "
-                                                "specular_transmittance are not supported "
-                                                "(unibeam has one tint for both)");
+        r.error(p ? p->pos : o.pos, o.label() +
+                                        ": different specular_reflectance and "
+                                        "specular_transmittance are not supported "
+                                        "(unibeam has one tint for both)");
     }
     return sr;
 }
@@ -151,9 +157,10 @@ void readConductorIor(MitsubaBuild& b, const XmlObject& o, Material& m) {
     if (material != "none") {
         const XmlProperty* p = o.find("material");
         r.error(p ? p->pos : o.pos,
-                o.label() + ": named conductor '" + material + "' is not supported (its complex "
-                            "IOR is spectral data unibeam does not ship); give <rgb name=\"eta\"> "
-                            "and <rgb name=\"k\"> instead");
+                o.label() + ": named conductor '" + material +
+                    "' is not supported (its complex "
+                    "IOR is spectral data unibeam does not ship); give <rgb name=\"eta\"> "
+                    "and <rgb name=\"k\"> instead");
     }
 }
 
@@ -175,8 +182,9 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
     } else if (o.type == "twosided") {
         std::vector<const XmlObject*> inner = r.children(o, "bsdf");
         if (inner.size() != 1) {
-            r.error(o.pos, o.label() + ": expected exactly one nested <bsdf> (two different "
-                                       "sides are not supported), got " +
+            r.error(o.pos, o.label() +
+                               ": expected exactly one nested <bsdf> (two different "
+                               "sides are not supported), got " +
                                std::to_string(inner.size()));
         } else if (inner[0]->type == "dielectric" || inner[0]->type == "roughdielectric" ||
                    inner[0]->type == "thindielectric" || inner[0]->type == "null" ||
@@ -198,8 +206,9 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
         m.specular = r.getColor(o, "specular_reflectance", Rgb(1.0f), ColorUse::Reflectance);
         if (o.find("eta") || o.find("k")) {
             r.error(o.find("eta") ? o.find("eta")->pos : o.find("k")->pos,
-                    o.label() + ": a smooth conductor with a Fresnel term (eta/k) is not "
-                                "supported; only material \"none\" (a perfect mirror) is");
+                    o.label() +
+                        ": a smooth conductor with a Fresnel term (eta/k) is not "
+                        "supported; only material \"none\" (a perfect mirror) is");
         }
         m.type = MaterialType::Mirror;
     } else if (o.type == "roughconductor") {
@@ -207,8 +216,9 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
         m.alpha = readGgxAlpha(r, o);
         m.separableMasking = true;  // Mitsuba's MicrofacetDistribution::G = G1(i) G1(o)
         if (!o.find("eta") && !o.find("k"))
-            r.error(o.pos, o.label() + ": needs <rgb name=\"eta\"> and <rgb name=\"k\"> (named "
-                                       "materials and 'none' are not supported)");
+            r.error(o.pos, o.label() +
+                               ": needs <rgb name=\"eta\"> and <rgb name=\"k\"> (named "
+                               "materials and 'none' are not supported)");
         readConductorIor(b, o, m);
         m.specular = r.getColor(o, "specular_reflectance", Rgb(1.0f), ColorUse::Reflectance);
     } else if (o.type == "dielectric") {
@@ -218,8 +228,7 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
     } else if (o.type == "thindielectric") {
         m.type = MaterialType::ThinDielectric;
         m.ior = readRelativeIor(r, o);
-        readReflectance(b, o, "specular_reflectance", Rgb(1.0f), &m.specular,
-                        &m.textures.specular);
+        readReflectance(b, o, "specular_reflectance", Rgb(1.0f), &m.specular, &m.textures.specular);
         readReflectance(b, o, "specular_transmittance", Rgb(1.0f), &m.transmittance,
                         &m.textures.transmittance);
     } else if (o.type == "plastic" || o.type == "roughplastic") {
@@ -229,11 +238,11 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
         float extIor = r.getIor(o, "ext_ior", kAirIor);
         m.ior = intIor / extIor;
         if (rough && intIor == extIor)
-            r.error(o.pos, o.label() + ": int_ior equals ext_ior (a rough coating needs an "
-                                       "index mismatch)");
+            r.error(o.pos, o.label() +
+                               ": int_ior equals ext_ior (a rough coating needs an "
+                               "index mismatch)");
         readReflectance(b, o, "diffuse_reflectance", Rgb(0.5f), &m.diffuse, &m.textures.diffuse);
-        readReflectance(b, o, "specular_reflectance", Rgb(1.0f), &m.specular,
-                        &m.textures.specular);
+        readReflectance(b, o, "specular_reflectance", Rgb(1.0f), &m.specular, &m.textures.specular);
         m.nonlinear = r.getBool(o, "nonlinear", false);
         if (rough) m.alpha = readGgxAlpha(r, o);
     } else if (o.type == "roughdielectric") {

@@ -25,7 +25,7 @@ namespace ub {
 enum class ColorUse { Reflectance, Emission, Unbounded };
 
 class XmlReader {
-public:
+  public:
     explicit XmlReader(Diagnostics& diags) : diags_(diags) {}
 
     void error(const XmlPos& p, const std::string& msg);
@@ -65,7 +65,7 @@ public:
     const XmlProperty* prop(const XmlObject& o, const std::string& name,
                             std::initializer_list<XmlValueKind> kinds, const char* expected);
 
-private:
+  private:
     Diagnostics& diags_;
     size_t errors_ = 0;
     XmlPos lastChildPos_;

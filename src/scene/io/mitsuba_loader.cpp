@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 namespace {
 
 const std::vector<std::string> kShapes = {"obj", "ply", "rectangle", "cube", "sphere"};
-const std::vector<std::string> kEmitters = {"area",     "point",  "spot",
+const std::vector<std::string> kEmitters = {"area",        "point",    "spot",
                                             "directional", "constant", "envmap"};
 const std::vector<std::string> kIntegrators = {"path", "volpath", "volpathmis", "moment"};
 const std::vector<std::string> kSamplers = {"independent", "stratified", "multijitter",
@@ -35,11 +35,11 @@ float similarityScale(const Transform& t) {
 }
 
 class Builder {
-public:
+  public:
     Builder(MitsubaBuild& b) : b_(b), r_(b.r) {}
     void build();
 
-private:
+  private:
     void readIntegrator(const XmlObject& o);
     void readSensor(const XmlObject& o);
     void readFilm(const XmlObject& o, int* w, int* h);
@@ -80,16 +80,19 @@ void Builder::build() {
         } else if (o.tag == "bsdf" || o.tag == "medium" || o.tag == "texture" ||
                    o.tag == "volume" || o.tag == "phase") {
             if (o.id.empty())
-                r_.error(o.pos, "top-level " + o.label() + " without an id cannot be used (give "
-                                "it an id and attach it with <ref id=\"...\"/>)");
+                r_.error(o.pos, "top-level " + o.label() +
+                                    " without an id cannot be used (give "
+                                    "it an id and attach it with <ref id=\"...\"/>)");
             else if (o.tag == "bsdf")
                 buildMitsubaBsdf(b_, o);  // validate even when unused
         } else {
             r_.error(o.pos, o.label() + " cannot appear at the top level of a scene");
         }
     }
-    if (!sensor) r_.error(XmlPos{b_.xml.file, 0, 0}, "the scene has no <sensor> (expected one "
-                                                     "perspective sensor)");
+    if (!sensor)
+        r_.error(XmlPos{b_.xml.file, 0, 0},
+                 "the scene has no <sensor> (expected one "
+                 "perspective sensor)");
     if (b_.scene.lights.empty() && r_.errorCount() == 0)
         r_.error(XmlPos{b_.xml.file, 0, 0}, "the scene has no emitter");
 }
@@ -116,8 +119,9 @@ void Builder::readIntegrator(const XmlObject& top) {
     // unibeam's maxPathLength (SmallVCM semantics). -1 means unlimited.
     int maxDepth = r_.getInt(*o, "max_depth", -1, -1, 1 << 20);
     if (maxDepth == 0)
-        r_.error(o->find("max_depth")->pos, o->label() + ": max_depth 0 renders nothing (expected "
-                                                         "-1 or a value >= 1)");
+        r_.error(o->find("max_depth")->pos, o->label() +
+                                                ": max_depth 0 renders nothing (expected "
+                                                "-1 or a value >= 1)");
     b_.scene.settings.maxPathLength = maxDepth < 0 ? (1 << 20) : maxDepth;
     r_.getInt(*o, "rr_depth", 5, 1, 1 << 20);  // Russian roulette: variance only
     if (r_.getBool(*o, "hide_emitters", false))
@@ -139,17 +143,18 @@ void Builder::readFilm(const XmlObject& f, int* w, int* h) {
                  f.label() + ": pixel_format '" + pf + "' is not supported (expected rgb or rgba)");
     std::string cf = r_.getString(f, "component_format", "float16");
     if (cf != "float16" && cf != "float32")
-        r_.error(f.find("component_format")->pos,
-                 f.label() + ": component_format '" + cf + "' is not supported (unibeam writes "
-                             "32-bit float EXR)");
+        r_.error(f.find("component_format")->pos, f.label() + ": component_format '" + cf +
+                                                      "' is not supported (unibeam writes "
+                                                      "32-bit float EXR)");
     std::string ff = r_.getString(f, "file_format", "openexr");
     if (ff != "openexr" && ff != "exr")
         r_.error(f.find("file_format")->pos, f.label() + ": file_format '" + ff +
                                                  "' is not supported (unibeam writes OpenEXR)");
     const XmlObject* rf = r_.child(f, "rfilter", "");
     if (!rf) {
-        r_.warning(f.pos, f.label() + ": no <rfilter>: Mitsuba's default Gaussian filter is "
-                          "replaced by unibeam's box filter (one uniform sample per pixel)");
+        r_.warning(f.pos, f.label() +
+                              ": no <rfilter>: Mitsuba's default Gaussian filter is "
+                              "replaced by unibeam's box filter (one uniform sample per pixel)");
     } else {
         if (rf->type != "box")
             r_.error(rf->pos, "unsupported rfilter plugin '" + rf->type +
@@ -203,8 +208,8 @@ void Builder::readSensor(const XmlObject& o) {
     } else {
         // Mitsuba's default: a 50 mm lens on a 36 x 24 mm film, fov along the diagonal.
         std::string f = r_.getString(o, "focal_length", "50mm");
-        std::string num = f.size() > 2 && f.substr(f.size() - 2) == "mm" ? f.substr(0, f.size() - 2)
-                                                                         : f;
+        std::string num =
+            f.size() > 2 && f.substr(f.size() - 2) == "mm" ? f.substr(0, f.size() - 2) : f;
         char* end = nullptr;
         double mm = std::strtod(num.c_str(), &end);
         if (num.empty() || *end != '\0' || !(mm > 0)) {
@@ -219,8 +224,9 @@ void Builder::readSensor(const XmlObject& o) {
     if (o.find("near_clip") || o.find("far_clip")) {
         r_.getFloatIn(o, "near_clip", 0.01f, 0.0f, kInf, true);
         r_.getFloatIn(o, "far_clip", 1e4f, 0.0f, kInf, true);
-        r_.warning(o.pos, o.label() + ": near_clip/far_clip are not applied (unibeam's camera "
-                                      "has no clipping planes)");
+        r_.warning(o.pos, o.label() +
+                              ": near_clip/far_clip are not applied (unibeam's camera "
+                              "has no clipping planes)");
     }
     Transform m = r_.getTransform(o, "to_world");
     r_.checkUnused(o);
@@ -231,8 +237,9 @@ void Builder::readSensor(const XmlObject& o) {
     float s = similarityScale(m);
     if (!(s > 0) || std::fabs(s - 1.0f) > 1e-3f || dot(cross(up, fwd), left) <= 0) {
         r_.error(tp ? tp->pos : o.pos,
-                 o.label() + ": to_world must be a rotation and translation (no scale or "
-                             "mirroring; use <lookat>)");
+                 o.label() +
+                     ": to_world must be a rotation and translation (no scale or "
+                     "mirroring; use <lookat>)");
         return;
     }
     if (!(fovX > 0.0f)) return;
@@ -283,8 +290,8 @@ void Builder::readShape(const XmlObject& o) {
         r_.unsupportedPlugin(o, kShapes);
         return;
     }
-    const std::string name = o.id.empty() ? o.type + " " + std::to_string(b_.scene.shapes.size())
-                                          : o.id;
+    const std::string name =
+        o.id.empty() ? o.type + " " + std::to_string(b_.scene.shapes.size()) : o.id;
     Transform toWorld = r_.getTransform(o, "to_world");
     bool flipNormals = r_.getBool(o, "flip_normals", false);
     TriangleMesh mesh;
@@ -305,8 +312,10 @@ void Builder::readShape(const XmlObject& o) {
                 for (const Diagnostic& d : meshDiags.all()) {
                     const XmlProperty* p = o.find("filename");
                     std::string msg = o.label() + ": " + d.format();
-                    if (d.warning) r_.warning(p->pos, msg);
-                    else r_.error(p->pos, msg);
+                    if (d.warning)
+                        r_.warning(p->pos, msg);
+                    else
+                        r_.error(p->pos, msg);
                 }
             }
         }
@@ -324,8 +333,9 @@ void Builder::readShape(const XmlObject& o) {
         float s = similarityScale(toWorld);
         if (!(s > 0)) {
             const XmlProperty* p = o.find("to_world");
-            r_.error(p ? p->pos : o.pos, o.label() + ": a sphere's to_world must be a rotation, "
-                                                     "translation and uniform scale");
+            r_.error(p ? p->pos : o.pos, o.label() +
+                                             ": a sphere's to_world must be a rotation, "
+                                             "translation and uniform scale");
         }
         center = toWorld.point(center);
         radius *= s;
@@ -344,8 +354,10 @@ void Builder::readShape(const XmlObject& o) {
 
     const XmlObject* em = r_.child(o, "emitter", "");
     int materialId = -2;
-    if (const XmlObject* bsdf = r_.child(o, "bsdf", "")) materialId = buildMitsubaBsdf(b_, *bsdf);
-    else materialId = em ? blackMaterial() : defaultMaterial();
+    if (const XmlObject* bsdf = r_.child(o, "bsdf", ""))
+        materialId = buildMitsubaBsdf(b_, *bsdf);
+    else
+        materialId = em ? blackMaterial() : defaultMaterial();
 
     int lightId = -1;
     Light light;
@@ -378,8 +390,9 @@ void Builder::readShape(const XmlObject& o) {
     r_.checkUnused(o);
     if (r_.errorCount() != before) return;
     if (materialId == -1 && !em && !boundary) {
-        r_.warning(o.pos, o.label() + " '" + name + "' has a null BSDF and no medium: it is "
-                                                    "invisible and is left out");
+        r_.warning(o.pos, o.label() + " '" + name +
+                              "' has a null BSDF and no medium: it is "
+                              "invisible and is left out");
         return;
     }
     // A null BSDF on an emitter: Mitsuba lets rays pass through it; unibeam's area lights
@@ -392,13 +405,14 @@ void Builder::readShape(const XmlObject& o) {
         try {
             lightId = b_.scene.addLight(std::move(light));
         } catch (const InputError& e) {
-            for (const Diagnostic& d : e.diagnostics()) r_.error(em->pos, em->label() + ": " + d.message);
+            for (const Diagnostic& d : e.diagnostics())
+                r_.error(em->pos, em->label() + ": " + d.message);
             return;
         }
     }
-    const uint32_t shapeId =
-        isSphere ? b_.scene.addSphere(center, radius, materialId, lightId, name)
-                 : b_.scene.addMesh(std::move(mesh), materialId, lightId, name);
+    const uint32_t shapeId = isSphere
+                                 ? b_.scene.addSphere(center, radius, materialId, lightId, name)
+                                 : b_.scene.addMesh(std::move(mesh), materialId, lightId, name);
     if (boundary) {
         b_.scene.setMediumBoundary(shapeId, interiorId, 0, imaginary);
         b_.scene.setExteriorMedium(shapeId, exteriorId);
@@ -450,7 +464,8 @@ void Builder::readEmitter(const XmlObject& o) {
         light.envToWorld = m;
         light.worldToEnv = m.inverse();
         std::string file = r_.getString(o, "filename", "");
-        if (file.empty()) r_.error(o.pos, o.label() + ": needs <string name=\"filename\">");
+        if (file.empty())
+            r_.error(o.pos, o.label() + ": needs <string name=\"filename\">");
         else if (std::string path = b_.resolveFile(o, "filename", file); !path.empty()) {
             try {
                 light.envMap = std::make_shared<Image>(readExr(path));
@@ -470,8 +485,10 @@ void Builder::readEmitter(const XmlObject& o) {
     if (r_.errorCount() != before) return;
     if (light.isEnvironment()) {
         if (envObject_) {
-            r_.error(o.pos, "more than one environment emitter (constant/envmap); the first is at "
-                            "line " + std::to_string(envObject_->pos.line));
+            r_.error(o.pos,
+                     "more than one environment emitter (constant/envmap); the first is at "
+                     "line " +
+                         std::to_string(envObject_->pos.line));
             return;
         }
         envObject_ = &o;

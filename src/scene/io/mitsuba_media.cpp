@@ -21,15 +21,17 @@ float readPhase(XmlReader& r, const XmlObject& medium) {
     const XmlObject* ph = r.child(medium, "phase", "");
     if (!ph) return 0.0f;
     float g = 0.0f;
-    if (ph->type == "hg") g = r.getFloatIn(*ph, "g", 0.8f, -1.0f, 1.0f, true, true);
-    else if (ph->type != "isotropic") r.unsupportedPlugin(*ph, {"isotropic", "hg"});
+    if (ph->type == "hg")
+        g = r.getFloatIn(*ph, "g", 0.8f, -1.0f, 1.0f, true, true);
+    else if (ph->type != "isotropic")
+        r.unsupportedPlugin(*ph, {"isotropic", "hg"});
     r.checkUnused(*ph);
     return g;
 }
 
 /// A spectrally constant or RGB value given directly or as <volume type="constvolume">.
-bool readConstant(XmlReader& r, const XmlObject& o, const std::string& name, Rgb def,
-                  ColorUse use, Rgb* out) {
+bool readConstant(XmlReader& r, const XmlObject& o, const std::string& name, Rgb def, ColorUse use,
+                  Rgb* out) {
     if (const XmlObject* v = r.child(o, "volume", name)) {
         if (v->type != "constvolume") return false;
         *out = r.getColor(*v, "value", Rgb(1.0f), use);
@@ -58,10 +60,13 @@ bool readGridVolume(MitsubaBuild& b, const XmlObject& v, VolumeRole role, GridVo
     Transform toWorld = r.getTransform(v, "to_world");
     bool useBbox = r.getBool(v, "use_grid_bbox", false);
     std::string filter = r.getString(v, "filter_type", "trilinear");
-    if (filter == "trilinear") out->options.filter = GridFilter::kTrilinear;
-    else if (filter == "nearest") out->options.filter = GridFilter::kNearest;
-    else r.error(v.find("filter_type")->pos, v.label() + ": filter_type '" + filter +
-                                                 "' is not one of trilinear, nearest");
+    if (filter == "trilinear")
+        out->options.filter = GridFilter::kTrilinear;
+    else if (filter == "nearest")
+        out->options.filter = GridFilter::kNearest;
+    else
+        r.error(v.find("filter_type")->pos,
+                v.label() + ": filter_type '" + filter + "' is not one of trilinear, nearest");
     std::string wrap = r.getString(v, "wrap_mode", "clamp");
     if (wrap != "clamp")
         r.error(v.find("wrap_mode")->pos, v.label() + ": wrap_mode '" + wrap +
@@ -87,12 +92,12 @@ bool readGridVolume(MitsubaBuild& b, const XmlObject& v, VolumeRole role, GridVo
         if (ext == ".vol") {
             if (hasGridName)
                 r.error(v.find("grid_name")->pos,
-                        v.label() + ": grid_name applies to .vdb files only (a .vol file holds "
-                                    "one grid)");
+                        v.label() +
+                            ": grid_name applies to .vdb files only (a .vol file holds "
+                            "one grid)");
             VolGrid vol = readVolFile(path);
             if (!albedo && vol.channels != 1) {
-                r.error(fpos, v.label() + ": '" + file + "' has " +
-                                  std::to_string(vol.channels) +
+                r.error(fpos, v.label() + ": '" + file + "' has " + std::to_string(vol.channels) +
                                   " channels; an extinction grid needs 1");
                 return false;
             }
@@ -119,11 +124,14 @@ bool readGridVolume(MitsubaBuild& b, const XmlObject& v, VolumeRole role, GridVo
         } else if (ext == ".vdb") {
             if (useBbox)
                 r.error(v.find("use_grid_bbox")->pos,
-                        v.label() + ": use_grid_bbox does not apply to .vdb files (their own "
-                                    "transform places the grid)");
+                        v.label() +
+                            ": use_grid_bbox does not apply to .vdb files (their own "
+                            "transform places the grid)");
             out->label = "'" + file + "' grid '" + gridName + "'";
-            if (albedo) out->grids = loadVdbAlbedoChannels(path, gridName);
-            else out->grids = {VdbGrid::load(path, gridName)};
+            if (albedo)
+                out->grids = loadVdbAlbedoChannels(path, gridName);
+            else
+                out->grids = {VdbGrid::load(path, gridName)};
             out->localToWorld = toWorld;
         } else {
             r.error(fpos, v.label() + ": '" + file + "' is neither a .vol nor a .vdb file");
@@ -206,15 +214,15 @@ bool buildMitsubaMedium(MitsubaBuild& b, const XmlObject& o, Medium* out) {
             const Rgb st = constSigmaT * scale, ss = albedo * st;
             *out = Medium::homogeneous(vmax(st - ss, Rgb(0.0f)), ss, g);
         } else {
-            *out = Medium::heterogeneous(gv.grids[0], scale, albedo, g, gv.localToWorld,
-                                         gv.options);
+            *out =
+                Medium::heterogeneous(gv.grids[0], scale, albedo, g, gv.localToWorld, gv.options);
         }
         if (albedoVol) {
             const GridMediumOptions& ao = albedoGrid.options;
-            out->albedoGrid = AlbedoGrid::make(
-                albedoGrid.grids, ao.filter, albedoGrid.localToWorld,
-                albedoGrid.domainGiven ? ao.domainLo : nullptr,
-                albedoGrid.domainGiven ? ao.domainHi : nullptr, albedoGrid.label);
+            out->albedoGrid =
+                AlbedoGrid::make(albedoGrid.grids, ao.filter, albedoGrid.localToWorld,
+                                 albedoGrid.domainGiven ? ao.domainLo : nullptr,
+                                 albedoGrid.domainGiven ? ao.domainHi : nullptr, albedoGrid.label);
         }
     } catch (const std::invalid_argument& e) {
         r.error(o.pos, o.label() + ": " + e.what());

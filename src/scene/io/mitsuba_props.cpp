@@ -13,15 +13,24 @@ namespace {
 
 const char* kindName(XmlValueKind k) {
     switch (k) {
-        case XmlValueKind::Float: return "float";
-        case XmlValueKind::Integer: return "integer";
-        case XmlValueKind::Boolean: return "boolean";
-        case XmlValueKind::String: return "string";
-        case XmlValueKind::Rgb: return "rgb";
-        case XmlValueKind::Spectrum: return "spectrum";
-        case XmlValueKind::Point: return "point";
-        case XmlValueKind::Vector: return "vector";
-        case XmlValueKind::Transform: return "transform";
+        case XmlValueKind::Float:
+            return "float";
+        case XmlValueKind::Integer:
+            return "integer";
+        case XmlValueKind::Boolean:
+            return "boolean";
+        case XmlValueKind::String:
+            return "string";
+        case XmlValueKind::Rgb:
+            return "rgb";
+        case XmlValueKind::Spectrum:
+            return "spectrum";
+        case XmlValueKind::Point:
+            return "point";
+        case XmlValueKind::Vector:
+            return "vector";
+        case XmlValueKind::Transform:
+            return "transform";
     }
     return "?";
 }
@@ -68,15 +77,13 @@ const XmlProperty* XmlReader::prop(const XmlObject& o, const std::string& name,
 }
 
 float XmlReader::getFloat(const XmlObject& o, const std::string& name, float def) {
-    const XmlProperty* p =
-        prop(o, name, {XmlValueKind::Float, XmlValueKind::Integer}, "a <float>");
+    const XmlProperty* p = prop(o, name, {XmlValueKind::Float, XmlValueKind::Integer}, "a <float>");
     return p ? float(p->number) : def;
 }
 
 float XmlReader::getFloatIn(const XmlObject& o, const std::string& name, float def, float lo,
                             float hi, bool loOpen, bool hiOpen) {
-    const XmlProperty* p =
-        prop(o, name, {XmlValueKind::Float, XmlValueKind::Integer}, "a <float>");
+    const XmlProperty* p = prop(o, name, {XmlValueKind::Float, XmlValueKind::Integer}, "a <float>");
     if (!p) return def;
     double v = p->number;
     bool ok = (loOpen ? v > lo : v >= lo) && (hiOpen ? v < hi : v <= hi);
@@ -97,8 +104,8 @@ int XmlReader::getInt(const XmlObject& o, const std::string& name, int def, int 
     if (!p) return def;
     if (p->number < lo || p->number > hi) {
         error(p->pos, o.label() + ": parameter '" + name + "' = " + p->text +
-                          " is out of range (expected an integer in [" + std::to_string(lo) +
-                          ", " + std::to_string(hi) + "])");
+                          " is out of range (expected an integer in [" + std::to_string(lo) + ", " +
+                          std::to_string(hi) + "])");
         return def;
     }
     return int(p->number);
@@ -116,10 +123,10 @@ std::string XmlReader::getString(const XmlObject& o, const std::string& name,
 }
 
 Rgb XmlReader::getColor(const XmlObject& o, const std::string& name, const Rgb& def, ColorUse use) {
-    const XmlProperty* p = prop(o, name,
-                                {XmlValueKind::Rgb, XmlValueKind::Spectrum, XmlValueKind::Float,
-                                 XmlValueKind::Integer},
-                                "a colour (<rgb>, <spectrum> or <float>)");
+    const XmlProperty* p = prop(
+        o, name,
+        {XmlValueKind::Rgb, XmlValueKind::Spectrum, XmlValueKind::Float, XmlValueKind::Integer},
+        "a colour (<rgb>, <spectrum> or <float>)");
     if (!p) return def;
     Rgb c = p->kind == XmlValueKind::Float || p->kind == XmlValueKind::Integer
                 ? Rgb(float(p->number))
@@ -137,8 +144,8 @@ Rgb XmlReader::getColor(const XmlObject& o, const std::string& name, const Rgb& 
         c = spectrumToLinearSrgb(p->wavelengths, p->values, true);
     }
     if (!isFinite(c) || minComponent(c) < 0.0f) {
-        error(p->pos, o.label() + ": parameter '" + name + "' = " + p->text +
-                          " must be finite and >= 0");
+        error(p->pos,
+              o.label() + ": parameter '" + name + "' = " + p->text + " must be finite and >= 0");
         return def;
     }
     if (use == ColorUse::Reflectance && maxComponent(c) > 1.0f) {
@@ -155,8 +162,7 @@ Vec3 XmlReader::getPoint(const XmlObject& o, const std::string& name, const Vec3
 }
 
 Vec3 XmlReader::getVector(const XmlObject& o, const std::string& name, const Vec3& def) {
-    const XmlProperty* p =
-        prop(o, name, {XmlValueKind::Vector, XmlValueKind::Point}, "a <vector>");
+    const XmlProperty* p = prop(o, name, {XmlValueKind::Vector, XmlValueKind::Point}, "a <vector>");
     return p ? p->vec : def;
 }
 
@@ -171,9 +177,9 @@ Transform XmlReader::getTransform(const XmlObject& o, const std::string& name) {
 }
 
 float XmlReader::getIor(const XmlObject& o, const std::string& name, float def) {
-    const XmlProperty* p = prop(o, name,
-                                {XmlValueKind::Float, XmlValueKind::Integer, XmlValueKind::String},
-                                "a <float> or a <string> naming a material");
+    const XmlProperty* p =
+        prop(o, name, {XmlValueKind::Float, XmlValueKind::Integer, XmlValueKind::String},
+             "a <float> or a <string> naming a material");
     if (!p) return def;
     if (p->kind == XmlValueKind::String) {
         float v = 0;
@@ -196,9 +202,8 @@ const XmlObject* XmlReader::child(const XmlObject& o, const std::string& tag,
     for (const XmlChild& c : o.children) {
         if (c.object->tag != tag) continue;
         if (!name.empty() && c.name != name) continue;
-        if (name.empty() && !c.name.empty() && tag != "bsdf" && tag != "emitter" &&
-            tag != "film" && tag != "sampler" && tag != "rfilter" && tag != "integrator" &&
-            tag != "phase")
+        if (name.empty() && !c.name.empty() && tag != "bsdf" && tag != "emitter" && tag != "film" &&
+            tag != "sampler" && tag != "rfilter" && tag != "integrator" && tag != "phase")
             continue;
         if (found) {
             error(c.pos, o.label() + ": more than one nested <" + tag + ">" +
@@ -246,8 +251,8 @@ std::string MitsubaBuild::resolveFile(const XmlObject& o, const std::string& pro
     std::string path = resolveXmlPath(xml, name);
     if (path.empty()) {
         const XmlProperty* p = o.find(propName);
-        r.error(p ? p->pos : o.pos, o.label() + ": file '" + name + "' not found (searched: " +
-                                        join(xml.searchPath) + ")");
+        r.error(p ? p->pos : o.pos, o.label() + ": file '" + name +
+                                        "' not found (searched: " + join(xml.searchPath) + ")");
     }
     return path;
 }

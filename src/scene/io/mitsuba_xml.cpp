@@ -7,9 +7,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
-
 #include <pugixml.hpp>
+#include <sstream>
 
 #include "scene/io/mitsuba_spectra.h"
 
@@ -19,13 +18,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kObjectTags = {"scene",   "shape",  "bsdf",   "emitter",
-                                              "medium",  "phase",  "volume", "texture",
-                                              "sensor",  "film",   "integrator", "sampler",
-                                              "rfilter"};
-const std::vector<std::string> kPropertyTags = {"float", "integer", "boolean", "string",
-                                                "rgb",   "spectrum", "point", "vector",
-                                                "transform"};
+const std::vector<std::string> kObjectTags = {
+    "scene",   "shape",  "bsdf", "emitter",    "medium",  "phase",  "volume",
+    "texture", "sensor", "film", "integrator", "sampler", "rfilter"};
+const std::vector<std::string> kPropertyTags = {"float",    "integer", "boolean", "string",   "rgb",
+                                                "spectrum", "point",   "vector",  "transform"};
 constexpr int kMaxIncludeDepth = 32;
 // Files read in all (the top file and every <include>): a file that includes another twice at
 // each of 32 levels would otherwise be read 2^32 times.
@@ -79,11 +76,11 @@ std::vector<std::string> splitList(const std::string& s) {
 struct FileCtx {
     std::string path;  ///< for messages
     std::string text;
-    std::string dir;   ///< directory of the file
+    std::string dir;  ///< directory of the file
 };
 
 class Parser {
-public:
+  public:
     Parser(const std::map<std::string, std::string>& defines, Diagnostics& diags, XmlScene& scene)
         : params_(defines), overridden_(defines), diags_(diags), scene_(scene) {}
 
@@ -92,7 +89,7 @@ public:
     void resolveRefs();
     void checkUnusedDefines();
 
-private:
+  private:
     XmlPos pos(const FileCtx& f, const pugi::xml_node& n) const {
         // offset_debug() of an element is its name; report the '<' before it.
         size_t off = size_t(std::max<ptrdiff_t>(0, n.offset_debug()));
@@ -134,7 +131,7 @@ private:
     };
     std::vector<PendingRef> refs_;
     std::vector<std::shared_ptr<XmlObject>> owned_;  // keeps objects alive for ref resolution
-    std::vector<std::string> includeStack_;  ///< canonical paths of the files being read
+    std::vector<std::string> includeStack_;          ///< canonical paths of the files being read
     int filesRead_ = 0;
     int objectDepth_ = 0;
 };
@@ -158,8 +155,9 @@ bool Parser::attr(const FileCtx& f, const pugi::xml_node& n, const char* name, s
         std::string key = v.substr(i + 1, j - i - 1);
         auto it = params_.find(key);
         if (key.empty() || it == params_.end()) {
-            error(pos(f, n), std::string("attribute '") + name + "' uses the undefined parameter '$" +
-                                 key + "' (define it with <default name=\"" + key +
+            error(pos(f, n), std::string("attribute '") + name +
+                                 "' uses the undefined parameter '$" + key +
+                                 "' (define it with <default name=\"" + key +
                                  "\" value=\"...\"/> or -D " + key + "=VALUE)");
             return false;
         }
@@ -191,16 +189,17 @@ void Parser::parseFile(const std::string& path, const XmlPos& includedFrom, int 
         if (includedFrom.file.empty())
             diags_.error(Diagnostic{path, 0, 0, "", "cannot open the scene file"});
         else
-            error(includedFrom, "cannot open the included file '" + path +
-                                    "' (not a readable regular file)");
+            error(includedFrom,
+                  "cannot open the included file '" + path + "' (not a readable regular file)");
         return;
     }
     std::error_code ec;
     fs::path canonical = fs::weakly_canonical(fs::path(path), ec);
     const std::string key = ec ? path : canonical.string();
     if (std::find(includeStack_.begin(), includeStack_.end(), key) != includeStack_.end()) {
-        error(includedFrom, "include cycle: '" + path + "' is already being read (it includes "
-                            "itself, directly or through other files)");
+        error(includedFrom, "include cycle: '" + path +
+                                "' is already being read (it includes "
+                                "itself, directly or through other files)");
         return;
     }
     if (++filesRead_ > kMaxIncludedFiles) {
@@ -285,8 +284,8 @@ void Parser::parseSceneChildren(const FileCtx& f, const pugi::xml_node& sceneNod
             }
             std::string resolved = resolveXmlPath(scene_, file);
             if (resolved.empty()) {
-                error(pos(f, n), "included file '" + file + "' not found (searched: " +
-                                     joinList(scene_.searchPath) + ")");
+                error(pos(f, n), "included file '" + file +
+                                     "' not found (searched: " + joinList(scene_.searchPath) + ")");
                 continue;
             }
             parseFile(resolved, pos(f, n), depth + 1);
@@ -306,13 +305,16 @@ void Parser::parseSceneChildren(const FileCtx& f, const pugi::xml_node& sceneNod
         } else if (isIn(tag, kObjectTags) && tag != "scene") {
             if (auto obj = parseObject(f, n)) scene_.objects.push_back(obj);
         } else if (tag == "ref") {
-            error(pos(f, n), "<ref> at the top level of a scene has no effect (a reference "
-                             "attaches an object to another object)");
+            error(pos(f, n),
+                  "<ref> at the top level of a scene has no effect (a reference "
+                  "attaches an object to another object)");
         } else if (isIn(tag, kPropertyTags)) {
-            error(pos(f, n), "property <" + tag + "> directly inside <scene> (properties belong "
-                             "to a plugin object)");
+            error(pos(f, n), "property <" + tag +
+                                 "> directly inside <scene> (properties belong "
+                                 "to a plugin object)");
         } else {
-            error(pos(f, n), "unknown tag <" + tag + "> (expected one of: default, include, path, " +
+            error(pos(f, n), "unknown tag <" + tag +
+                                 "> (expected one of: default, include, path, " +
                                  joinList(kObjectTags) + ")");
         }
     }
@@ -322,8 +324,8 @@ void Parser::registerId(const std::shared_ptr<XmlObject>& obj) {
     if (obj->id.empty()) return;
     auto it = ids_.find(obj->id);
     if (it != ids_.end()) {
-        error(obj->pos, "duplicate id '" + obj->id + "' (first defined at " +
-                            it->second->pos.file + ":" + std::to_string(it->second->pos.line) + ")");
+        error(obj->pos, "duplicate id '" + obj->id + "' (first defined at " + it->second->pos.file +
+                            ":" + std::to_string(it->second->pos.line) + ")");
         return;
     }
     ids_[obj->id] = obj;
@@ -405,8 +407,8 @@ bool Parser::parseVec3Attr(const FileCtx& f, const pugi::xml_node& n, const char
     for (size_t i = 0; ok && i < parts.size(); ++i) ok = parseDouble(parts[i], &x[i]);
     if (!ok) {
         error(pos(f, n), std::string("<") + n.name() + "> attribute '" + name + "': expected " +
-                             (allowScalar ? "one or three numbers" : "three numbers") +
-                             ", got '" + v + "'");
+                             (allowScalar ? "one or three numbers" : "three numbers") + ", got '" +
+                             v + "'");
         return false;
     }
     if (parts.size() == 1) x[1] = x[2] = x[0];
@@ -428,8 +430,8 @@ bool Parser::parseProperty(const FileCtx& f, const pugi::xml_node& n, XmlPropert
         return false;
     }
     auto bad = [&](const std::string& expected) {
-        error(p->pos, "<" + tag + "> property '" + p->name + "': expected " + expected +
-                          ", got '" + p->text + "'");
+        error(p->pos, "<" + tag + "> property '" + p->name + "': expected " + expected + ", got '" +
+                          p->text + "'");
         return false;
     };
     if (tag == "point" || tag == "vector") {
@@ -472,9 +474,12 @@ bool Parser::parseProperty(const FileCtx& f, const pugi::xml_node& n, XmlPropert
         p->kind = XmlValueKind::Boolean;
         std::string v = p->text;
         std::transform(v.begin(), v.end(), v.begin(), ::tolower);
-        if (v == "true") p->boolean = true;
-        else if (v == "false") p->boolean = false;
-        else return bad("true or false");
+        if (v == "true")
+            p->boolean = true;
+        else if (v == "false")
+            p->boolean = false;
+        else
+            return bad("true or false");
         return true;
     }
     if (tag == "string") {
@@ -508,8 +513,9 @@ bool Parser::parseProperty(const FileCtx& f, const pugi::xml_node& n, XmlPropert
             double a = 0, b = 0;
             if (colon == std::string::npos || !parseDouble(s.substr(0, colon), &a) ||
                 !parseDouble(s.substr(colon + 1), &b))
-                return bad("a constant or wavelength:value pairs (\"400:0.1, 500:0.5\"); "
-                           "spectrum files are not supported");
+                return bad(
+                    "a constant or wavelength:value pairs (\"400:0.1, 500:0.5\"); "
+                    "spectrum files are not supported");
             if (!wl.empty() && a <= wl.back()) return bad("wavelengths in increasing order");
             wl.push_back(a);
             val.push_back(b);
@@ -565,14 +571,16 @@ bool Parser::parseTransform(const FileCtx& f, const pugi::xml_node& node, Transf
         };
         if (tag == "translate") {
             Vec3 v;
-            if (!checkAttributes(f, n, {"x", "y", "z", "value"}) || !readXyz(Vec3(0.0f), false, &v)) {
+            if (!checkAttributes(f, n, {"x", "y", "z", "value"}) ||
+                !readXyz(Vec3(0.0f), false, &v)) {
                 ok = false;
                 continue;
             }
             op = Transform::translate(v);
         } else if (tag == "scale") {
             Vec3 v;
-            if (!checkAttributes(f, n, {"x", "y", "z", "value"}) || !readXyz(Vec3(1.0f), true, &v)) {
+            if (!checkAttributes(f, n, {"x", "y", "z", "value"}) ||
+                !readXyz(Vec3(1.0f), true, &v)) {
                 ok = false;
                 continue;
             }
@@ -609,18 +617,21 @@ bool Parser::parseTransform(const FileCtx& f, const pugi::xml_node& node, Transf
             bool good = parts.size() == 16 || parts.size() == 9;
             for (size_t i = 0; good && i < parts.size(); ++i) good = parseDouble(parts[i], &x[i]);
             if (!good) {
-                error(pos(f, n), "<matrix> value: expected 16 (4x4) or 9 (3x3) numbers in "
-                                 "row-major order, got '" + v + "'");
+                error(pos(f, n),
+                      "<matrix> value: expected 16 (4x4) or 9 (3x3) numbers in "
+                      "row-major order, got '" +
+                          v + "'");
                 ok = false;
                 continue;
             }
             int dim = parts.size() == 16 ? 4 : 3;
             for (int r = 0; r < dim; ++r)
                 for (int c = 0; c < dim; ++c) op.m[r][c] = float(x[r * dim + c]);
-            if (dim == 4 && (op.m[3][0] != 0 || op.m[3][1] != 0 || op.m[3][2] != 0 ||
-                             op.m[3][3] != 1)) {
-                error(pos(f, n), "<matrix>: projective matrices are not supported (expected the "
-                                 "last row 0 0 0 1)");
+            if (dim == 4 &&
+                (op.m[3][0] != 0 || op.m[3][1] != 0 || op.m[3][2] != 0 || op.m[3][3] != 1)) {
+                error(pos(f, n),
+                      "<matrix>: projective matrices are not supported (expected the "
+                      "last row 0 0 0 1)");
                 ok = false;
                 continue;
             }
@@ -638,8 +649,9 @@ bool Parser::parseTransform(const FileCtx& f, const pugi::xml_node& node, Transf
             }
             Vec3 dir = target - origin;
             if (!(length(dir) > 0.0f) || !(length(cross(normalize(dir), up)) > 1e-6f)) {
-                error(pos(f, n), "<lookat>: target must differ from origin and up must not be "
-                                 "parallel to the viewing direction");
+                error(pos(f, n),
+                      "<lookat>: target must differ from origin and up must not be "
+                      "parallel to the viewing direction");
                 ok = false;
                 continue;
             }
@@ -695,9 +707,13 @@ void Parser::checkUnusedDefines() {
 
 }  // namespace
 
-const std::vector<std::string>& xmlObjectTags() { return kObjectTags; }
+const std::vector<std::string>& xmlObjectTags() {
+    return kObjectTags;
+}
 
-std::string XmlObject::label() const { return "<" + tag + " type=\"" + type + "\">"; }
+std::string XmlObject::label() const {
+    return "<" + tag + " type=\"" + type + "\">";
+}
 
 const XmlProperty* XmlObject::find(const std::string& name) const {
     for (const auto& p : properties)

@@ -32,19 +32,29 @@ struct XmlPos {
     int line = 0, column = 0;
 };
 
-enum class XmlValueKind { Float, Integer, Boolean, String, Rgb, Spectrum, Point, Vector, Transform };
+enum class XmlValueKind {
+    Float,
+    Integer,
+    Boolean,
+    String,
+    Rgb,
+    Spectrum,
+    Point,
+    Vector,
+    Transform
+};
 
 struct XmlProperty {
     std::string name;
     XmlValueKind kind = XmlValueKind::Float;
     XmlPos pos;
-    double number = 0.0;   ///< Float, Integer; Spectrum given as one constant value
-    bool boolean = false;  ///< Boolean
-    std::string text;      ///< String (also the raw value of every other kind)
-    Vec3 vec;              ///< Rgb, Point, Vector; Spectrum converted to linear sRGB
+    double number = 0.0;              ///< Float, Integer; Spectrum given as one constant value
+    bool boolean = false;             ///< Boolean
+    std::string text;                 ///< String (also the raw value of every other kind)
+    Vec3 vec;                         ///< Rgb, Point, Vector; Spectrum converted to linear sRGB
     bool spectrumIsConstant = false;  ///< Spectrum: a single value (not wavelength pairs)
     std::vector<double> wavelengths, values;  ///< Spectrum given as wavelength:value pairs
-    Transform transform;   ///< Transform
+    Transform transform;                      ///< Transform
     mutable bool used = false;
 };
 

@@ -9,7 +9,9 @@
 
 namespace ub {
 
-std::vector<std::string> supportedSceneExtensions() { return {".json", ".xml", ".obj"}; }
+std::vector<std::string> supportedSceneExtensions() {
+    return {".json", ".xml", ".obj"};
+}
 
 std::unique_ptr<Scene> loadScene(const std::string& path, std::vector<Diagnostic>* warnings) {
     return loadScene(path, {}, warnings);

@@ -111,8 +111,9 @@ void readUpbpMtl(const std::string& path, std::vector<UpbpMaterial>* materials,
                 continue;
             }
             if ((k[1] == 'd' || k[1] == 's') && std::max({c[0], c[1], c[2]}) > 1.0f)
-                r.warning(kw, "'" + name + "' above 1 reflects more light than arrives (the "
-                              "material creates energy); read as written, as SmallUPBP does");
+                r.warning(kw, "'" + name +
+                                  "' above 1 reflects more light than arrives (the "
+                                  "material creates energy); read as written, as SmallUPBP does");
             if (k[1] == 'd') current->diffuse = Rgb(c[0], c[1], c[2]);
             if (k[1] == 's') current->specular = Rgb(c[0], c[1], c[2]);
             if (k[1] == 'e') current->emission = Rgb(c[0], c[1], c[2]);
