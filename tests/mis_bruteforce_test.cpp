@@ -129,8 +129,8 @@ TEST(MisBruteForce, WeightsOfOnePathSumToOne) {
     }
 }
 
-// With both connection and merging enabled, dVM = dVC / eta at every vertex (same
-// initial ratio [TR (33)], same linear recursion [TR (34), (35)] scaled by 1/eta).
+// With connection enabled, dVM (eta times SmallVCM's dVM) = dVC at every vertex: same
+// initial value [TR (33)], same recursion [TR (34), (35)] (Moonen & Jalba's d_pde = d_bpt).
 TEST(MisBruteForce, MergePartialIsConnectionPartialOverEta) {
     Rng rng(44, 7);
     ub_mis_constants c = ub_mis_make_constants(0.05f, 1000.0f, 1, 1, UB_MIS_POWER);
@@ -141,9 +141,9 @@ TEST(MisBruteForce, MergePartialIsConnectionPartialOverEta) {
         for (int i = 1; i < 8; ++i) {
             const MisVertex& x = p.v[i];
             lp = ub_mis_at_hit(c, lp, p.dist[i], x.cosIn, 1);
-            ASSERT_NEAR(lp.dVM, lp.dVC * c.vcWeightFactor, 1e-5f * lp.dVM + 1e-30f);
-            lp =
-                ub_mis_scatter(c, lp, x.cosOut, x.pdfFwdW * x.cont, x.pdfRevW * x.cont, x.specular);
+            ASSERT_NEAR(lp.dVM, lp.dVC, 1e-5f * lp.dVM + 1e-30f);
+            lp = ub_mis_scatter(c, lp, x.cosOut, x.pdfFwdW * x.cont, x.pdfRevW * x.cont, x.specular,
+                                ub_mis_merge_factor(c, x.medium, 0));
         }
     }
 }
@@ -220,6 +220,54 @@ TEST(MisBruteForce, MediumVerticesRecursiveWeightsEqualExplicitPdfWeights) {
     }
     EXPECT_GT(compared, 30000);
     EXPECT_GT(mediumVertices, 10000);
+}
+
+// UPBP point estimators (kernels/shared/ub_mis.h, merging factors per vertex): surface
+// merging at surface vertices and pp3d at medium vertices, with and without connections,
+// and pp3d alone. Every recursive weight equals the explicit-pdf weight, where a pp3d merge
+// at medium vertex x_i has the pdf (prod_{j<=i} a_j)(prod_{j>=i} b_j) N_L (4/3) pi r^3.
+TEST(MisBruteForce, PointEstimatorsInMediaMatchExplicitPdfWeights) {
+    Rng rng(47, 7);
+    struct Upbp {
+        const char* name;
+        bool vc, surf, pp3d;
+    };
+    const Upbp kSets[] = {{"bpt+surf+pp3d", true, true, true},
+                          {"bpt+pp3d", true, false, true},
+                          {"surf+pp3d", false, true, true},
+                          {"pp3d", false, false, true}};
+    int compared = 0, pp3dMerges = 0;
+    for (ub_uint h : {UB_MIS_POWER, UB_MIS_BALANCE})
+        for (const Upbp& set : kSets) {
+            MisConfig cfg;
+            cfg.heuristic = h;
+            cfg.useVC = set.vc;
+            cfg.useVM = set.surf;
+            cfg.usePP3D = set.pp3d;
+            cfg.radiusPP3D = 0.08f;  // eta_pp3d = N_L 4/3 pi r^3 ~ 2: competes with the others
+            for (int n = 0; n < 3000; ++n) {
+                int k = 2 + int(rng.uniform() * 7);
+                MisLightKind kind = kKinds[n % 4];
+                MisPath p = randomPath(rng, k, kind, 0.2f);
+                addMedia(rng, &p, 0.5f);
+                auto ref = bruteForceWeights(p, cfg);
+                auto rec = recursiveWeights(p, cfg);
+                ASSERT_EQ(ref.size(), rec.size());
+                double sum = 0;
+                for (size_t t = 0; t < ref.size(); ++t) {
+                    ASSERT_NEAR(rec[t].weight, ref[t].weight, 1e-4)
+                        << set.name << (h == UB_MIS_POWER ? "/power" : "/balance") << " k=" << k
+                        << " light kind " << int(kind) << " technique " << ref[t].name()
+                        << " (path " << n << ")";
+                    sum += rec[t].weight;
+                    ++compared;
+                    pp3dMerges += ref[t].merge && p.v[size_t(ref[t].index)].medium;
+                }
+                if (!rec.empty()) ASSERT_NEAR(sum, 1.0, 1e-4) << set.name << " k=" << k;
+            }
+        }
+    EXPECT_GT(compared, 40000);
+    EXPECT_GT(pp3dMerges, 10000);
 }
 
 // Without media the media-aware updates reduce to the surface ones exactly.

@@ -18,18 +18,34 @@
  *         of this subpath from the other side by connection, as ratios of
  *         their pdfs to the current technique's pdf, with the last reverse
  *         pdf left out (it is only known once the next direction is fixed).
- *   dVM   the same sum for the merging techniques.
+ *   dVM   the same sum for the merging techniques, each ratio times the
+ *         merging technique's eta (so that the eta of the vertex where a merge
+ *         happens divides it out in the merge weight).
  *
  * Each weight is w = 1 / (w_light + 1 + w_camera)  [TR (37)], where w_light and
  * w_camera are the partial weights of the two subpaths, built from these
  * quantities and the pdfs available at the two ends of the new edge.
  *
- * With eta_VCM = N_L * pi * r^2 [TR (20)] (N_L light subpaths per iteration,
- * one connection per camera subpath), the two switched constants are
- *   vmWeightFactor = Mis(eta_VCM)   if merging is enabled, else 0,
- *   vcWeightFactor = Mis(1/eta_VCM) if connection is enabled, else 0.
+ * MERGING FACTORS PER VERTEX (UPBP). SmallVCM has one merging technique with
+ * one constant eta_VCM = N_L * pi * r^2 [TR (20)] (N_L light subpaths per
+ * iteration, one connection per camera subpath). UPBP (Krivanek et al. 2014,
+ * Sec. 5) merges with different estimators on surfaces and in media, each with
+ * its own eta: surface photon mapping (surf) eta_surf = N_L pi r_surf^2 at
+ * non-specular surface vertices, photon points x query points (pp3d)
+ * eta_pp3d = N_L (4/3) pi r_pp3d^3 at medium vertices (the kernel's support
+ * measure; UPBP eq. (8) with the box kernel). The recursion therefore takes the
+ * merging factor f(x) = Mis(eta) of the vertex where each update happens, as
+ * in the recursive form of Moonen & Jalba 2023 (their d_bpt / d_pde with the
+ * deferred factor f_i): dVC gains f(x_i) where SmallVCM adds eta_VCM [TR (34)],
+ * and dVM (here eta times SmallVCM's dVM) gains f(x_i) where SmallVCM adds 1
+ * [TR (35)], and n_bpt dVCM (n_bpt = 1 with connections, 0 without) where
+ * SmallVCM adds dVCM / eta_VCM. With one constant eta this is SmallVCM's
+ * recursion, with dVM scaled by eta. The merge weight divides by the eta of
+ * its own technique, and every other merging technique possible at the same
+ * vertex adds its eta ratio to the local term [Moonen & Jalba 2023, eq. (4.17)].
  * Mis(x) is x^beta: beta = 2 (power heuristic) or 1 (balance heuristic),
- * applied to every ratio factor, including eta and the pdfs (TR Sec. 3).
+ * applied to every ratio factor, including eta and the pdfs (TR Sec. 3); a sum
+ * of factors is the sum of the powered terms.
  *
  * MEDIA (vlt, vbpt). A vertex may lie in a participating medium. Following
  * Veach's path-space formulation extended to media (Pauly et al. 2000,
@@ -77,8 +93,9 @@ typedef struct {
 
 /* Per-iteration constants. */
 typedef struct {
-    float vmWeightFactor;    /* Mis(eta_VCM) or 0 [TR (20)] */
-    float vcWeightFactor;    /* Mis(1 / eta_VCM) or 0 [TR (20)] */
+    float vmWeightFactor;    /* Mis(eta_surf) if surface merging is enabled, else 0 [TR (20)] */
+    float pp3dWeightFactor;  /* Mis(eta_pp3d) if pp3d is enabled, else 0 (see above) */
+    float bptFactor;         /* n_bpt: 1 if connections are enabled, else 0 */
     float lightSubPathCount; /* N_L, not raised to beta */
     ub_uint heuristic;       /* UB_MIS_POWER or UB_MIS_BALANCE */
 } ub_mis_constants;
@@ -88,8 +105,8 @@ UB_INLINE float ub_mis(ub_mis_constants c, float x) {
     return c.heuristic == UB_MIS_POWER ? x * x : x;
 }
 
-/* Constants of one iteration with merging radius `radius`. useVC / useVM enable
- * the connection (incl. light tracing and NEE) and merging techniques. */
+/* Constants of one iteration with surface merging radius `radius`. useVC / useVM enable
+ * the connection (incl. light tracing and NEE) and surface merging techniques. */
 UB_INLINE ub_mis_constants ub_mis_make_constants(float radius, float lightSubPathCount, int useVC,
                                                  int useVM, ub_uint heuristic) {
     ub_mis_constants c;
@@ -98,8 +115,29 @@ UB_INLINE ub_mis_constants ub_mis_make_constants(float radius, float lightSubPat
     /* eta_VCM = n_VM / n_VC * pi r^2, with n_VC = 1, n_VM = N_L [TR (20)] */
     float etaVCM = UB_PI * radius * radius * lightSubPathCount;
     c.vmWeightFactor = useVM ? ub_mis(c, etaVCM) : 0.0f;
-    c.vcWeightFactor = useVC ? ub_mis(c, 1.0f / etaVCM) : 0.0f;
+    c.pp3dWeightFactor = 0.0f;
+    c.bptFactor = useVC ? 1.0f : 0.0f;
     return c;
+}
+
+/* eta_pp3d = N_L (4/3) pi r^3: N_L photon points, each merged with a query point within
+ * the ball of radius r (UPBP Sec. 5, Table 1, the 3D box kernel's support volume). */
+UB_INLINE float ub_mis_eta_pp3d(float radius, float lightSubPathCount) {
+    return lightSubPathCount * (4.0f / 3.0f) * UB_PI * radius * radius * radius;
+}
+
+/* Enables pp3d with radius `radius` in constants made by ub_mis_make_constants. */
+UB_INLINE ub_mis_constants ub_mis_enable_pp3d(ub_mis_constants c, float radius) {
+    c.pp3dWeightFactor = ub_mis(c, ub_mis_eta_pp3d(radius, c.lightSubPathCount));
+    return c;
+}
+
+/* Merging factor f(x) = sum of Mis(eta) over the merging techniques possible at a vertex:
+ * surface merging at a non-specular surface vertex, the volumetric point estimators at a
+ * medium vertex. isDelta: the vertex has no non-specular lobe (nothing merges there). */
+UB_INLINE float ub_mis_merge_factor(ub_mis_constants c, int inMedium, int isDelta) {
+    if (isDelta) return 0.0f;
+    return inMedium ? c.pp3dWeightFactor : c.vmWeightFactor;
 }
 
 /* ---- Initialisation ---------------------------------------------------------------- */
@@ -118,8 +156,8 @@ UB_INLINE ub_mis_partials ub_mis_init_light(ub_mis_constants c, float directPdfA
      * paths cannot hit; cos := 1 for lights at infinity [TR Sec. 5.1] */
     float usedCos = isFinite ? cosLight : 1.0f;
     p.dVC = isDelta ? 0.0f : ub_mis(c, usedCos / emissionPdfW);
-    /* dVM_1 = dVC_1 / eta_VCM [TR (33)] */
-    p.dVM = p.dVC * c.vcWeightFactor;
+    /* dVM_1 = eta dVC_1 / eta [TR (33)], i.e. n_bpt dVC_1 (merging factors above) */
+    p.dVM = p.dVC * c.bptFactor;
     return p;
 }
 
@@ -174,9 +212,11 @@ UB_INLINE ub_mis_partials ub_mis_at_hit(ub_mis_constants c, ub_mis_partials p, f
 
 /* Scattering at a vertex: the new direction was sampled with dirPdfW, the reverse
  * direction would be sampled with revPdfW (both times the continuation probability),
- * cosOut = |cos| of the new direction. isSpecular: a delta lobe was sampled. */
+ * cosOut = |cos| of the new direction. isSpecular: a delta lobe was sampled. mergeFactor:
+ * ub_mis_merge_factor of the vertex. */
 UB_INLINE ub_mis_partials ub_mis_scatter(ub_mis_constants c, ub_mis_partials p, float cosOut,
-                                         float dirPdfW, float revPdfW, int isSpecular) {
+                                         float dirPdfW, float revPdfW, int isSpecular,
+                                         float mergeFactor) {
     ub_mis_partials q;
     if (isSpecular) {
         /* For a delta lobe the forward and reverse pdfs are equal and cancel;
@@ -188,9 +228,9 @@ UB_INLINE ub_mis_partials ub_mis_scatter(ub_mis_constants c, ub_mis_partials p, 
     }
     float g = ub_mis(c, cosOut / dirPdfW);
     float rev = ub_mis(c, revPdfW);
-    q.dVC = g * (p.dVC * rev + p.dVCM + c.vmWeightFactor);        /* [TR (34)] */
-    q.dVM = g * (p.dVM * rev + p.dVCM * c.vcWeightFactor + 1.0f); /* [TR (35)] */
-    q.dVCM = ub_mis(c, 1.0f / dirPdfW);                           /* [TR (36)] */
+    q.dVC = g * (p.dVC * rev + p.dVCM + mergeFactor);               /* [TR (34)] */
+    q.dVM = g * (p.dVM * rev + p.dVCM * c.bptFactor + mergeFactor); /* [TR (35)], x eta */
+    q.dVCM = ub_mis(c, 1.0f / dirPdfW);                             /* [TR (36)] */
     return q;
 }
 
@@ -202,16 +242,17 @@ UB_INLINE ub_mis_partials ub_mis_scatter(ub_mis_constants c, ub_mis_partials p, 
  * lightDirPdfA: light BSDF at y sampling z, in area measure at z;
  * cameraRevPdfW: camera BSDF at z sampling its previous vertex given the direction to y.
  * Media: both area pdfs include the free-flight pdf of the connecting chain in their
- * direction (stopping at the end vertex if it lies in a medium, passing otherwise). */
+ * direction (stopping at the end vertex if it lies in a medium, passing otherwise).
+ * lightMerge / cameraMerge: ub_mis_merge_factor of y and of z. */
 UB_INLINE float ub_mis_weight_connect(ub_mis_constants c, ub_mis_partials l, ub_mis_partials e,
                                       float cameraDirPdfA, float lightRevPdfW, float lightDirPdfA,
-                                      float cameraRevPdfW) {
+                                      float cameraRevPdfW, float lightMerge, float cameraMerge) {
     /* Partial light subpath weight [TR (40)] */
     float wLight =
-        ub_mis(c, cameraDirPdfA) * (c.vmWeightFactor + l.dVCM + l.dVC * ub_mis(c, lightRevPdfW));
+        ub_mis(c, cameraDirPdfA) * (lightMerge + l.dVCM + l.dVC * ub_mis(c, lightRevPdfW));
     /* Partial camera subpath weight [TR (41)] */
     float wCamera =
-        ub_mis(c, lightDirPdfA) * (c.vmWeightFactor + e.dVCM + e.dVC * ub_mis(c, cameraRevPdfW));
+        ub_mis(c, lightDirPdfA) * (cameraMerge + e.dVCM + e.dVC * ub_mis(c, cameraRevPdfW));
     return 1.0f / (wLight + 1.0f + wCamera); /* [TR (37)] */
 }
 
@@ -223,26 +264,28 @@ UB_INLINE float ub_mis_weight_connect(ub_mis_constants c, ub_mis_partials l, ub_
  * Media: passProb = probability that free-flight sampling from z passes the whole shadow
  * chain (what BSDF sampling needs to reach the light), distPdfToZ = free-flight pdf of the
  * light subpath stopping at z over that chain (scatter density times passes if z is a
- * medium vertex, passProb if z is on a surface). Both are 1 without media. */
+ * medium vertex, passProb if z is on a surface). Both are 1 without media.
+ * cameraMerge: ub_mis_merge_factor of z. */
 UB_INLINE float ub_mis_weight_nee_media(ub_mis_constants c, ub_mis_partials e, float bsdfDirPdfW,
                                         float bsdfRevPdfW, float lightPickProb, float directPdfW,
                                         float emissionPdfW, float cosToLight, float cosAtLight,
-                                        float passProb, float distPdfToZ) {
+                                        float passProb, float distPdfToZ, float cameraMerge) {
     /* Partial light subpath weight [TR (44)]: hitting the light by BSDF sampling */
     float wLight = ub_mis(c, bsdfDirPdfW * passProb / (lightPickProb * directPdfW));
     /* Partial camera subpath weight [TR (45)]: the light emitted towards z; the pick
      * probability cancels in the ratio emissionPdfW / directPdfW */
     float wCamera = ub_mis(c, emissionPdfW * cosToLight * distPdfToZ / (directPdfW * cosAtLight)) *
-                    (c.vmWeightFactor + e.dVCM + e.dVC * ub_mis(c, bsdfRevPdfW));
+                    (cameraMerge + e.dVCM + e.dVC * ub_mis(c, bsdfRevPdfW));
     return 1.0f / (wLight + 1.0f + wCamera); /* [TR (37)] */
 }
 
-/* The same without media. */
+/* The same without media, at a surface vertex. */
 UB_INLINE float ub_mis_weight_nee(ub_mis_constants c, ub_mis_partials e, float bsdfDirPdfW,
                                   float bsdfRevPdfW, float lightPickProb, float directPdfW,
                                   float emissionPdfW, float cosToLight, float cosAtLight) {
     return ub_mis_weight_nee_media(c, e, bsdfDirPdfW, bsdfRevPdfW, lightPickProb, directPdfW,
-                                   emissionPdfW, cosToLight, cosAtLight, 1.0f, 1.0f);
+                                   emissionPdfW, cosToLight, cosAtLight, 1.0f, 1.0f,
+                                   c.vmWeightFactor);
 }
 
 /* A camera subpath (partials e, after ub_mis_at_hit) hits an emitter, with pdfs of
@@ -258,12 +301,13 @@ UB_INLINE float ub_mis_weight_hit_light(ub_mis_constants c, ub_mis_partials e, f
 /* Light tracing: light vertex y (partials l) connected to the camera.
  * cameraPdfA: pdf of the camera sampling y, area measure (p_cam,W |cos_y| / d^2), times the
  * free-flight pdf of the camera ray reaching y (media; |cos_y| = 1 at a medium vertex);
- * bsdfRevPdfW: light BSDF at y sampling its previous vertex given the camera direction. */
+ * bsdfRevPdfW: light BSDF at y sampling its previous vertex given the camera direction;
+ * lightMerge: ub_mis_merge_factor of y. */
 UB_INLINE float ub_mis_weight_light_trace(ub_mis_constants c, ub_mis_partials l, float cameraPdfA,
-                                          float bsdfRevPdfW) {
+                                          float bsdfRevPdfW, float lightMerge) {
     /* Partial light subpath weight [TR (46)]; the camera part is 0 [TR (47)] */
     float wLight = ub_mis(c, cameraPdfA / c.lightSubPathCount) *
-                   (c.vmWeightFactor + l.dVCM + l.dVC * ub_mis(c, bsdfRevPdfW));
+                   (lightMerge + l.dVCM + l.dVC * ub_mis(c, bsdfRevPdfW));
     return 1.0f / (wLight + 1.0f); /* [TR (37)] */
 }
 
@@ -271,14 +315,27 @@ UB_INLINE float ub_mis_weight_light_trace(ub_mis_constants c, ub_mis_partials l,
  * cameraDirPdfW: camera BSDF sampling the light vertex's incoming direction, times the
  * camera vertex's continuation probability; cameraRevPdfW: camera BSDF sampling the
  * camera's previous vertex given that direction, times the LIGHT vertex's continuation
- * probability (the light subpath would have continued there). */
+ * probability (the light subpath would have continued there).
+ * mergeFactor: Mis(eta) of this merging technique (c.vmWeightFactor for surface merging,
+ * c.pp3dWeightFactor for pp3d); otherMerge: the sum of Mis(eta) of the other merging
+ * techniques possible at the same vertex (0 with one). */
+UB_INLINE float ub_mis_weight_merge_tech(ub_mis_constants c, ub_mis_partials l, ub_mis_partials e,
+                                         float cameraDirPdfW, float cameraRevPdfW,
+                                         float mergeFactor, float otherMerge) {
+    float invEta = 1.0f / mergeFactor;
+    /* Partial light subpath weight [TR (38)]; [Moonen & Jalba 2023, eq. (4.52)] */
+    float wLight = (l.dVCM * c.bptFactor + l.dVM * ub_mis(c, cameraDirPdfW)) * invEta;
+    /* Partial camera subpath weight [TR (39)]; [Moonen & Jalba 2023, eq. (4.53)] */
+    float wCamera = (e.dVCM * c.bptFactor + e.dVM * ub_mis(c, cameraRevPdfW)) * invEta;
+    /* Local term: this technique and the others at the same vertex [Moonen & Jalba, (4.17)] */
+    float wLocal = 1.0f + otherMerge * invEta;
+    return 1.0f / (wLight + wLocal + wCamera); /* [TR (37)] */
+}
+
+/* Surface merging (the only merging technique at a surface vertex). */
 UB_INLINE float ub_mis_weight_merge(ub_mis_constants c, ub_mis_partials l, ub_mis_partials e,
                                     float cameraDirPdfW, float cameraRevPdfW) {
-    /* Partial light subpath weight [TR (38)] */
-    float wLight = l.dVCM * c.vcWeightFactor + l.dVM * ub_mis(c, cameraDirPdfW);
-    /* Partial camera subpath weight [TR (39)] */
-    float wCamera = e.dVCM * c.vcWeightFactor + e.dVM * ub_mis(c, cameraRevPdfW);
-    return 1.0f / (wLight + 1.0f + wCamera); /* [TR (37)] */
+    return ub_mis_weight_merge_tech(c, l, e, cameraDirPdfW, cameraRevPdfW, c.vmWeightFactor, 0.0f);
 }
 
 #endif /* UB_MIS_H */

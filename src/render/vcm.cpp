@@ -259,7 +259,8 @@ bool VertexCM::sampleScattering(Rng& rng, const VertexScatter& scatter, const Pa
     revPdfW *= contProb;
 
     // MIS partials after scattering [TR (34)-(36)], or [TR (53)-(55)] for specular events.
-    state.mis = ub_mis_scatter(mis_, state.mis, cosThetaOut, dirPdfW, revPdfW, specular);
+    state.mis = ub_mis_scatter(mis_, state.mis, cosThetaOut, dirPdfW, revPdfW, specular,
+                               ub_mis_merge_factor(mis_, v.inMedium, scatter.isDelta()));
     state.specularPath = state.specularPath && specular;
     state.throughput *= f * (cosThetaOut / dirPdfW);
     if (isBlack(state.throughput) || !isFinite(state.throughput)) return false;

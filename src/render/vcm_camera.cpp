@@ -25,7 +25,7 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration) const {
     const Vec2 lensU = rng.uniform2();
     state.ray = camera.generateRay(Vec2(float(x) + jitter.x, float(y) + jitter.y), lensU);
     // Camera subpath partials [TR (31)-(33)], completed at the first hit. Thin lenses (ppm and
-    // bpm only) never use dVCM of the camera vertex: it is multiplied by vcWeightFactor = 0.
+    // bpm only) never use dVCM of the camera vertex: it is multiplied by bptFactor = 0.
     const float cameraPdfW = camera.isPinhole() ? camera.pdfW(state.ray.dir) : 1.0f;
     state.mis = ub_mis_init_camera(mis_, cameraPdfW);
 
@@ -164,7 +164,8 @@ Rgb VertexCM::directIllumination(Rng& rng, const SubPath& state, const PathVerte
     if (sh.blocked || isBlack(sh.transmittance)) return Rgb(0.0f);
     const float weight = ub_mis_weight_nee_media(
         mis_, state.mis, bsdfDirPdfW, bsdfRevPdfW, lightPickProb_, directPdfW, emissionPdfW,
-        cosToLight, cosAtLight, sh.probPass, v.inMedium ? sh.pdfScatterRevL : sh.probPass);
+        cosToLight, cosAtLight, sh.probPass, v.inMedium ? sh.pdfScatterRevL : sh.probPass,
+        ub_mis_merge_factor(mis_, v.inMedium, 0));
     return le * f * sh.transmittance * (weight * cosToLight / (lightPickProb_ * directPdfW));
 }
 
@@ -219,8 +220,9 @@ Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const
     const float lightDirPdfA = lightDirPdfW * cosCamera * distPdfToCamera / distSqr;
     ub_mis_partials lightMis = {lv.dVCM, lv.dVC, lv.dVM};
     // Weight of [TR (40), (41)].
-    const float weight = ub_mis_weight_connect(mis_, lightMis, state.mis, cameraDirPdfA,
-                                               lightRevPdfW, lightDirPdfA, cameraRevPdfW);
+    const float weight = ub_mis_weight_connect(
+        mis_, lightMis, state.mis, cameraDirPdfA, lightRevPdfW, lightDirPdfA, cameraRevPdfW,
+        ub_mis_merge_factor(mis_, lv.inMedium(), 0), ub_mis_merge_factor(mis_, v.inMedium, 0));
     const Rgb contrib = fCamera * fLight * transmittance * (weight * geometry);
     if (isBlack(contrib)) return Rgb(0.0f);
     if (!useMedia_ && scene_.occluded(v.pos, v.hit.geoNormal, lv.position, lv.geoNormal))

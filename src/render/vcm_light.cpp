@@ -147,7 +147,8 @@ void VertexCM::connectToCamera(const SubPath& state, const PathVertex& v,
     // Light tracing alone has no MIS; otherwise the weight of [TR (46), (47)].
     const float weight = lightTraceOnly_
                              ? 1.0f
-                             : ub_mis_weight_light_trace(mis_, state.mis, cameraPdfA, bsdfRevPdfW);
+                             : ub_mis_weight_light_trace(mis_, state.mis, cameraPdfA, bsdfRevPdfW,
+                                                         ub_mis_merge_factor(mis_, v.inMedium, 0));
     const Rgb contrib =
         state.throughput * f * transmittance * (weight * imageToSurface / lightSubPathCount_);
     if (isBlack(contrib)) return;

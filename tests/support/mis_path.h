@@ -73,19 +73,27 @@ struct MisPath {
 
 struct MisConfig {
     bool useVC = true, useVM = true;
+    bool usePP3D = false;  ///< photon points x query points at medium vertices (UPBP)
     float radius = 0.05f;
+    float radiusPP3D = 0.05f;
     float lightSubPathCount = 1000;
     ub_uint heuristic = UB_MIS_POWER;
 };
 
 /// A technique: connection with s light vertices (s = 0: camera hits the light,
-/// s = 1: NEE, s = k: light tracing), or merging at x_i.
+/// s = 1: NEE, s = k: light tracing), or merging at x_i (surface merging on a surface
+/// vertex, pp3d on a medium vertex).
 struct MisTechnique {
     bool merge = false;
     int index = 0;  ///< s for connections, i for merges
     double weight = 0;
     std::string name() const { return (merge ? "merge@x" : "connect s=") + std::to_string(index); }
 };
+
+/// Merging possible at x_i (surface merging at surface vertices, pp3d at medium vertices).
+inline bool mergesAt(const MisPath& p, const MisConfig& cfg, int i) {
+    return p.v[size_t(i)].medium ? cfg.usePP3D : cfg.useVM;
+}
 
 /// Which techniques the renderer has for `path` under `cfg` (SmallVCM's semantics: BPM/PPM
 /// count a camera subpath hitting a light only for purely specular camera subpaths).
@@ -96,15 +104,16 @@ inline std::vector<MisTechnique> validTechniques(const MisPath& p, const MisConf
     bool allSpecular = true;
     for (int i = 1; i < k; ++i) allSpecular &= p.v[i].specular;
     bool hitValid = !p.lightIsDelta() && (cfg.useVC || allSpecular);
+    // Without connections, a light hit counts only after purely specular camera vertices
+    // (render/vcm.h); with pp3d but neither VC nor surface merging that stays the rule.
     if (hitValid) out.push_back({false, 0});
     if (cfg.useVC) {
         for (int s = 1; s <= k - 1; ++s)
             if (connectible(s) && (s == 1 || connectible(s - 1))) out.push_back({false, s});
         if (k >= 2 && connectible(k - 1)) out.push_back({false, k});
     }
-    if (cfg.useVM)
-        for (int i = 1; i <= k - 1; ++i)
-            if (connectible(i) && !p.v[i].medium) out.push_back({true, i});
+    for (int i = 1; i <= k - 1; ++i)
+        if (connectible(i) && mergesAt(p, cfg, i)) out.push_back({true, i});
     return out;
 }
 
@@ -141,6 +150,8 @@ inline std::vector<MisTechnique> bruteForceWeights(const MisPath& p, const MisCo
     if (p.lightIsDelta()) b[0] = 0;
 
     const double eta = M_PI * double(cfg.radius) * cfg.radius * cfg.lightSubPathCount;
+    const double etaPP3D = 4.0 / 3.0 * M_PI * double(cfg.radiusPP3D) * cfg.radiusPP3D *
+                           cfg.radiusPP3D * cfg.lightSubPathCount;
     std::vector<MisTechnique> techs = validTechniques(p, cfg);
     double beta = cfg.heuristic == UB_MIS_POWER ? 2.0 : 1.0;
     double sum = 0;
@@ -155,7 +166,7 @@ inline std::vector<MisTechnique> bruteForceWeights(const MisPath& p, const MisCo
             int i = t.index;
             for (int j = 0; j <= i; ++j) pdf *= a[j];
             for (int j = i; j <= k - 1; ++j) pdf *= b[j];
-            pdf *= eta;
+            pdf *= p.v[size_t(i)].medium ? etaPP3D : eta;
         }
         t.weight = std::pow(pdf, beta);
         sum += t.weight;
@@ -170,6 +181,8 @@ inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisCon
     const int k = p.k();
     ub_mis_constants c = ub_mis_make_constants(cfg.radius, cfg.lightSubPathCount, cfg.useVC,
                                                cfg.useVM, cfg.heuristic);
+    if (cfg.usePP3D) c = ub_mis_enable_pp3d(c, cfg.radiusPP3D);
+    auto merge = [&](int i) { return ub_mis_merge_factor(c, p.v[size_t(i)].medium, 0); };
     const bool finite = p.lightIsFinite();
     const float pick = p.lightPickProb;
     const float emissionPdfW = p.emitPosPdf * p.emitDirPdfW;  // without pick probability
@@ -183,7 +196,8 @@ inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisCon
         const MisVertex& x = p.v[i];
         lp = ub_mis_at_hit_media(c, lp, p.dist[i], x.cosIn, i > 1 || finite, p.tFwd(i), p.tRev(i));
         L[i] = lp;
-        lp = ub_mis_scatter(c, lp, x.cosOut, x.pdfFwdW * x.cont, x.pdfRevW * x.cont, x.specular);
+        lp = ub_mis_scatter(c, lp, x.cosOut, x.pdfFwdW * x.cont, x.pdfRevW * x.cont, x.specular,
+                            merge(i));
     }
     // Camera subpath: partials at x_{k-1}..x_1, and at x_0 when it hits the light.
     ub_mis_partials ep = ub_mis_init_camera(c, p.cameraPdfW);
@@ -191,7 +205,8 @@ inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisCon
         const MisVertex& x = p.v[i];
         ep = ub_mis_at_hit_media(c, ep, p.dist[i + 1], x.cosOut, 1, p.tRev(i + 1), p.tFwd(i + 1));
         E[i] = ep;
-        ep = ub_mis_scatter(c, ep, x.cosIn, x.pdfRevW * x.cont, x.pdfFwdW * x.cont, x.specular);
+        ep = ub_mis_scatter(c, ep, x.cosIn, x.pdfRevW * x.cont, x.pdfFwdW * x.cont, x.specular,
+                            merge(i));
     }
     // Lights at infinity are "hit" by escaping rays: no distance and no cosine.
     E[0] = finite ? ub_mis_at_hit_media(c, ep, p.dist[1], p.cosLight, 1, p.tRev(1), p.tFwd(1))
@@ -202,8 +217,8 @@ inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisCon
         float w = 0;
         if (t.merge) {
             const MisVertex& x = p.v[t.index];
-            w = ub_mis_weight_merge(c, L[t.index], E[t.index], x.pdfRevW * x.cont,
-                                    x.pdfFwdW * x.cont);
+            w = ub_mis_weight_merge_tech(c, L[t.index], E[t.index], x.pdfRevW * x.cont,
+                                         x.pdfFwdW * x.cont, merge(t.index), 0.0f);
         } else if (t.index == 0) {
             w = ub_mis_weight_hit_light(c, E[0], p.directPdfA * pick, emissionPdfW * pick);
         } else if (t.index == 1 && k > 1) {
@@ -213,11 +228,13 @@ inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisCon
             float directPdfW = finite ? p.directPdfA * sq(p.dist[1]) / cosAtLight : p.directPdfA;
             float bsdfDirPdfW = p.lightIsDelta() ? 0.0f : x.pdfRevW * x.cont;
             w = ub_mis_weight_nee_media(c, E[1], bsdfDirPdfW, x.pdfFwdW * x.cont, pick, directPdfW,
-                                        emissionPdfW, x.cosIn, cosAtLight, p.tRev(1), p.tFwd(1));
+                                        emissionPdfW, x.cosIn, cosAtLight, p.tRev(1), p.tFwd(1),
+                                        merge(1));
         } else if (t.index == k) {
             const MisVertex& y = p.v[k - 1];
             float cameraPdfA = p.cameraPdfW * y.cosOut * p.tRev(k) / sq(p.dist[k]);
-            w = ub_mis_weight_light_trace(c, L[k - 1], cameraPdfA, y.pdfRevW * y.cont);
+            w = ub_mis_weight_light_trace(c, L[k - 1], cameraPdfA, y.pdfRevW * y.cont,
+                                          merge(k - 1));
         } else {
             int s = t.index;
             const MisVertex& y = p.v[s - 1];  // light vertex
@@ -226,7 +243,7 @@ inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisCon
             float cameraDirPdfA = z.pdfRevW * z.cont * y.cosOut * p.tRev(s) / d2;
             float lightDirPdfA = y.pdfFwdW * y.cont * z.cosIn * p.tFwd(s) / d2;
             w = ub_mis_weight_connect(c, L[s - 1], E[s], cameraDirPdfA, y.pdfRevW * y.cont,
-                                      lightDirPdfA, z.pdfFwdW * z.cont);
+                                      lightDirPdfA, z.pdfFwdW * z.cont, merge(s - 1), merge(s));
         }
         t.weight = w;
     }
