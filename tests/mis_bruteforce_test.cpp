@@ -185,6 +185,23 @@ void addMedia(Rng& rng, MisPath* p, float mediumProb) {
     }
 }
 
+/// Pass probabilities for the beam estimators: a segment ending at a medium vertex passes
+/// it with a probability in [0.02, 1] (independent of its stop density), a segment ending
+/// on a surface passes with its distance pdf (they are the same event); and a random
+/// sin(theta) at each medium vertex.
+void addBeamData(Rng& rng, MisPath* p) {
+    const int k = p->k();
+    auto inMedium = [&](int i) { return i >= 1 && i <= k - 1 && p->v[size_t(i)].medium; };
+    p->passFwd = p->distFwd;
+    p->passRev = p->distRev;
+    for (int i = 1; i <= k; ++i) {
+        if (inMedium(i)) p->passFwd[size_t(i)] = uniformIn(rng, 0.02f, 1.0f);
+        if (inMedium(i - 1)) p->passRev[size_t(i)] = uniformIn(rng, 0.02f, 1.0f);
+    }
+    for (int i = 1; i < k; ++i)
+        if (p->v[size_t(i)].medium) p->v[size_t(i)].sinTheta = uniformIn(rng, 0.05f, 1.0f);
+}
+
 std::vector<NamedConfig> bptConfigs() {
     std::vector<NamedConfig> out;
     for (const NamedConfig& nc : configs())
@@ -268,6 +285,68 @@ TEST(MisBruteForce, PointEstimatorsInMediaMatchExplicitPdfWeights) {
         }
     EXPECT_GT(compared, 40000);
     EXPECT_GT(pp3dMerges, 10000);
+}
+
+// Every UPBP estimator (kernels/shared/ub_mis_volume.h): the recursive weights, with the
+// beam techniques' deferred factors, equal the explicit-pdf weights of UPBP eq. (8) for
+// subsets with and without connections, short and long photon and query beams, power and
+// balance heuristic; one path's weights sum to 1. Radii make every eta of order 1 so that
+// the techniques compete (N_L = 1000, N_B = 100).
+TEST(MisBruteForce, BeamEstimatorsInMediaMatchExplicitPdfWeights) {
+    Rng rng(48, 7);
+    struct Upbp {
+        const char* name;
+        bool vc, surf, pp3d, pb2d, bp2d, bb1d;
+    };
+    const Upbp kSets[] = {{"all", true, true, true, true, true, true},
+                          {"bpt+pb2d", true, false, false, true, false, false},
+                          {"bpt+bp2d", true, false, false, false, true, false},
+                          {"bpt+bb1d", true, false, false, false, false, true},
+                          {"pb2d+bb1d", false, false, false, true, false, true},
+                          {"bb1d", false, false, false, false, false, true},
+                          {"surf+pp3d+bp2d", false, true, true, false, true, false}};
+    int compared = 0, beamMerges = 0;
+    for (ub_uint h : {UB_MIS_POWER, UB_MIS_BALANCE})
+        for (int beams = 0; beams < 4; ++beams)
+            for (const Upbp& set : kSets) {
+                MisConfig cfg;
+                cfg.heuristic = h;
+                cfg.useVC = set.vc;
+                cfg.useVM = set.surf;
+                cfg.usePP3D = set.pp3d;
+                cfg.usePB2D = set.pb2d;
+                cfg.useBP2D = set.bp2d;
+                cfg.useBB1D = set.bb1d;
+                cfg.shortPhotonBeams = (beams & 1) != 0;
+                cfg.shortQueryBeams = (beams & 2) != 0;
+                cfg.radiusPP3D = 0.08f;
+                cfg.radiusPB2D = 0.02f;   // N_L pi r^2 ~ 1.3
+                cfg.radiusBP2D = 0.06f;   // N_B pi r^2 ~ 1.1
+                cfg.radiusBB1D = 0.005f;  // N_B 2 r ~ 1
+                for (int n = 0; n < 600; ++n) {
+                    int k = 2 + int(rng.uniform() * 7);
+                    MisLightKind kind = kKinds[n % 4];
+                    MisPath p = randomPath(rng, k, kind, 0.2f);
+                    addMedia(rng, &p, 0.5f);
+                    addBeamData(rng, &p);
+                    auto ref = bruteForceWeights(p, cfg);
+                    auto rec = recursiveWeights(p, cfg);
+                    ASSERT_EQ(ref.size(), rec.size());
+                    double sum = 0;
+                    for (size_t t = 0; t < ref.size(); ++t) {
+                        ASSERT_NEAR(rec[t].weight, ref[t].weight, 1e-4)
+                            << set.name << (h == UB_MIS_POWER ? "/power" : "/balance") << " beams "
+                            << beams << " k=" << k << " light kind " << int(kind) << " technique "
+                            << ref[t].name() << " (path " << n << ")";
+                        sum += rec[t].weight;
+                        ++compared;
+                        beamMerges += ref[t].tech > 0;
+                    }
+                    if (!rec.empty()) ASSERT_NEAR(sum, 1.0, 1e-4) << set.name << " k=" << k;
+                }
+            }
+    EXPECT_GT(compared, 50000);
+    EXPECT_GT(beamMerges, 20000);
 }
 
 // Without media the media-aware updates reduce to the surface ones exactly.

@@ -12,8 +12,10 @@
 #ifndef UB_DEFS_H
 #define UB_DEFS_H
 
-#ifdef __OPENCL_VERSION__
-#define UB_INLINE inline
+/* __OPENCL_C_VERSION__ is defined by every OpenCL C compiler (1.2 and later). Functions
+ * are static inline so that each program or translation unit has its own copy. */
+#ifdef __OPENCL_C_VERSION__
+#define UB_INLINE static inline
 #define UB_GLOBAL __global
 #define UB_PRIVATE __private
 typedef uint ub_uint;
@@ -31,7 +33,7 @@ typedef uint ub_uint;
 #else
 #include <cmath>
 #include <cstdint>
-#define UB_INLINE inline
+#define UB_INLINE static inline
 #define UB_GLOBAL
 #define UB_PRIVATE
 typedef uint32_t ub_uint;

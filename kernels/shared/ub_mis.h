@@ -84,20 +84,29 @@
 #define UB_MIS_BALANCE 0u
 #define UB_MIS_POWER 1u
 
-/* The three MIS partials of a subpath (state while tracing, stored at light vertices). */
+/* The MIS partials of a subpath (state while tracing, stored at light vertices).
+ * dOut: the part of the merging factor of the vertex the subpath just left that waits for
+ * Mis(R_out) of the segment being traced (the beam estimators, ub_mis_volume.h); 0 at
+ * stored vertices and whenever no beam technique is enabled. */
 typedef struct {
     float dVCM;
     float dVC;
     float dVM;
+    float dOut;
 } ub_mis_partials;
 
 /* Per-iteration constants. */
 typedef struct {
-    float vmWeightFactor;    /* Mis(eta_surf) if surface merging is enabled, else 0 [TR (20)] */
-    float pp3dWeightFactor;  /* Mis(eta_pp3d) if pp3d is enabled, else 0 (see above) */
-    float bptFactor;         /* n_bpt: 1 if connections are enabled, else 0 */
-    float lightSubPathCount; /* N_L, not raised to beta */
-    ub_uint heuristic;       /* UB_MIS_POWER or UB_MIS_BALANCE */
+    float vmWeightFactor;     /* Mis(eta_surf) if surface merging is enabled, else 0 [TR (20)] */
+    float pp3dWeightFactor;   /* Mis(eta_pp3d) if pp3d is enabled, else 0 (see above) */
+    float pb2dWeightFactor;   /* Mis(N_L pi r_pb2d^2) or 0 (ub_mis_volume.h) */
+    float bp2dWeightFactor;   /* Mis(N_B pi r_bp2d^2) or 0 (ub_mis_volume.h) */
+    float bb1dWeightFactor;   /* Mis(N_B 2 r_bb1d) or 0 (ub_mis_volume.h) */
+    ub_uint shortPhotonBeams; /* 1: photon beams end at the sampled distance; 0: long */
+    ub_uint shortQueryBeams;  /* 1: query beams end at the sampled distance; 0: long */
+    float bptFactor;          /* n_bpt: 1 if connections are enabled, else 0 */
+    float lightSubPathCount;  /* N_L, not raised to beta */
+    ub_uint heuristic;        /* UB_MIS_POWER or UB_MIS_BALANCE */
 } ub_mis_constants;
 
 /* Mis(x): the heuristic's exponent applied to one ratio factor. */
@@ -116,6 +125,11 @@ UB_INLINE ub_mis_constants ub_mis_make_constants(float radius, float lightSubPat
     float etaVCM = UB_PI * radius * radius * lightSubPathCount;
     c.vmWeightFactor = useVM ? ub_mis(c, etaVCM) : 0.0f;
     c.pp3dWeightFactor = 0.0f;
+    c.pb2dWeightFactor = 0.0f;
+    c.bp2dWeightFactor = 0.0f;
+    c.bb1dWeightFactor = 0.0f;
+    c.shortPhotonBeams = 1u;
+    c.shortQueryBeams = 0u;
     c.bptFactor = useVC ? 1.0f : 0.0f;
     return c;
 }
@@ -158,6 +172,7 @@ UB_INLINE ub_mis_partials ub_mis_init_light(ub_mis_constants c, float directPdfA
     p.dVC = isDelta ? 0.0f : ub_mis(c, usedCos / emissionPdfW);
     /* dVM_1 = eta dVC_1 / eta [TR (33)], i.e. n_bpt dVC_1 (merging factors above) */
     p.dVM = p.dVC * c.bptFactor;
+    p.dOut = 0.0f;
     return p;
 }
 
@@ -170,6 +185,7 @@ UB_INLINE ub_mis_partials ub_mis_init_camera(ub_mis_constants c, float cameraPdf
     p.dVCM = ub_mis(c, c.lightSubPathCount / cameraPdfW); /* [TR (31)] */
     p.dVC = 0.0f;                                         /* [TR (32)] */
     p.dVM = 0.0f;                                         /* [TR (33)] */
+    p.dOut = 0.0f;
     return p;
 }
 
@@ -186,10 +202,19 @@ UB_INLINE ub_mis_partials ub_mis_init_camera(ub_mis_constants c, float cameraPdf
  * sampled the other way, from the new vertex back to the previous one (stopping there if
  * it is a medium vertex). The forward pdf completes p(x_i) in dVCM = 1/p(x_i) and in the
  * ratio p(x_{i-1} from x_i) / p(x_i) that dVC and dVM carry; the reverse pdf belongs to
- * that ratio's numerator (docs/mis.md, "Notation", a_i and b_{i-1}). */
-UB_INLINE ub_mis_partials ub_mis_at_hit_media(ub_mis_constants c, ub_mis_partials p, float dist,
-                                              float cosFix, int applyDistSqr, float distPdfFwd,
-                                              float distPdfRev) {
+ * that ratio's numerator (docs/mis.md, "Notation", a_i and b_{i-1}). rOut: R_out of this
+ * segment for the deferred merging factor p.dOut of the previous vertex (ub_mis_volume.h). */
+UB_INLINE ub_mis_partials ub_mis_at_hit_volume(ub_mis_constants c, ub_mis_partials p, float dist,
+                                               float cosFix, int applyDistSqr, float distPdfFwd,
+                                               float distPdfRev, float rOut) {
+    /* Complete the merging factor of the previous vertex with R_out of this segment
+     * (ub_mis_volume.h; Moonen & Jalba 2023, the deferred factor f_i of eq. (4.47)) */
+    if (p.dOut != 0.0f) {
+        float deferred = p.dOut * ub_mis(c, rOut);
+        p.dVC += deferred;
+        p.dVM += deferred;
+        p.dOut = 0.0f;
+    }
     if (applyDistSqr) p.dVCM *= ub_mis(c, dist * dist);
     float invFwd = 1.0f / ub_mis(c, cosFix * distPdfFwd);
     float revOverFwd = ub_mis(c, distPdfRev) * invFwd;
@@ -197,6 +222,13 @@ UB_INLINE ub_mis_partials ub_mis_at_hit_media(ub_mis_constants c, ub_mis_partial
     p.dVC *= revOverFwd;
     p.dVM *= revOverFwd;
     return p;
+}
+
+/* ub_mis_at_hit_volume without beam techniques (p.dOut is 0). */
+UB_INLINE ub_mis_partials ub_mis_at_hit_media(ub_mis_constants c, ub_mis_partials p, float dist,
+                                              float cosFix, int applyDistSqr, float distPdfFwd,
+                                              float distPdfRev) {
+    return ub_mis_at_hit_volume(c, p, dist, cosFix, applyDistSqr, distPdfFwd, distPdfRev, 0.0f);
 }
 
 /* The same without media (both distance pdfs 1). */
@@ -218,6 +250,7 @@ UB_INLINE ub_mis_partials ub_mis_scatter(ub_mis_constants c, ub_mis_partials p, 
                                          float dirPdfW, float revPdfW, int isSpecular,
                                          float mergeFactor) {
     ub_mis_partials q;
+    q.dOut = 0.0f;
     if (isSpecular) {
         /* For a delta lobe the forward and reverse pdfs are equal and cancel;
          * no connection or merging can use this vertex [TR (53)-(55)]. */
@@ -231,6 +264,16 @@ UB_INLINE ub_mis_partials ub_mis_scatter(ub_mis_constants c, ub_mis_partials p, 
     q.dVC = g * (p.dVC * rev + p.dVCM + mergeFactor);               /* [TR (34)] */
     q.dVM = g * (p.dVM * rev + p.dVCM * c.bptFactor + mergeFactor); /* [TR (35)], x eta */
     q.dVCM = ub_mis(c, 1.0f / dirPdfW);                             /* [TR (36)] */
+    return q;
+}
+
+/* ub_mis_scatter with a merging factor F0 + F1 Mis(R_out) (ub_mis_volume.h): F0 is added
+ * now, F1 waits in dOut for the R_out of the segment about to be traced. */
+UB_INLINE ub_mis_partials ub_mis_scatter_volume(ub_mis_constants c, ub_mis_partials p, float cosOut,
+                                                float dirPdfW, float revPdfW, int isSpecular,
+                                                float factorNow, float factorOut) {
+    ub_mis_partials q = ub_mis_scatter(c, p, cosOut, dirPdfW, revPdfW, isSpecular, factorNow);
+    if (!isSpecular) q.dOut = ub_mis(c, cosOut / dirPdfW) * factorOut;
     return q;
 }
 

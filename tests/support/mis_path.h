@@ -26,7 +26,7 @@
 #include <string>
 #include <vector>
 
-#include "kernels/shared/ub_mis.h"
+#include "kernels/shared/ub_mis_volume.h"
 
 namespace ub::test {
 
@@ -40,6 +40,7 @@ struct MisVertex {
     float cont = 1;         ///< Russian-roulette continuation probability at x_i
     bool specular = false;  ///< delta lobe: pdfs are the discrete lobe probability (equal)
     bool medium = false;    ///< medium vertex: cosines 1, phase pdfs, not specular
+    float sinTheta = 1;     ///< medium vertex: sine of the angle x_{i-1} -> x_i -> x_{i+1}
 };
 
 enum class MisLightKind { Area, Point, Directional, Environment };
@@ -60,6 +61,12 @@ struct MisPath {
     /// Free-flight pdfs of segment i (x_{i-1} x_i), i = 1..k, in the light (Fwd) and camera
     /// (Rev) directions; empty: no media (all 1).
     std::vector<float> distFwd, distRev;
+    /// Probability that free-flight sampling passes segment i (up to x_i, or x_{i-1} in the
+    /// camera direction) without stopping; empty: equal to distFwd / distRev (that is the
+    /// distance pdf of a surface end).
+    std::vector<float> passFwd, passRev;
+    float pFwd(int i) const { return passFwd.empty() ? tFwd(i) : passFwd[size_t(i)]; }
+    float pRev(int i) const { return passRev.empty() ? tRev(i) : passRev[size_t(i)]; }
     int k() const { return int(dist.size()) - 1; }
     float tFwd(int i) const { return distFwd.empty() ? 1.0f : distFwd[size_t(i)]; }
     float tRev(int i) const { return distRev.empty() ? 1.0f : distRev[size_t(i)]; }
@@ -74,25 +81,40 @@ struct MisPath {
 struct MisConfig {
     bool useVC = true, useVM = true;
     bool usePP3D = false;  ///< photon points x query points at medium vertices (UPBP)
+    bool usePB2D = false, useBP2D = false, useBB1D = false;  ///< the beam estimators (UPBP)
+    bool shortPhotonBeams = true, shortQueryBeams = false;
     float radius = 0.05f;
-    float radiusPP3D = 0.05f;
+    float radiusPP3D = 0.05f, radiusPB2D = 0.05f, radiusBP2D = 0.05f, radiusBB1D = 0.05f;
+    float beamPathCount = 100;  ///< N_B
     float lightSubPathCount = 1000;
     ub_uint heuristic = UB_MIS_POWER;
 };
 
 /// A technique: connection with s light vertices (s = 0: camera hits the light,
 /// s = 1: NEE, s = k: light tracing), or merging at x_i (surface merging on a surface
-/// vertex, pp3d on a medium vertex).
+/// vertex, tech = -1; a volumetric technique UB_TECH_* on a medium vertex).
 struct MisTechnique {
     bool merge = false;
     int index = 0;  ///< s for connections, i for merges
+    int tech = -1;  ///< merges at medium vertices: UB_TECH_PP3D ... UB_TECH_BB1D
     double weight = 0;
-    std::string name() const { return (merge ? "merge@x" : "connect s=") + std::to_string(index); }
+    std::string name() const {
+        return (merge ? "merge" + std::to_string(tech) + "@x" : "connect s=") +
+               std::to_string(index);
+    }
 };
 
-/// Merging possible at x_i (surface merging at surface vertices, pp3d at medium vertices).
-inline bool mergesAt(const MisPath& p, const MisConfig& cfg, int i) {
-    return p.v[size_t(i)].medium ? cfg.usePP3D : cfg.useVM;
+inline bool volumeTechEnabled(const MisConfig& cfg, int tech) {
+    switch (tech) {
+        case UB_TECH_PP3D:
+            return cfg.usePP3D;
+        case UB_TECH_PB2D:
+            return cfg.usePB2D;
+        case UB_TECH_BP2D:
+            return cfg.useBP2D;
+        default:
+            return cfg.useBB1D;
+    }
 }
 
 /// Which techniques the renderer has for `path` under `cfg` (SmallVCM's semantics: BPM/PPM
@@ -112,8 +134,15 @@ inline std::vector<MisTechnique> validTechniques(const MisPath& p, const MisConf
             if (connectible(s) && (s == 1 || connectible(s - 1))) out.push_back({false, s});
         if (k >= 2 && connectible(k - 1)) out.push_back({false, k});
     }
-    for (int i = 1; i <= k - 1; ++i)
-        if (connectible(i) && mergesAt(p, cfg, i)) out.push_back({true, i});
+    for (int i = 1; i <= k - 1; ++i) {
+        if (!connectible(i)) continue;
+        if (!p.v[size_t(i)].medium) {
+            if (cfg.useVM) out.push_back({true, i, -1});
+            continue;
+        }
+        for (int t = 0; t < 4; ++t)
+            if (volumeTechEnabled(cfg, t)) out.push_back({true, i, t});
+    }
     return out;
 }
 
@@ -166,7 +195,30 @@ inline std::vector<MisTechnique> bruteForceWeights(const MisPath& p, const MisCo
             int i = t.index;
             for (int j = 0; j <= i; ++j) pdf *= a[j];
             for (int j = i; j <= k - 1; ++j) pdf *= b[j];
-            pdf *= p.v[size_t(i)].medium ? etaPP3D : eta;
+            if (!p.v[size_t(i)].medium) {
+                pdf *= eta;
+            } else {
+                // UPBP eq. (8) (kernels/shared/ub_mis_volume.h): R = cover / T of the photon
+                // beam reaching x_i (segment i) and of the query beam (segment i+1, reverse).
+                double rPhoton = (cfg.shortPhotonBeams ? p.pFwd(i) : 1.0) / p.tFwd(i);
+                double rQuery = (cfg.shortQueryBeams ? p.pRev(i + 1) : 1.0) / p.tRev(i + 1);
+                double nL = cfg.lightSubPathCount, nB = cfg.beamPathCount;
+                double sinT = p.v[size_t(i)].sinTheta;
+                auto sq = [](double x) { return x * x; };
+                switch (t.tech) {
+                    case UB_TECH_PP3D:
+                        pdf *= etaPP3D;
+                        break;
+                    case UB_TECH_PB2D:
+                        pdf *= nL * M_PI * sq(cfg.radiusPB2D) * rQuery;
+                        break;
+                    case UB_TECH_BP2D:
+                        pdf *= nB * M_PI * sq(cfg.radiusBP2D) * rPhoton;
+                        break;
+                    default:
+                        pdf *= nB * 2.0 * cfg.radiusBB1D * sinT * rPhoton * rQuery;
+                }
+            }
         }
         t.weight = std::pow(pdf, beta);
         sum += t.weight;
@@ -181,8 +233,22 @@ inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisCon
     const int k = p.k();
     ub_mis_constants c = ub_mis_make_constants(cfg.radius, cfg.lightSubPathCount, cfg.useVC,
                                                cfg.useVM, cfg.heuristic);
-    if (cfg.usePP3D) c = ub_mis_enable_pp3d(c, cfg.radiusPP3D);
-    auto merge = [&](int i) { return ub_mis_merge_factor(c, p.v[size_t(i)].medium, 0); };
+    c = ub_mis_enable_volume(
+        c, cfg.usePP3D ? cfg.radiusPP3D : 0.0f, cfg.usePB2D ? cfg.radiusPB2D : 0.0f,
+        cfg.useBP2D ? cfg.radiusBP2D : 0.0f, cfg.useBB1D ? cfg.radiusBB1D : 0.0f, cfg.beamPathCount,
+        cfg.shortPhotonBeams, cfg.shortQueryBeams);
+    // R of the photon beam reaching x_i over segment i, of the query beam over segment i+1.
+    auto rPhoton = [&](int i) { return ub_mis_photon_ratio(c, p.pFwd(i), p.tFwd(i)); };
+    auto rQuery = [&](int i) { return ub_mis_query_ratio(c, p.pRev(i + 1), p.tRev(i + 1)); };
+    // Merging factor parts of x_i as each subpath sees it (R_in of its own arrival).
+    auto lightFactor = [&](int i) {
+        const MisVertex& x = p.v[size_t(i)];
+        return ub_mis_vertex_factor(c, x.medium, 0, 1, rPhoton(i), x.sinTheta);
+    };
+    auto cameraFactor = [&](int i) {
+        const MisVertex& x = p.v[size_t(i)];
+        return ub_mis_vertex_factor(c, x.medium, 0, 0, rQuery(i), x.sinTheta);
+    };
     const bool finite = p.lightIsFinite();
     const float pick = p.lightPickProb;
     const float emissionPdfW = p.emitPosPdf * p.emitDirPdfW;  // without pick probability
@@ -194,31 +260,49 @@ inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisCon
                                            p.lightIsDelta(), finite);
     for (int i = 1; i <= k - 1; ++i) {
         const MisVertex& x = p.v[i];
-        lp = ub_mis_at_hit_media(c, lp, p.dist[i], x.cosIn, i > 1 || finite, p.tFwd(i), p.tRev(i));
+        // R_out of x_{i-1}: the query beam over segment i.
+        lp = ub_mis_at_hit_volume(c, lp, p.dist[i], x.cosIn, i > 1 || finite, p.tFwd(i), p.tRev(i),
+                                  ub_mis_query_ratio(c, p.pRev(i), p.tRev(i)));
         L[i] = lp;
-        lp = ub_mis_scatter(c, lp, x.cosOut, x.pdfFwdW * x.cont, x.pdfRevW * x.cont, x.specular,
-                            merge(i));
+        ub_mis_factor f = lightFactor(i);
+        lp = ub_mis_scatter_volume(c, lp, x.cosOut, x.pdfFwdW * x.cont, x.pdfRevW * x.cont,
+                                   x.specular, f.now, f.out);
     }
     // Camera subpath: partials at x_{k-1}..x_1, and at x_0 when it hits the light.
     ub_mis_partials ep = ub_mis_init_camera(c, p.cameraPdfW);
     for (int i = k - 1; i >= 1; --i) {
         const MisVertex& x = p.v[i];
-        ep = ub_mis_at_hit_media(c, ep, p.dist[i + 1], x.cosOut, 1, p.tRev(i + 1), p.tFwd(i + 1));
+        // R_out of x_{i+1} on the camera side: the photon beam over segment i+1.
+        ep = ub_mis_at_hit_volume(c, ep, p.dist[i + 1], x.cosOut, 1, p.tRev(i + 1), p.tFwd(i + 1),
+                                  rPhoton(i + 1));
         E[i] = ep;
-        ep = ub_mis_scatter(c, ep, x.cosIn, x.pdfRevW * x.cont, x.pdfFwdW * x.cont, x.specular,
-                            merge(i));
+        ub_mis_factor f = cameraFactor(i);
+        ep = ub_mis_scatter_volume(c, ep, x.cosIn, x.pdfRevW * x.cont, x.pdfFwdW * x.cont,
+                                   x.specular, f.now, f.out);
     }
     // Lights at infinity are "hit" by escaping rays: no distance and no cosine.
-    E[0] = finite ? ub_mis_at_hit_media(c, ep, p.dist[1], p.cosLight, 1, p.tRev(1), p.tFwd(1))
-                  : ub_mis_at_hit_media(c, ep, 0.0f, 1.0f, 0, p.tRev(1), p.tFwd(1));
+    E[0] = finite ? ub_mis_at_hit_volume(c, ep, p.dist[1], p.cosLight, 1, p.tRev(1), p.tFwd(1),
+                                         rPhoton(1))
+                  : ub_mis_at_hit_volume(c, ep, 0.0f, 1.0f, 0, p.tRev(1), p.tFwd(1), rPhoton(1));
+    // Whole merging factor of a vertex for the connection weights, R_out being that of the
+    // connecting segment.
+    auto lightTotal = [&](int i) { return ub_mis_factor_total(c, lightFactor(i), rQuery(i)); };
+    auto cameraTotal = [&](int i) { return ub_mis_factor_total(c, cameraFactor(i), rPhoton(i)); };
 
     std::vector<MisTechnique> techs = validTechniques(p, cfg);
     for (MisTechnique& t : techs) {
         float w = 0;
         if (t.merge) {
             const MisVertex& x = p.v[t.index];
-            w = ub_mis_weight_merge_tech(c, L[t.index], E[t.index], x.pdfRevW * x.cont,
-                                         x.pdfFwdW * x.cont, merge(t.index), 0.0f);
+            if (t.tech < 0) {
+                w = ub_mis_weight_merge(c, L[t.index], E[t.index], x.pdfRevW * x.cont,
+                                        x.pdfFwdW * x.cont);
+            } else {
+                ub_mis_etas etas =
+                    ub_mis_volume_etas(c, rPhoton(t.index), rQuery(t.index), x.sinTheta);
+                w = ub_mis_weight_volume(c, L[t.index], E[t.index], x.pdfRevW * x.cont,
+                                         x.pdfFwdW * x.cont, etas, ub_uint(t.tech));
+            }
         } else if (t.index == 0) {
             w = ub_mis_weight_hit_light(c, E[0], p.directPdfA * pick, emissionPdfW * pick);
         } else if (t.index == 1 && k > 1) {
@@ -229,12 +313,12 @@ inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisCon
             float bsdfDirPdfW = p.lightIsDelta() ? 0.0f : x.pdfRevW * x.cont;
             w = ub_mis_weight_nee_media(c, E[1], bsdfDirPdfW, x.pdfFwdW * x.cont, pick, directPdfW,
                                         emissionPdfW, x.cosIn, cosAtLight, p.tRev(1), p.tFwd(1),
-                                        merge(1));
+                                        cameraTotal(1));
         } else if (t.index == k) {
             const MisVertex& y = p.v[k - 1];
             float cameraPdfA = p.cameraPdfW * y.cosOut * p.tRev(k) / sq(p.dist[k]);
             w = ub_mis_weight_light_trace(c, L[k - 1], cameraPdfA, y.pdfRevW * y.cont,
-                                          merge(k - 1));
+                                          lightTotal(k - 1));
         } else {
             int s = t.index;
             const MisVertex& y = p.v[s - 1];  // light vertex
@@ -243,7 +327,8 @@ inline std::vector<MisTechnique> recursiveWeights(const MisPath& p, const MisCon
             float cameraDirPdfA = z.pdfRevW * z.cont * y.cosOut * p.tRev(s) / d2;
             float lightDirPdfA = y.pdfFwdW * y.cont * z.cosIn * p.tFwd(s) / d2;
             w = ub_mis_weight_connect(c, L[s - 1], E[s], cameraDirPdfA, y.pdfRevW * y.cont,
-                                      lightDirPdfA, z.pdfFwdW * z.cont, merge(s - 1), merge(s));
+                                      lightDirPdfA, z.pdfFwdW * z.cont, lightTotal(s - 1),
+                                      cameraTotal(s));
         }
         t.weight = w;
     }
