@@ -34,6 +34,11 @@ struct RenderArgs {
     std::string mis = "power";
     std::optional<float> radius;
     std::optional<float> alpha;
+    /// UPBP (--radius-pp3d ... --alpha-bb1d, indexed by UB_TECH_*), --photon-beams,
+    /// --query-beams, --beam-paths.
+    std::optional<float> volumeRadius[4], volumeAlpha[4];
+    std::string photonBeams, queryBeams;  ///< "short" / "long", empty: default
+    std::optional<int> beamPaths;
     std::map<std::string, std::string> defines;  ///< -D name=value (Mitsuba XML parameters)
     std::string variancePath;                    ///< --variance: per-iteration variance EXR
 };

@@ -117,7 +117,13 @@ int run(int argc, char** argv) {
         ->type_name("SCENE");
     render
         ->add_option("-a,--algorithm", ra.algorithm,
-                     "Rendering algorithm: one of " + algorithmList() + " (default pt)")
+                     "Rendering algorithm: one of " + algorithmList() +
+                         " (default pt). UPBP: 'upbp' runs all six techniques, "
+                         "'upbp:T1+T2+...' any subset of bpt (connections, NEE, light "
+                         "tracing), surf (surface merging), pp3d, pb2d, bp2d, bb1d (volumetric "
+                         "points and beams), with MIS over exactly those; without bpt only "
+                         "paths the chosen estimators can merge are rendered (docs/"
+                         "algorithms.md). 'vcm' on a scene with media is upbp:bpt+surf")
         ->type_name("ALGO");
     CLI::Option* timeOpt =
         render
@@ -177,6 +183,56 @@ int run(int argc, char** argv) {
                          "Radius reduction exponent of progressive merging, in (0, 1]")
             ->check(positiveReal(1.0))
             ->type_name("A");
+
+    // UPBP's volumetric estimators.
+    const char* kTech[4] = {"pp3d", "pb2d", "bp2d", "bb1d"};
+    const char* kDim[4] = {"3", "2", "2", "1"};
+    const float kDefaultRadius[4] = {ub::RenderOptions().radiusPP3D, ub::RenderOptions().radiusPB2D,
+                                     ub::RenderOptions().radiusBP2D,
+                                     ub::RenderOptions().radiusBB1D};
+    float volumeRadius[4] = {0, 0, 0, 0}, volumeAlpha[4] = {0, 0, 0, 0};
+    CLI::Option* volumeRadiusOpt[4];
+    CLI::Option* volumeAlphaOpt[4];
+    for (int t = 0; t < 4; ++t) {
+        char def[32];
+        std::snprintf(def, sizeof(def), "%g", double(kDefaultRadius[t]));
+        volumeRadiusOpt[t] =
+            render
+                ->add_option(std::string("--radius-") + kTech[t], volumeRadius[t],
+                             std::string("upbp: initial ") + kTech[t] +
+                                 " radius as a fraction of the scene bounding sphere radius (> "
+                                 "0; default " +
+                                 def + ")")
+                ->check(positiveReal())
+                ->type_name("R");
+        volumeAlphaOpt[t] =
+            render
+                ->add_option(std::string("--alpha-") + kTech[t], volumeAlpha[t],
+                             std::string("upbp: ") + kTech[t] +
+                                 " radius reduction, r_i = r_1 i^((alpha-1)/" + kDim[t] +
+                                 "), in (0, 1] (default 0.75)")
+                ->check(positiveReal(1.0))
+                ->type_name("A");
+    }
+    render
+        ->add_option("--photon-beams", ra.photonBeams,
+                     "upbp: photon beams end at the sampled scattering distance (short, "
+                     "default) or run to the next surface (long)")
+        ->check(CLI::IsMember({"short", "long"}).description(""))
+        ->type_name("short|long");
+    render
+        ->add_option("--query-beams", ra.queryBeams,
+                     "upbp: query (camera) beams short or long (default long)")
+        ->check(CLI::IsMember({"short", "long"}).description(""))
+        ->type_name("short|long");
+    int beamPaths = 0;
+    CLI::Option* beamPathsOpt =
+        render
+            ->add_option("--beam-paths", beamPaths,
+                         "upbp: the first N light subpaths of an iteration emit photon beams "
+                         "(>= 1; default 1/16 of the light subpaths)")
+            ->check(positiveInteger())
+            ->type_name("N");
 
     std::vector<std::string> renderDefines, infoDefines;
     render
@@ -275,6 +331,11 @@ int run(int argc, char** argv) {
             }
             if (radiusOpt->count() > 0) ra.radius = radius;
             if (alphaOpt->count() > 0) ra.alpha = alpha;
+            for (int t = 0; t < 4; ++t) {
+                if (volumeRadiusOpt[t]->count() > 0) ra.volumeRadius[t] = volumeRadius[t];
+                if (volumeAlphaOpt[t]->count() > 0) ra.volumeAlpha[t] = volumeAlpha[t];
+            }
+            if (beamPathsOpt->count() > 0) ra.beamPaths = beamPaths;
             ra.defines = ub::app::parseDefines(renderDefines);
             return ub::app::runRender(ra);
         }

@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+
+#include "render/upbp_techniques.h"
 #include <cctype>
 #include <csignal>
 #include <cstdio>
@@ -80,9 +82,16 @@ std::string join(const std::vector<std::string>& v) {
 int runRender(const RenderArgs& args) {
     // ---- validate everything that does not need the scene ----
     const auto names = integratorNames();
-    if (std::find(names.begin(), names.end(), args.algorithm) == names.end())
+    if (isUpbpAlgorithm(args.algorithm)) {
+        try {
+            parseUpbpTechniques(args.algorithm);
+        } catch (const InputError& e) {
+            throw UsageError("-a/--algorithm: " + e.diagnostics()[0].message);
+        }
+    } else if (std::find(names.begin(), names.end(), args.algorithm) == names.end()) {
         throw UsageError("-a/--algorithm: unknown algorithm '" + args.algorithm +
-                         "' (valid: " + join(names) + ")");
+                         "' (valid: " + join(names) + ", upbp:T1+T2+...)");
+    }
     int width = 0, height = 0;
     if (!args.resolution.empty()) parseResolution(args.resolution, &width, &height);
     std::string exrPath = args.exrPath;
@@ -110,6 +119,17 @@ int runRender(const RenderArgs& args) {
     options.heuristic = args.mis == "balance" ? MisHeuristic::Balance : MisHeuristic::Power;
     if (args.radius) options.radius = *args.radius;
     if (args.alpha) options.alpha = *args.alpha;
+    float* radii[4] = {&options.radiusPP3D, &options.radiusPB2D, &options.radiusBP2D,
+                       &options.radiusBB1D};
+    float* alphas[4] = {&options.alphaPP3D, &options.alphaPB2D, &options.alphaBP2D,
+                        &options.alphaBB1D};
+    for (int t = 0; t < 4; ++t) {
+        if (args.volumeRadius[t]) *radii[t] = *args.volumeRadius[t];
+        if (args.volumeAlpha[t]) *alphas[t] = *args.volumeAlpha[t];
+    }
+    if (!args.photonBeams.empty()) options.shortPhotonBeams = args.photonBeams == "short";
+    if (!args.queryBeams.empty()) options.shortQueryBeams = args.queryBeams == "short";
+    if (args.beamPaths) options.beamPaths = *args.beamPaths;
     std::unique_ptr<Integrator> integrator = makeIntegrator(*scene, options);
 
     ProgressiveOptions prog;

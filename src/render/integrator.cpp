@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "render/pt.h"
+#include "render/upbp_techniques.h"
 #include "render/vcm.h"
 #include "render/vpt.h"
 
@@ -29,10 +30,11 @@ const IntegratorEntry kIntegrators[] = {
     {"bpt", makeVertexCM, false},      // bidirectional path tracing, recursive MIS (render/vcm.h)
     {"ppm", makeVertexCM, false},      // progressive photon mapping (render/vcm.h)
     {"bpm", makeVertexCM, false},      // bidirectional photon mapping (render/vcm.h)
-    {"vcm", makeVertexCM, false},      // vertex connection and merging (render/vcm.h)
+    {"vcm", makeVertexCM, true},       // vertex connection and merging; upbp:bpt+surf in media
     {"vpt", makeVolPathTracer, true},  // volumetric path tracing, NEE + MIS (render/vpt.h)
     {"vlt", makeVertexCM, true},       // volumetric light tracing (render/vcm.h, media)
     {"vbpt", makeVertexCM, true},      // volumetric bidirectional path tracing (render/vcm.h)
+    {"upbp", makeVertexCM, true},      // UPBP, all techniques or upbp:T1+T2 (render/vcm.h)
 };
 
 }  // namespace
@@ -45,7 +47,8 @@ std::vector<std::string> integratorNames() {
 
 std::unique_ptr<Integrator> makeIntegrator(const Scene& scene, const RenderOptions& options) {
     for (const auto& e : kIntegrators)
-        if (options.algorithm == e.name) {
+        if (options.algorithm == e.name ||
+            (std::string(e.name) == "upbp" && isUpbpAlgorithm(options.algorithm))) {
             if (!e.handlesMedia && scene.hasMedia()) {
                 std::string media;
                 for (const auto& m : kIntegrators)

@@ -29,6 +29,16 @@ struct RenderOptions {
     float radius = 0.003f;
     bool radiusIsRelative = true;
     float alpha = 0.75f;  ///< progressive radius reduction exponent
+    /// UPBP's volumetric estimators (render/upbp_techniques.h, docs/algorithms.md): initial
+    /// radii (fractions of the scene bounding-sphere radius if radiusIsRelative) and
+    /// reduction exponents, r_i = r_1 i^((alpha - 1) / k) for a k-dimensional kernel.
+    float radiusPP3D = 0.01f, radiusPB2D = 0.005f, radiusBP2D = 0.005f, radiusBB1D = 0.005f;
+    float alphaPP3D = 0.75f, alphaPB2D = 0.75f, alphaBP2D = 0.75f, alphaBB1D = 0.75f;
+    bool shortPhotonBeams = true;  ///< photon beams end at the sampled distance (else: surface)
+    bool shortQueryBeams = false;  ///< query beams end at the sampled distance (else: surface)
+    /// Light subpaths per iteration that emit photon beams (N_B, the first ones by index);
+    /// 0: N_L / 16, at least 1 (SmallUPBP's -pbc).
+    int beamPaths = 0;
 };
 
 class Integrator {

@@ -40,6 +40,8 @@ struct LightVertex {
     float dVM;               ///< MIS partial [TR (33)/(35)]
     uint32_t flags;          ///< kLightVertex* bits
     Vec2 uv;                 ///< surface uv: Scene::setupBsdf looks the textures up here
+    float rInL;              ///< medium vertex: R of the photon beam that reached it (UPBP MIS)
+    uint32_t pad[3];
 
     bool inMedium() const { return (flags & kLightVertexInMedium) != 0; }
     /// Medium of a medium vertex (index into Scene::media).
@@ -51,7 +53,8 @@ struct LightVertex {
 static_assert(std::is_standard_layout<LightVertex>::value, "LightVertex must be flat");
 static_assert(std::is_trivially_copyable<LightVertex>::value, "LightVertex must be flat");
 static_assert(sizeof(Vec3) == 12, "Vec3 must be three packed floats");
-static_assert(sizeof(LightVertex) == 96, "LightVertex layout changed");
+static_assert(sizeof(LightVertex) == 112, "LightVertex layout changed");
+static_assert(offsetof(LightVertex, rInL) == 96, "LightVertex layout changed");
 static_assert(offsetof(LightVertex, throughput) == 16, "LightVertex layout changed");
 static_assert(offsetof(LightVertex, dirFix) == 32, "LightVertex layout changed");
 static_assert(offsetof(LightVertex, geoNormal) == 48, "LightVertex layout changed");

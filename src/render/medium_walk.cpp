@@ -8,11 +8,19 @@
 namespace ub {
 
 ChainVertex sampleChainVertex(const Scene& scene, const MediumTrace& trace, const Vec3& dir,
-                              bool prevInMedium, Rng& rng) {
+                              bool prevInMedium, Rng& rng, ChainVisit* visit) {
     ChainVertex v;
     float travelled = 0.0f;
+    if (visit) visit->count = 0;
     for (int k = 0; k < trace.count; ++k) {
         const MediumTraceSegment& seg = trace.segments[k];
+        if (visit) {
+            visit->count = k + 1;
+            visit->length[k] = seg.length;
+            visit->passProb[k] = 1.0f;
+            visit->stopRevStartL[k] = 0.0f;
+            visit->transmittance[k] = Rgb(1.0f);
+        }
         if (seg.mediumId < 0) {
             // Vacuum: passed with probability 1; a chain cannot start at a medium vertex here.
             if (k == 0 && prevInMedium) v.distPdfRev = 0.0f;
@@ -32,6 +40,13 @@ ChainVertex sampleChainVertex(const Scene& scene, const MediumTrace& trace, cons
         v.distPdfRev *=
             (k == 0 && prevInMedium) ? ff.segment.pdfScatterRevL() : ff.segment.probPass();
         v.distPdfFwd *= ff.pdf;
+        v.passProb *= ff.segment.probPass();
+        if (visit) {
+            visit->length[k] = ff.scattered ? ff.t : seg.length;
+            visit->passProb[k] = ff.segment.probPass();
+            visit->stopRevStartL[k] = ff.segment.pdfScatterRevL();
+            visit->transmittance[k] = ff.segment.transmittance;
+        }
         if (ff.scattered) {
             v.scattered = true;
             v.pos = seg.origin + dir * ff.t;

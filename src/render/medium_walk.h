@@ -42,14 +42,29 @@ struct ChainVertex {
     Rgb emission{0.0f};
     float distPdfFwd = 1.0f;  ///< free-flight pdf of reaching the vertex (see the banner)
     float distPdfRev = 1.0f;  ///< free-flight pdf of the reverse direction
+    /// Probability of passing the chain up to the vertex without stopping (either direction:
+    /// the product of the pass probabilities of the visited parts of the segments; equals
+    /// distPdfFwd when the chain is passed to its real hit). Beam estimators' cover.
+    float passProb = 1.0f;
+};
+
+/// What free-flight sampling saw of each segment it visited (for the beams of UPBP): the
+/// visited part of segment k is [0, length[k]) (the whole segment if it was passed).
+struct ChainVisit {
+    int count = 0;  ///< segments visited: 0 .. count-1 (the last holds the vertex if scattered)
+    float length[MediumTrace::kMaxSegments];
+    float passProb[MediumTrace::kMaxSegments];      ///< probPass of the visited part
+    float stopRevStartL[MediumTrace::kMaxSegments];  ///< pdfScatterRevL of the visited part
+    Rgb transmittance[MediumTrace::kMaxSegments];   ///< T of the visited part
 };
 
 /// Samples the vertex that follows a chain traced along unit direction dir. prevInMedium:
 /// the chain starts at a medium vertex (its reverse pdf then stops there). Draws two random
 /// numbers per medium segment visited. A black weight means the path ends (a pdf
 /// underflowed, or the vertex does not scatter).
+/// visit (optional) receives what was seen of each visited segment.
 ChainVertex sampleChainVertex(const Scene& scene, const MediumTrace& trace, const Vec3& dir,
-                              bool prevInMedium, Rng& rng);
+                              bool prevInMedium, Rng& rng, ChainVisit* visit = nullptr);
 
 /// Free-flight pdf of the connecting chain a -> b (Scene::shadowTransmittance from a)
 /// in the direction a -> b: stopping at b if b is a medium vertex, passing otherwise.

@@ -10,6 +10,8 @@
 
 #include "core/error.h"
 #include "core/rng.h"
+#include "estimators/volume_estimate.h"
+#include "render/chain_beams.h"
 #include "render/medium_walk.h"
 #include "render/vertex_scatter.h"
 
@@ -23,8 +25,9 @@ VertexCM::Algorithm parseAlgorithm(const std::string& name) {
     if (name == "ppm") return VertexCM::Algorithm::Ppm;
     if (name == "bpm") return VertexCM::Algorithm::Bpm;
     if (name == "vcm") return VertexCM::Algorithm::Vcm;
+    if (isUpbpAlgorithm(name)) return VertexCM::Algorithm::Upbp;
     throw InputError("", "VertexCM: unknown algorithm '" + name +
-                             "' (valid: lt, bpt, ppm, bpm, vcm, vlt, vbpt)");
+                             "' (valid: lt, bpt, ppm, bpm, vcm, vlt, vbpt, upbp, upbp:...)");
 }
 
 /// The media where subpaths of `light` start: at a point just off its emitting side (area
@@ -69,7 +72,39 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
         case Algorithm::Vcm:
             useVC_ = true;
             useVM_ = true;
+            // vcm on a scene with media is upbp:bpt+surf (connections and surface merging
+            // through the media).
+            if (scene.hasMedia()) {
+                algorithm_ = Algorithm::Upbp;
+                upbp_.bpt = upbp_.surf = true;
+            }
             break;
+        case Algorithm::Upbp:
+            upbp_ = parseUpbpTechniques(options.algorithm);
+            useVC_ = upbp_.bpt;
+            useVM_ = upbp_.surf;
+            break;
+    }
+    if (algorithm_ == Algorithm::Upbp) {
+        const float radii[4] = {options.radiusPP3D, options.radiusPB2D, options.radiusBP2D,
+                                options.radiusBB1D};
+        const float alphas[4] = {options.alphaPP3D, options.alphaPB2D, options.alphaBP2D,
+                                 options.alphaBB1D};
+        const char* names[4] = {"pp3d", "pb2d", "bp2d", "bb1d"};
+        for (int t = 0; t < 4; ++t) {
+            if (!(radii[t] > 0.0f) || !std::isfinite(radii[t]))
+                throw InputError(scene.sourceFile, std::string(names[t]) +
+                                                       " radius must be a positive number, got " +
+                                                       std::to_string(radii[t]));
+            if (!(alphas[t] > 0.0f && alphas[t] <= 1.0f))
+                throw InputError(scene.sourceFile,
+                                 std::string(names[t]) +
+                                     " radius reduction alpha must be in (0, 1], got " +
+                                     std::to_string(alphas[t]));
+        }
+        if (options.beamPaths < 0)
+            throw InputError(scene.sourceFile, "beam paths must be >= 0 (0: N_L / 16), got " +
+                                                   std::to_string(options.beamPaths));
     }
     if ((useVC_ || lightTraceOnly_) && !scene.camera.isPinhole())
         throw InputError(scene.sourceFile,
@@ -87,7 +122,8 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
                                                    std::to_string(options.alpha));
     }
     nullNotCounted_ = scene.settings.depthCounting == DepthCounting::kNonNullVertices;
-    const bool volumetric = options.algorithm == "vlt" || options.algorithm == "vbpt";
+    const bool volumetric = options.algorithm == "vlt" || options.algorithm == "vbpt" ||
+                            algorithm_ == Algorithm::Upbp;
     useMedia_ = volumetric && scene.hasMedia();
     if (useMedia_) {
         for (size_t m = 0; m < scene.media.size(); ++m)
@@ -117,6 +153,19 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
     splats_.reset(scene.camera.width(), scene.camera.height());
 }
 
+float VertexCM::volumeRadiusAt(int tech, int iteration) const {
+    // r_i = r_1 i^((alpha - 1) / k) for a k-dimensional kernel (Knaus & Zwicker 2011, eq. 19
+    // with the kernel's dimension; UPBP Sec. 6): k = 3 for pp3d, 2 for pb2d/bp2d, 1 for bb1d.
+    const float r1[4] = {options_.radiusPP3D, options_.radiusPB2D, options_.radiusBP2D,
+                         options_.radiusBB1D};
+    const float alpha[4] = {options_.alphaPP3D, options_.alphaPB2D, options_.alphaBP2D,
+                            options_.alphaBB1D};
+    const float dims[4] = {3.0f, 2.0f, 2.0f, 1.0f};
+    const float scale = options_.radiusIsRelative ? scene_.sceneSphere.radius : 1.0f;
+    float r = r1[tech] * scale * std::pow(float(iteration + 1), (alpha[tech] - 1.0f) / dims[tech]);
+    return std::max(r, 1e-7f);
+}
+
 float VertexCM::radiusAt(int iteration) const {
     // r_i = r_1 i^((alpha - 1) / 2), i = iteration + 1 (Knaus & Zwicker 2011, eq. 19);
     // clamped only for numerical safety after very many iterations.
@@ -135,6 +184,16 @@ void VertexCM::renderIteration(int iteration, Image& out) {
     mis_ = ub_mis_make_constants(
         radius, lightSubPathCount_, useVC_, useVM_,
         options_.heuristic == MisHeuristic::Balance ? UB_MIS_BALANCE : UB_MIS_POWER);
+    if (algorithm_ == Algorithm::Upbp) {
+        const bool on[4] = {upbp_.pp3d, upbp_.pb2d, upbp_.bp2d, upbp_.bb1d};
+        for (int t = 0; t < 4; ++t) volumeRadius_[t] = on[t] ? volumeRadiusAt(t, iteration) : 0.0f;
+        beamPaths_ = options_.beamPaths > 0
+                         ? int(std::min<size_t>(size_t(options_.beamPaths), pathCount))
+                         : int(std::max<size_t>(pathCount / 16, 1));
+        mis_ = ub_mis_enable_volume(mis_, volumeRadius_[0], volumeRadius_[1], volumeRadius_[2],
+                                    volumeRadius_[3], float(beamPaths_), options_.shortPhotonBeams,
+                                    options_.shortQueryBeams);
+    }
     // Merging normalisation: density estimate with a disk kernel of radius r over N_L paths.
     vmNormalization_ = 1.0f / (kPi * radius * radius * lightSubPathCount_);
 
@@ -142,24 +201,25 @@ void VertexCM::renderIteration(int iteration, Image& out) {
     // task in index order, so vertices and splats do not depend on the thread count.
     splats_.clear();
     const int chunkCount = SplatBuffer::kChunkCount;
-    std::vector<std::vector<LightVertex>>& chunkVertices = chunkVertices_;
-    std::vector<std::vector<uint32_t>>& chunkEnds = chunkEnds_;
-    chunkVertices.resize(static_cast<size_t>(chunkCount));
-    chunkEnds.resize(static_cast<size_t>(chunkCount));
+    lightChunks_.resize(static_cast<size_t>(chunkCount));
     tbb::parallel_for(0, chunkCount, [&](int c) {
         auto range = SplatBuffer::chunkRange(c, pathCount);
         traceLightPaths(iteration, range.first, range.second, splats_.chunk(c),
-                        chunkVertices[size_t(c)], chunkEnds[size_t(c)]);
+                        lightChunks_[size_t(c)]);
     });
     lightVertices_.clear();
+    photonPoints_.clear();
+    photonBeams_.clear();
     pathEnds_.assign(pathCount, 0);
     for (int c = 0; c < chunkCount; ++c) {
         auto range = SplatBuffer::chunkRange(c, pathCount);
+        const LightChunk& chunk = lightChunks_[size_t(c)];
         uint32_t offset = uint32_t(lightVertices_.size());
         for (size_t i = range.first; i < range.second; ++i)
-            pathEnds_[i] = offset + chunkEnds[size_t(c)][i - range.first];
-        lightVertices_.insert(lightVertices_.end(), chunkVertices[size_t(c)].begin(),
-                              chunkVertices[size_t(c)].end());
+            pathEnds_[i] = offset + chunk.pathEnds[i - range.first];
+        lightVertices_.insert(lightVertices_.end(), chunk.vertices.begin(), chunk.vertices.end());
+        photonPoints_.insert(photonPoints_.end(), chunk.photons.begin(), chunk.photons.end());
+        photonBeams_.insert(photonBeams_.end(), chunk.beams.begin(), chunk.beams.end());
     }
 
     // (2) Hashed grid over the light vertices for merging.
@@ -167,16 +227,47 @@ void VertexCM::renderIteration(int iteration, Image& out) {
 
     // (3) Camera pass: one subpath per pixel (lt traces only the primary ray, for
     // directly visible emitters). Each pixel has its own random stream.
+    cameraRows_.resize(size_t(height));
     tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
-        for (int y = r.begin(); y != r.end(); ++y)
-            for (int x = 0; x < width; ++x) out.at(x, y) = traceCameraPath(x, y, iteration);
+        for (int y = r.begin(); y != r.end(); ++y) {
+            CameraRecords& rec = cameraRows_[size_t(y)];
+            rec.points.clear();
+            rec.beams.clear();
+            for (int x = 0; x < width; ++x) out.at(x, y) = traceCameraPath(x, y, iteration, &rec);
+        }
     });
 
     // (4) Light-tracing splats, added in a fixed order.
     splats_.resolve(out);
+
+    // (5) UPBP estimate pass: the volumetric estimators over the recorded queries, added to
+    // their pixels in query order (estimators/volume_estimate.h).
+    if (upbp_.anyVolume()) {
+        queryPoints_.clear();
+        queryBeams_.clear();
+        for (const CameraRecords& rec : cameraRows_) {
+            queryPoints_.insert(queryPoints_.end(), rec.points.begin(), rec.points.end());
+            queryBeams_.insert(queryBeams_.end(), rec.beams.begin(), rec.beams.end());
+        }
+        VolumeEstimateInput in;
+        in.scene = &scene_;
+        in.mis = mis_;
+        in.techniques = upbp_;
+        for (int t = 0; t < 4; ++t) in.radius[t] = volumeRadius_[t];
+        in.lightPathCount = lightSubPathCount_;
+        in.beamPathCount = float(beamPaths_);
+        in.minLength = options_.minPathLength;
+        in.maxLength = options_.maxPathLength;
+        in.photonPoints = &photonPoints_;
+        in.photonBeams = &photonBeams_;
+        in.queryPoints = &queryPoints_;
+        in.queryBeams = &queryBeams_;
+        estimateVolume(in, &out, nullptr);
+    }
 }
 
-bool VertexCM::traceToVertex(Rng& rng, SubPath& state, PathVertex* v, bool* escaped) const {
+bool VertexCM::traceToVertex(Rng& rng, SubPath& state, PathVertex* v, bool* escaped,
+                             std::vector<ub_beam>* beams, uint32_t tag) const {
     *escaped = false;
     if (!useMedia_) {
         v->inMedium = false;
@@ -193,11 +284,24 @@ bool VertexCM::traceToVertex(Rng& rng, SubPath& state, PathVertex* v, bool* esca
     MediumTrace trace;
     scene_.traceMedia(state.ray, &state.stack, &trace, &v->hit);
     if (trace.overflow) return false;
-    const ChainVertex cv =
-        sampleChainVertex(scene_, trace, state.ray.dir, state.rayFromMedium, rng);
+    ChainVisit visit;
+    const ChainVertex cv = sampleChainVertex(scene_, trace, state.ray.dir, state.rayFromMedium,
+                                             rng, beams ? &visit : nullptr);
+    if (beams) {
+        ChainBeamSource src;
+        src.throughput = state.throughput;
+        src.mis = state.mis;
+        src.pathLength = uint32_t(state.pathLength);
+        src.fromMedium = state.rayFromMedium;
+        src.applyDistSqr = state.pathLength > 1 || state.isFiniteLight;
+        src.shortBeams = state.fromLight ? options_.shortPhotonBeams : options_.shortQueryBeams;
+        src.tag = tag;
+        appendChainBeams(scene_, trace, state.ray.dir, visit, cv, src, beams);
+    }
     state.throughput *= cv.weight;
     v->distPdfFwd = cv.distPdfFwd;
     v->distPdfRev = cv.distPdfRev;
+    v->passProb = cv.passProb;
     v->mediumEmission = cv.emission;
     if (isBlack(state.throughput) || !isFinite(state.throughput)) return false;
     v->dist = cv.distance;
@@ -258,9 +362,13 @@ bool VertexCM::sampleScattering(Rng& rng, const VertexScatter& scatter, const Pa
     dirPdfW *= contProb;
     revPdfW *= contProb;
 
-    // MIS partials after scattering [TR (34)-(36)], or [TR (53)-(55)] for specular events.
-    state.mis = ub_mis_scatter(mis_, state.mis, cosThetaOut, dirPdfW, revPdfW, specular,
-                               ub_mis_merge_factor(mis_, v.inMedium, scatter.isDelta()));
+    // MIS partials after scattering [TR (34)-(36)], or [TR (53)-(55)] for specular events,
+    // with the merging factor of this vertex (ub_mis_volume.h: F0 now, F1 deferred).
+    const ub_mis_factor factor =
+        ub_mis_vertex_factor(mis_, v.inMedium, scatter.isDelta(), state.fromLight,
+                             ratioIn(state, v), length(cross(state.ray.dir, dirGen)));
+    state.mis = ub_mis_scatter_volume(mis_, state.mis, cosThetaOut, dirPdfW, revPdfW, specular,
+                                      factor.now, factor.out);
     state.specularPath = state.specularPath && specular;
     state.throughput *= f * (cosThetaOut / dirPdfW);
     if (isBlack(state.throughput) || !isFinite(state.throughput)) return false;
@@ -277,6 +385,23 @@ bool VertexCM::sampleScattering(Rng& rng, const VertexScatter& scatter, const Pa
     state.rayFromMedium = v.inMedium;
     if (nullEvent) --state.pathLength;  // not a vertex of the path's length
     return true;
+}
+
+float VertexCM::ratioIn(const SubPath& state, const PathVertex& v) const {
+    return state.fromLight ? ub_mis_photon_ratio(mis_, v.passProb, v.distPdfFwd)
+                           : ub_mis_query_ratio(mis_, v.passProb, v.distPdfFwd);
+}
+
+float VertexCM::ratioOut(const SubPath& state, const PathVertex& v) const {
+    if (state.mis.dOut == 0.0f) return 0.0f;
+    return state.fromLight ? ub_mis_query_ratio(mis_, v.passProb, v.distPdfRev)
+                           : ub_mis_photon_ratio(mis_, v.passProb, v.distPdfRev);
+}
+
+ub_mis_partials VertexCM::misAtHit(const SubPath& state, const PathVertex& v, float cosFix,
+                                   int applyDistSqr) const {
+    return ub_mis_at_hit_volume(mis_, state.mis, v.dist, cosFix, applyDistSqr, v.distPdfFwd,
+                                v.distPdfRev, ratioOut(state, v));
 }
 
 float vcmContinuationProb(const Bsdf& bsdf) {

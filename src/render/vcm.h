@@ -56,10 +56,12 @@
 #include <vector>
 
 #include "estimators/hash_grid.h"
-#include "kernels/shared/ub_mis.h"
+#include "kernels/shared/ub_mis_volume.h"
+#include "kernels/shared/ub_upbp_records.h"
 #include "render/film.h"
 #include "render/integrator.h"
 #include "render/light_vertex.h"
+#include "render/upbp_techniques.h"
 #include "scene/bsdf.h"
 #include "scene/medium_stack.h"
 
@@ -71,7 +73,7 @@ struct ChainVertex;
 
 class VertexCM : public Integrator {
   public:
-    enum class Algorithm { LightTrace, Bpt, Ppm, Bpm, Vcm };
+    enum class Algorithm { LightTrace, Bpt, Ppm, Bpm, Vcm, Upbp };
 
     /// Reads options.algorithm (lt, bpt, ppm, bpm, vcm, vlt, vbpt). Throws InputError for
     /// another name, a thin-lens camera with lt/bpt/vcm/vlt/vbpt, a bad radius/alpha, or a
@@ -87,6 +89,17 @@ class VertexCM : public Integrator {
     float radiusAt(int iteration) const;
     /// Light vertices stored by the last iteration (for tests).
     const std::vector<LightVertex>& lightVertices() const { return lightVertices_; }
+    /// UPBP: the techniques run (all false for the other algorithms).
+    const UpbpTechniques& upbpTechniques() const { return upbp_; }
+    /// UPBP records of the last iteration (for tests and the summary).
+    const std::vector<ub_photon_point>& photonPoints() const { return photonPoints_; }
+    const std::vector<ub_beam>& photonBeams() const { return photonBeams_; }
+    const std::vector<ub_query_point>& queryPoints() const { return queryPoints_; }
+    const std::vector<ub_beam>& queryBeams() const { return queryBeams_; }
+    /// UPBP: radius of a volumetric technique (UB_TECH_*) in iteration `iteration` (0-based).
+    float volumeRadiusAt(int tech, int iteration) const;
+    /// Light subpaths per iteration that emit photon beams.
+    int beamPathCount() const { return beamPaths_; }
 
   private:
     /// State of a subpath being traced (SmallVCM's SubPathState).
@@ -97,6 +110,7 @@ class VertexCM : public Integrator {
         bool isFiniteLight = true;
         bool specularPath = true;    ///< every scattering so far was specular (camera side)
         bool rayFromMedium = false;  ///< the ray starts at a medium vertex
+        bool fromLight = false;      ///< a light subpath (else camera)
         ub_mis_partials mis{};       ///< dVCM, dVC, dVM
         MediumStack stack;           ///< media at the ray origin, for its direction (media only)
     };
@@ -111,6 +125,8 @@ class VertexCM : public Integrator {
         /// Free-flight pdfs of the segment in the tracing and the reverse direction (1 without
         /// media; render/medium_walk.h).
         float distPdfFwd = 1.0f, distPdfRev = 1.0f;
+        /// Probability of passing the chain to the vertex (render/medium_walk.h).
+        float passProb = 1.0f;
         Rgb mediumEmission{0.0f};  ///< collision estimate of medium emission (camera side)
         Vec3 geoNormal() const { return inMedium ? Vec3(0.0f) : hit.geoNormal; }
     };
@@ -118,7 +134,17 @@ class VertexCM : public Integrator {
     // Shared (vcm.cpp): traces state.ray to the next vertex (surface hit or, with media, a
     // medium vertex), updating throughput and medium stack. False if the ray escaped (then
     // *v holds the distance pdfs of the escape) or the path must end (black throughput).
-    bool traceToVertex(Rng& rng, SubPath& state, PathVertex* v, bool* escaped) const;
+    // beams: UPBP, append the beam pieces of the traced chain (photon beams for light
+    // subpaths, query beams for camera subpaths; `tag` goes to ub_beam::pixel).
+    bool traceToVertex(Rng& rng, SubPath& state, PathVertex* v, bool* escaped,
+                       std::vector<ub_beam>* beams = nullptr, uint32_t tag = 0) const;
+    /// R of the segment that reached v, of this subpath's beam kind (ub_mis_volume.h).
+    float ratioIn(const SubPath& state, const PathVertex& v) const;
+    /// R_out of the segment that reached v, for the previous vertex (the other kind).
+    float ratioOut(const SubPath& state, const PathVertex& v) const;
+    /// Completes the partials at v (ub_mis_at_hit_volume with the segment's pdfs).
+    ub_mis_partials misAtHit(const SubPath& state, const PathVertex& v, float cosFix,
+                             int applyDistSqr) const;
     /// Sets up the scattering function at v (dirFix = -state.ray.dir); false if degenerate.
     bool setupScatter(const PathVertex& v, const SubPath& state, bool fromLight,
                       VertexScatter* scatter) const;
@@ -127,15 +153,28 @@ class VertexCM : public Integrator {
     bool stackTowards(const PathVertex& v, const SubPath& state, const Vec3& dir,
                       MediumStack* out) const;
 
+    /// What the light pass of one chunk of light subpaths stores.
+    struct LightChunk {
+        std::vector<LightVertex> vertices;
+        std::vector<uint32_t> pathEnds;
+        std::vector<ub_photon_point> photons;  ///< UPBP photon points
+        std::vector<ub_beam> beams;            ///< UPBP photon beams
+    };
+    /// What the camera pass of one image row records for the estimate pass (UPBP).
+    struct CameraRecords {
+        std::vector<ub_query_point> points;
+        std::vector<ub_beam> beams;
+    };
+
     // Light pass (vcm_light.cpp): traces light subpaths [begin, end) of an iteration.
     void traceLightPaths(int iteration, size_t begin, size_t end, SplatBuffer::Chunk& splats,
-                         std::vector<LightVertex>& vertices, std::vector<uint32_t>& pathEnds) const;
+                         LightChunk& out) const;
     bool startLightPath(Rng& rng, SubPath& state) const;
     void connectToCamera(const SubPath& state, const PathVertex& v, const VertexScatter& scatter,
                          SplatBuffer::Chunk& splats) const;
 
     // Camera pass (vcm_camera.cpp).
-    Rgb traceCameraPath(int x, int y, int iteration) const;
+    Rgb traceCameraPath(int x, int y, int iteration, CameraRecords* records) const;
     Rgb lightHitRadiance(const Light& light, const SubPath& state, const Vec3& rayDir,
                          const Vec3& hitPos, const Vec3& hitNormal) const;
     Rgb directIllumination(Rng& rng, const SubPath& state, const PathVertex& v,
@@ -156,7 +195,9 @@ class VertexCM : public Integrator {
     RenderOptions options_;
     Algorithm algorithm_;
     bool useVC_ = false, useVM_ = false, lightTraceOnly_ = false, ppm_ = false;
-    bool useMedia_ = false;  ///< vlt/vbpt on a scene with media
+    bool useMedia_ = false;  ///< vlt/vbpt/upbp on a scene with media
+    UpbpTechniques upbp_;    ///< UPBP techniques (Algorithm::Upbp)
+    int beamPaths_ = 0;      ///< N_B
     /// DepthCounting::kNonNullVertices: null-lobe vertices do not count towards the length.
     bool nullNotCounted_ = false;
     std::vector<MediumStack> lightStacks_;  ///< media where each light's subpaths start
@@ -170,8 +211,13 @@ class VertexCM : public Integrator {
     std::vector<LightVertex> lightVertices_;
     std::vector<uint32_t> pathEnds_;  ///< light subpath i owns [pathEnds_[i-1], pathEnds_[i])
     HashGrid grid_;
-    std::vector<std::vector<LightVertex>> chunkVertices_;  ///< light pass output per chunk
-    std::vector<std::vector<uint32_t>> chunkEnds_;
+    std::vector<LightChunk> lightChunks_;        ///< light pass output per chunk
+    std::vector<CameraRecords> cameraRows_;      ///< camera pass records per image row
+    std::vector<ub_photon_point> photonPoints_;  ///< UPBP records of the iteration
+    std::vector<ub_beam> photonBeams_;
+    std::vector<ub_query_point> queryPoints_;
+    std::vector<ub_beam> queryBeams_;
+    float volumeRadius_[4] = {0, 0, 0, 0};  ///< this iteration's radii (UB_TECH_*), 0: off
     SplatBuffer splats_;
 };
 

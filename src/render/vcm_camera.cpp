@@ -14,7 +14,7 @@ namespace {
 constexpr uint64_t kCameraSalt = 2;
 }  // namespace
 
-Rgb VertexCM::traceCameraPath(int x, int y, int iteration) const {
+Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* records) const {
     const Camera& camera = scene_.camera;
     const int maxLength = options_.maxPathLength, minLength = options_.minPathLength;
     const size_t pixelIndex = size_t(y) * size_t(camera.width()) + size_t(x);
@@ -37,13 +37,15 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration) const {
         PathVertex v;
         bool escaped = false;
         const Rgb throughputBefore = state.throughput;
-        if (!traceToVertex(rng, state, &v, &escaped)) {
+        // UPBP query beams along this chain: their points merge with light lengths >= 1.
+        const bool beamsHere = upbp_.queryBeams() && state.pathLength + 1 <= maxLength;
+        if (!traceToVertex(rng, state, &v, &escaped, beamsHere ? &records->beams : nullptr,
+                           uint32_t(pixelIndex))) {
             // Environment: no distance or cosine conversion for lights at infinity [TR 5.1];
             // with media, the free-flight pdfs of the escaping chain (ub_mis.h, MEDIA).
             if (escaped && scene_.backgroundLightId >= 0 && state.pathLength >= minLength) {
                 SubPath atLight = state;
-                atLight.mis =
-                    ub_mis_at_hit_media(mis_, state.mis, 0.0f, 1.0f, 0, v.distPdfFwd, v.distPdfRev);
+                atLight.mis = misAtHit(state, v, 1.0f, 0);
                 color += state.throughput *
                          lightHitRadiance(scene_.lights[size_t(scene_.backgroundLightId)], atLight,
                                           state.ray.dir, state.ray.org, Vec3(0.0f));
@@ -57,9 +59,7 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration) const {
         // Emitter hit: the light endpoint's cosine is the geometric one, as in emission.
         if (!v.inMedium && v.hit.lightId >= 0 && state.pathLength >= minLength) {
             SubPath atLight = state;
-            atLight.mis = ub_mis_at_hit_media(mis_, state.mis, v.dist,
-                                              std::fabs(dot(v.hit.geoNormal, state.ray.dir)), 1,
-                                              v.distPdfFwd, v.distPdfRev);
+            atLight.mis = misAtHit(state, v, std::fabs(dot(v.hit.geoNormal, state.ray.dir)), 1);
             color +=
                 state.throughput * lightHitRadiance(scene_.lights[size_t(v.hit.lightId)], atLight,
                                                     state.ray.dir, v.hit.pos, v.hit.geoNormal);
@@ -74,8 +74,25 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration) const {
         if (!setupScatter(v, state, /*fromLight=*/false, &scatter)) break;
         if (atLimit && !scatter.hasNullLobe()) break;
         // Complete the partials at this vertex [TR (31)-(36)] (ub_mis.h, MEDIA).
-        state.mis = ub_mis_at_hit_media(mis_, state.mis, v.dist, scatter.cosThetaFix(), 1,
-                                        v.distPdfFwd, v.distPdfRev);
+        state.mis = misAtHit(state, v, scatter.cosThetaFix(), 1);
+
+        // UPBP query point: merged with photon points (pp3d) and photon beams (bp2d).
+        if (v.inMedium && upbp_.queryPoints() && !atLimit) {
+            ub_query_point q{};
+            for (int a = 0; a < 3; ++a) {
+                q.pos[a] = v.pos[a];
+                q.throughput[a] = state.throughput[a];
+                q.dirFix[a] = -state.ray.dir[a];
+            }
+            q.pathLength = uint32_t(state.pathLength);
+            q.mediumId = uint32_t(v.mediumId);
+            q.rQueryL = ratioIn(state, v);
+            q.dVCM = state.mis.dVCM;
+            q.dVM = state.mis.dVM;
+            q.contProb = scatter.continuationProb();
+            q.pixel = uint32_t(pixelIndex);
+            records->points.push_back(q);
+        }
 
         if (!atLimit && !scatter.isDelta() && useVC_) {
             // Next-event estimation: a path of pathLength + 1 segments.
@@ -91,7 +108,7 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration) const {
                 color += state.throughput * lv.throughput * connectVertices(lv, state, v, scatter);
             }
         }
-        if (!atLimit && !scatter.isDelta() && useVM_) {
+        if (!atLimit && !scatter.isDelta() && useVM_ && !v.inMedium) {
             color += state.throughput * mergeVertices(state, v.hit, scatter.bsdf());
             if (ppm_) break;  // PPM merges at the first non-specular camera vertex only
         }
@@ -162,10 +179,16 @@ Rgb VertexCM::directIllumination(Rng& rng, const SubPath& state, const PathVerte
             ? scene_.shadowTransmittance(v.pos, v.geoNormal(), stack, lightPos, lightOffset)
             : scene_.shadowTransmittanceToInfinity(v.pos, v.geoNormal(), stack, dirToLight);
     if (sh.blocked || isBlack(sh.transmittance)) return Rgb(0.0f);
-    const float weight = ub_mis_weight_nee_media(
-        mis_, state.mis, bsdfDirPdfW, bsdfRevPdfW, lightPickProb_, directPdfW, emissionPdfW,
-        cosToLight, cosAtLight, sh.probPass, v.inMedium ? sh.pdfScatterRevL : sh.probPass,
-        ub_mis_merge_factor(mis_, v.inMedium, 0));
+    // Merging factor of v, its R_out being the photon beam along the shadow chain.
+    const float distPdfToZ = v.inMedium ? sh.pdfScatterRevL : sh.probPass;
+    const ub_mis_factor factor = ub_mis_vertex_factor(mis_, v.inMedium, 0, 0, ratioIn(state, v),
+                                                      length(cross(state.ray.dir, dirToLight)));
+    const float merge =
+        ub_mis_factor_total(mis_, factor, ub_mis_photon_ratio(mis_, sh.probPass, distPdfToZ));
+    const float weight = ub_mis_weight_nee_media(mis_, state.mis, bsdfDirPdfW, bsdfRevPdfW,
+                                                 lightPickProb_, directPdfW, emissionPdfW,
+                                                 cosToLight, cosAtLight, sh.probPass, distPdfToZ,
+                                                 merge);
     return le * f * sh.transmittance * (weight * cosToLight / (lightPickProb_ * directPdfW));
 }
 
@@ -202,7 +225,7 @@ Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const
     // camera vertex through imaginary boundaries) and its free-flight pdfs in both
     // directions, stopping at the end vertex if that lies in a medium (ub_mis.h, MEDIA).
     Rgb transmittance(1.0f);
-    float distPdfToLight = 1.0f, distPdfToCamera = 1.0f;
+    float distPdfToLight = 1.0f, distPdfToCamera = 1.0f, passProb = 1.0f;
     if (useMedia_) {
         MediumStack stack;
         if (!stackTowards(v, state, dir, &stack)) return Rgb(0.0f);
@@ -212,17 +235,28 @@ Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const
         transmittance = sh.transmittance;
         distPdfToLight = lv.inMedium() ? sh.pdfScatterFwdL : sh.probPass;
         distPdfToCamera = v.inMedium ? sh.pdfScatterRevL : sh.probPass;
+        passProb = sh.probPass;
     }
 
     const float geometry = cosLight * cosCamera / distSqr;
     // Pdfs of sampling each end from the other, in area (volume) measure.
     const float cameraDirPdfA = cameraDirPdfW * cosLight * distPdfToLight / distSqr;
     const float lightDirPdfA = lightDirPdfW * cosCamera * distPdfToCamera / distSqr;
-    ub_mis_partials lightMis = {lv.dVCM, lv.dVC, lv.dVM};
+    ub_mis_partials lightMis = {lv.dVCM, lv.dVC, lv.dVM, 0.0f};
+    // Merging factors of both ends; R_out of each is the other kind of beam along the
+    // connecting chain (ub_mis_volume.h).
+    const ub_mis_factor lightFactor = ub_mis_vertex_factor(mis_, lv.inMedium(), 0, 1, lv.rInL,
+                                                           length(cross(lv.dirFix, dir)));
+    const ub_mis_factor cameraFactor = ub_mis_vertex_factor(
+        mis_, v.inMedium, 0, 0, ratioIn(state, v), length(cross(state.ray.dir, dir)));
+    const float lightMerge = ub_mis_factor_total(
+        mis_, lightFactor, ub_mis_query_ratio(mis_, passProb, distPdfToLight));
+    const float cameraMerge = ub_mis_factor_total(
+        mis_, cameraFactor, ub_mis_photon_ratio(mis_, passProb, distPdfToCamera));
     // Weight of [TR (40), (41)].
-    const float weight = ub_mis_weight_connect(
-        mis_, lightMis, state.mis, cameraDirPdfA, lightRevPdfW, lightDirPdfA, cameraRevPdfW,
-        ub_mis_merge_factor(mis_, lv.inMedium(), 0), ub_mis_merge_factor(mis_, v.inMedium, 0));
+    const float weight =
+        ub_mis_weight_connect(mis_, lightMis, state.mis, cameraDirPdfA, lightRevPdfW,
+                              lightDirPdfA, cameraRevPdfW, lightMerge, cameraMerge);
     const Rgb contrib = fCamera * fLight * transmittance * (weight * geometry);
     if (isBlack(contrib)) return Rgb(0.0f);
     if (!useMedia_ && scene_.occluded(v.pos, v.hit.geoNormal, lv.position, lv.geoNormal))
@@ -236,6 +270,7 @@ Rgb VertexCM::mergeVertices(const SubPath& state, const Hit& hit, const Bsdf& bs
     Rgb sum(0.0f);
     grid_.query(hit.pos, lightVertices_, &LightVertex::position, [&](uint32_t index) {
         const LightVertex& lv = lightVertices_[index];
+        if (lv.inMedium()) return;  // medium photons merge through the volumetric estimators
         const int length = int(lv.pathLength) + state.pathLength;
         if (length > maxLength || length < minLength) return;
         float cameraDirPdfW = 0.0f, cameraRevPdfW = 0.0f;
@@ -247,7 +282,7 @@ Rgb VertexCM::mergeVertices(const SubPath& state, const Hit& hit, const Bsdf& bs
             cameraDirPdfW *= cameraCont;
             // The reverse direction would be sampled by the light subpath: its roulette.
             cameraRevPdfW *= lv.continuationProb;
-            ub_mis_partials lightMis = {lv.dVCM, lv.dVC, lv.dVM};
+            ub_mis_partials lightMis = {lv.dVCM, lv.dVC, lv.dVM, 0.0f};
             // Weight of [TR (38), (39)].
             weight = ub_mis_weight_merge(mis_, lightMis, state.mis, cameraDirPdfW, cameraRevPdfW);
         }

@@ -34,6 +34,7 @@ bool VertexCM::startLightPath(Rng& rng, SubPath& state) const {
     state.pathLength = 1;
     state.isFiniteLight = light.isFinite();
     state.specularPath = true;
+    state.fromLight = true;
     // Light subpath MIS partials [TR (31)-(33)].
     state.mis = ub_mis_init_light(mis_, directPdfA, emissionPdfW, cosLight, light.isDelta(),
                                   light.isFinite());
@@ -49,27 +50,36 @@ bool VertexCM::startLightPath(Rng& rng, SubPath& state) const {
 }
 
 void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuffer::Chunk& splats,
-                               std::vector<LightVertex>& vertices,
-                               std::vector<uint32_t>& pathEnds) const {
+                               LightChunk& out) const {
     const int maxLength = options_.maxPathLength, minLength = options_.minPathLength;
+    std::vector<LightVertex>& vertices = out.vertices;
+    std::vector<uint32_t>& pathEnds = out.pathEnds;
     vertices.clear();
+    out.photons.clear();
+    out.beams.clear();
     pathEnds.assign(end - begin, 0);
     for (size_t pathIndex = begin; pathIndex < end; ++pathIndex) {
         Rng rng = Rng::forPath(options_.seed, uint64_t(iteration), uint64_t(pathIndex), kLightSalt);
         SubPath state;
         bool alive = startLightPath(rng, state);
+        // UPBP: the first N_B light subpaths emit photon beams (their MIS counts N_B).
+        const bool emitBeams = upbp_.photonBeams() && pathIndex < size_t(beamPaths_);
         for (; alive; ++state.pathLength) {
             PathVertex v;
             bool escaped = false;
-            if (!traceToVertex(rng, state, &v, &escaped)) break;
+            // A point of a beam at this length merges with camera lengths >= 1.
+            const bool beamsHere = emitBeams && state.pathLength + 1 <= maxLength;
+            if (!traceToVertex(rng, state, &v, &escaped, beamsHere ? &out.beams : nullptr,
+                               uint32_t(pathIndex)))
+                break;
             VertexScatter scatter;  // BSDF, or phase function at a medium vertex
             if (!setupScatter(v, state, /*fromLight=*/true, &scatter)) break;  // pure emitter
             // Complete the MIS partials at this vertex [TR (31)-(36)], with the free-flight
             // pdfs of the segment (ub_mis.h, MEDIA); the first segment of a light at infinity
             // is in planar measure already [TR Sec. 5.1].
-            state.mis = ub_mis_at_hit_media(mis_, state.mis, v.dist, scatter.cosThetaFix(),
-                                            state.pathLength > 1 || state.isFiniteLight,
-                                            v.distPdfFwd, v.distPdfRev);
+            state.mis = misAtHit(state, v, scatter.cosThetaFix(),
+                                 state.pathLength > 1 || state.isFiniteLight);
+            const float rIn = ratioIn(state, v);
 
             // Store the vertex unless the BSDF is purely specular (no connection or merging).
             if (!scatter.isDelta() && (useVC_ || useVM_)) {
@@ -82,6 +92,7 @@ void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuf
                 lv.dVCM = state.mis.dVCM;
                 lv.dVC = state.mis.dVC;
                 lv.dVM = state.mis.dVM;
+                lv.rInL = rIn;
                 if (v.inMedium) {
                     lv.flags = LightVertex::kLightVertexInMedium;
                     lv.materialId = uint32_t(v.mediumId);
@@ -91,7 +102,27 @@ void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuf
                     lv.shadingNormal = v.hit.shadingNormal;
                     lv.uv = v.hit.uv;
                 }
+                // UPBP: surface vertices are connected and merged on surfaces; medium
+                // vertices are connected, and merged through the photon points below.
                 vertices.push_back(lv);
+            }
+            if (v.inMedium && upbp_.photonPoints() && state.pathLength + 1 <= maxLength) {
+                ub_photon_point ph{};
+                const MediumCoefficients mc =
+                    mediumCoefficientsAt(scene_.media[size_t(v.mediumId)], v.pos);
+                for (int a = 0; a < 3; ++a) {
+                    ph.pos[a] = v.pos[a];
+                    ph.throughput[a] = state.throughput[a];
+                    ph.sigmaS[a] = mc.sigmaS[a];
+                    ph.dirFix[a] = -state.ray.dir[a];
+                }
+                ph.pathLength = uint32_t(state.pathLength);
+                ph.mediumId = uint32_t(v.mediumId);
+                ph.contProb = scatter.continuationProb();
+                ph.rPhotonL = rIn;
+                ph.dVCM = state.mis.dVCM;
+                ph.dVM = state.mis.dVM;
+                out.photons.push_back(ph);
             }
             // Light tracing: connect to the camera (a path of pathLength + 1 segments).
             if (!scatter.isDelta() && (useVC_ || lightTraceOnly_) &&
@@ -134,21 +165,27 @@ void VertexCM::connectToCamera(const SubPath& state, const PathVertex& v,
     // Visibility, and with media the transmittance of the chain from the camera (walked from
     // the camera's media) with the pdf of the camera ray stopping at v (ub_mis.h, MEDIA).
     Rgb transmittance(1.0f);
-    float distPdfToVertex = 1.0f;
+    float distPdfToVertex = 1.0f, passToVertex = 1.0f;
     if (useMedia_) {
         const MediumShadow sh = scene_.shadowTransmittance(
             camera.position(), Vec3(0.0f), scene_.cameraMediumStack, v.pos, v.geoNormal());
         if (sh.blocked || isBlack(sh.transmittance)) return;
         transmittance = sh.transmittance;
         distPdfToVertex = v.inMedium ? sh.pdfScatterFwdL : sh.probPass;
+        passToVertex = sh.probPass;
     }
     const float cameraPdfA = imageToSurface * distPdfToVertex;
 
-    // Light tracing alone has no MIS; otherwise the weight of [TR (46), (47)].
-    const float weight = lightTraceOnly_
-                             ? 1.0f
-                             : ub_mis_weight_light_trace(mis_, state.mis, cameraPdfA, bsdfRevPdfW,
-                                                         ub_mis_merge_factor(mis_, v.inMedium, 0));
+    // Light tracing alone has no MIS; otherwise the weight of [TR (46), (47)], with the
+    // merging factor of v whose R_out is that of the camera ray (ub_mis_volume.h).
+    const ub_mis_factor factor =
+        ub_mis_vertex_factor(mis_, v.inMedium, 0, 1, ratioIn(state, v),
+                             length(cross(state.ray.dir, dirToCamera)));
+    const float merge = ub_mis_factor_total(
+        mis_, factor, ub_mis_query_ratio(mis_, passToVertex, distPdfToVertex));
+    const float weight = lightTraceOnly_ ? 1.0f
+                                         : ub_mis_weight_light_trace(mis_, state.mis, cameraPdfA,
+                                                                     bsdfRevPdfW, merge);
     const Rgb contrib =
         state.throughput * f * transmittance * (weight * imageToSurface / lightSubPathCount_);
     if (isBlack(contrib)) return;

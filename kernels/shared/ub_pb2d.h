@@ -1,0 +1,46 @@
+/* pb2d: photon points x query beams, the beam radiance estimate with a 2D
+ * kernel (Jarosz et al. 2008, "The beam radiance estimate for volumetric photon
+ * mapping"; UPBP Table 1: "P-B2D").
+ *
+ * Estimates the radiance arriving at the origin of a query beam (a camera-subpath
+ * segment through a medium, origin o, direction d) from the photon points y within
+ * distance r of the beam, each at the beam parameter t of its projection:
+ *   L ~= sum_y Theta_o T(o, t) / cover(t) * rho(v; -d, w_y) * Phi_y * K2 / N_L,
+ *   K2 = 1 / (pi r^2)                             (box kernel, UPBP Table 1)
+ * cover(t) = probability that a short query beam reaches t (1 for long beams).
+ * Phi_y carries sigma_s(y), the one scattering coefficient of the merged path; the
+ * query beam carries none (it samples no vertex).
+ * pdfs for MIS: the phase at v = o + t d in both directions, the camera's continuation
+ * probability at v; the camera partials completed at v (ub_beam_at), the light partials
+ * of the photon.
+ */
+#ifndef UB_PB2D_H
+#define UB_PB2D_H
+
+#include "ub_beam_geometry.h"
+#include "ub_phase.h"
+#include "ub_upbp_records.h"
+
+/* Contribution of photon ph to query beam qb at parameter t (from
+ * ub_point_beam_dist2), with the medium of qb evaluated over [0, t] in s.
+ * normalization = 1 / (N_L pi r^2). */
+UB_INLINE ub_float3 ub_pb2d_contribution(ub_mis_constants c, ub_photon_point ph, ub_beam qb,
+                                         ub_segment_eval s, float t, float g,
+                                         float normalization) {
+    ub_beam_point cp = ub_beam_at(c, qb, s, t, 0u);
+    ub_float3 wz = ub_f3_neg(ub_f3_from(qb.dir)), wy = ub_f3_from(ph.dirFix);
+    float phase = ub_hg_eval_dirs(wz, wy, g);
+    ub_mis_partials l;
+    l.dVCM = ph.dVCM;
+    l.dVC = 0.0f;
+    l.dVM = ph.dVM;
+    l.dOut = 0.0f;
+    float sinTheta = ub_f3_length(ub_f3_cross(wz, wy));
+    ub_mis_etas etas = ub_mis_volume_etas(c, ph.rPhotonL, cp.rInL, sinTheta);
+    float w = ub_mis_weight_volume(c, l, cp.mis, phase * s.contProb, phase * ph.contProb, etas,
+                                   UB_TECH_PB2D);
+    return ub_f3_scale(ub_f3_mul(cp.throughput, ub_f3_from(ph.throughput)),
+                       phase * w * normalization);
+}
+
+#endif /* UB_PB2D_H */

@@ -1,0 +1,114 @@
+// Bounding volume hierarchy over axis-aligned boxes: the lookup of the beam
+// estimators (UPBP). pb2d stores photon points as boxes of their kernel
+// sphere (traversed by query beams); bp2d and bb1d store photon-beam pieces,
+// diced along their axis into boxes of the cylinder of radius r (traversed by
+// query points and query beams; src/estimators/volume_estimate.h).
+//
+// Built top-down: a node's primitives are split at the median of their box
+// centres along the axis of largest centre extent, down to leaves of at most
+// kLeafSize primitives (O(n log n) with nth_element). Median splits keep the
+// tree balanced whatever the beam distribution; for the long, thin boxes of
+// beams a SAH split would cut traversal cost further (not done).
+//
+// Own code rather than Embree's user geometry: the nodes are a flat array of
+// fixed-size records, which the OpenCL backend uploads and traverses as they are
+// (kernels cannot call Embree), so the host twin walks the same structure.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/vec.h"
+
+namespace ub {
+
+struct BvhNode {
+    float lo[3];
+    uint32_t first;  ///< leaf: first index into Bvh::prims; inner: index of the right child
+    float hi[3];
+    uint32_t count;  ///< leaf: primitive count (> 0); inner: 0 (left child = this + 1)
+};
+static_assert(sizeof(BvhNode) == 32, "BvhNode layout");
+
+class Bvh {
+  public:
+    static constexpr uint32_t kLeafSize = 4;
+
+    /// Builds over boxes[i], i = 0..n-1; visits report i.
+    void build(const std::vector<Bounds3>& boxes);
+    bool empty() const { return nodes_.empty(); }
+    size_t nodeCount() const { return nodes_.size(); }
+    size_t bytes() const { return nodes_.size() * sizeof(BvhNode) + prims_.size() * 4; }
+
+    /// visit(i) for every primitive whose box contains p.
+    template <class Visit>
+    void queryPoint(const Vec3& p, Visit&& visit) const;
+    /// visit(i) for every primitive whose box meets the segment o + t d, t in [0, len].
+    template <class Visit>
+    void querySegment(const Vec3& o, const Vec3& d, float len, Visit&& visit) const;
+
+  private:
+    static bool contains(const BvhNode& n, const Vec3& p) {
+        return p.x >= n.lo[0] && p.x <= n.hi[0] && p.y >= n.lo[1] && p.y <= n.hi[1] &&
+               p.z >= n.lo[2] && p.z <= n.hi[2];
+    }
+    /// Slab test of the segment against the node's box (invD = 1 / d per axis, inf for 0).
+    static bool meets(const BvhNode& n, const Vec3& o, const Vec3& invD, float len) {
+        float t0 = 0.0f, t1 = len;
+        for (int a = 0; a < 3; ++a) {
+            float ta = (n.lo[a] - o[a]) * invD[a], tb = (n.hi[a] - o[a]) * invD[a];
+            if (ta > tb) std::swap(ta, tb);
+            // NaN (0 * inf: origin on a slab plane of a flat box) keeps the interval.
+            if (ta > t0) t0 = ta;
+            if (tb < t1) t1 = tb;
+            if (t0 > t1) return false;
+        }
+        return true;
+    }
+    uint32_t buildNode(const std::vector<Bounds3>& boxes, std::vector<Vec3>& centres,
+                       uint32_t begin, uint32_t end);
+
+    std::vector<BvhNode> nodes_;
+    std::vector<uint32_t> prims_;
+};
+
+template <class Visit>
+void Bvh::queryPoint(const Vec3& p, Visit&& visit) const {
+    if (nodes_.empty()) return;
+    uint32_t stack[64];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const BvhNode& n = nodes_[stack[--top]];
+        if (!contains(n, p)) continue;
+        if (n.count > 0) {
+            for (uint32_t i = n.first; i < n.first + n.count; ++i) visit(prims_[i]);
+        } else {
+            const uint32_t self = uint32_t(&n - nodes_.data());
+            stack[top++] = n.first;
+            stack[top++] = self + 1;
+        }
+    }
+}
+
+template <class Visit>
+void Bvh::querySegment(const Vec3& o, const Vec3& d, float len, Visit&& visit) const {
+    if (nodes_.empty()) return;
+    const Vec3 invD(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+    uint32_t stack[64];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const BvhNode& n = nodes_[stack[--top]];
+        if (!meets(n, o, invD, len)) continue;
+        if (n.count > 0) {
+            for (uint32_t i = n.first; i < n.first + n.count; ++i) visit(prims_[i]);
+        } else {
+            const uint32_t self = uint32_t(&n - nodes_.data());
+            stack[top++] = n.first;
+            stack[top++] = self + 1;
+        }
+    }
+}
+
+}  // namespace ub

@@ -1,0 +1,62 @@
+// pb2d host twin: photon points x query beams, 2D kernel (the beam radiance
+// estimate, Jarosz et al. 2008).
+//
+// Estimates, for each query beam, the radiance arriving at its origin from the
+// photon points within r_pb2d of the beam (UPBP Table 1, "P-B2D"; per-pair value,
+// MIS weight and normalisation 1 / (N_L pi r^2) in kernels/shared/ub_pb2d.h).
+// Lookup: BVH over the photon points as boxes of their kernel sphere, traversed by
+// the beam's segment (estimators/bvh.h). The medium along the query beam up to the
+// photon's projection is evaluated exactly (regular tracking).
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+
+#include "estimators/bvh.h"
+#include "estimators/volume_estimate.h"
+#include "kernels/shared/ub_pb2d.h"
+#include "scene/scene.h"
+
+namespace ub {
+
+void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres, std::vector<Rgb>* out,
+                  size_t* pairs) {
+    const std::vector<ub_photon_point>& photons = *in.photonPoints;
+    const std::vector<ub_beam>& queries = *in.queryBeams;
+    if (photons.empty() || queries.empty()) return;
+    const float r = in.radius[UB_TECH_PB2D];
+    const float normalization = 1.0f / (in.lightPathCount * kPi * r * r);  // K2 / N_L
+    std::atomic<size_t> found{0};
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, queries.size(), 16),
+        [&](const tbb::blocked_range<size_t>& range) {
+            size_t n = 0;
+            for (size_t i = range.begin(); i != range.end(); ++i) {
+                const ub_beam& qb = queries[i];
+                const float g = in.scene->media[qb.mediumId].g;
+                const ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
+                Rgb sum(0.0f);
+                photonSpheres.querySegment(
+                    Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length, [&](uint32_t j) {
+                        const ub_photon_point& ph = photons[j];
+                        if (ph.mediumId != qb.mediumId) return;
+                        const ub_uint length = ph.pathLength + qb.pathLength;
+                        if (length > ub_uint(in.maxLength) || length < ub_uint(in.minLength))
+                            return;
+                        float t = 0.0f;
+                        const float d2 = ub_point_beam_dist2(ub_f3_from(ph.pos), o, d, qb.length, &t);
+                        if (d2 < 0.0f || d2 > r * r) return;
+                        const ub_segment_eval s = evalBeamMedium(*in.scene, qb, t);
+                        const ub_float3 c =
+                            ub_pb2d_contribution(in.mis, ph, qb, s, t, g, normalization);
+                        sum += Rgb(c.x, c.y, c.z);
+                        ++n;
+                    });
+                (*out)[i] = sum;
+            }
+            found += n;
+        });
+    *pairs = found;
+}
+
+}  // namespace ub

@@ -1,0 +1,138 @@
+// The UPBP estimate pass: lookups and the order of accumulation (see
+// volume_estimate.h). The estimators themselves are in *_estimator.cpp.
+#include "estimators/volume_estimate.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "estimators/bvh.h"
+#include "estimators/hash_grid.h"
+#include "scene/medium.h"
+#include "scene/scene.h"
+
+namespace ub {
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Box of the cylinder of radius r around o + t d, t in [t0, t1].
+Bounds3 cylinderBox(const Vec3& o, const Vec3& d, float t0, float t1, float r) {
+    Bounds3 b;
+    const Vec3 pad(r, r, r);
+    b.extend(o + d * t0 - pad);
+    b.extend(o + d * t0 + pad);
+    b.extend(o + d * t1 - pad);
+    b.extend(o + d * t1 + pad);
+    return b;
+}
+
+Vec3 vec(const float v[3]) { return Vec3(v[0], v[1], v[2]); }
+
+}  // namespace
+
+ub_segment_eval evalBeamMedium(const Scene& scene, const ub_beam& b, float t) {
+    const Medium& m = scene.media[b.mediumId];
+    const MediumSegment s = evalMediumSegment(m, vec(b.origin), vec(b.dir), t);
+    ub_segment_eval e;
+    for (int a = 0; a < 3; ++a) {
+        e.transmittance[a] = s.transmittance[a];
+        e.sigmaS[a] = s.sigmaS1[a];
+    }
+    e.stopFwdL = s.pdfScatterFwdL();
+    e.stopRevStartL = s.pdfScatterRevL();
+    e.passProb = s.probPass();
+    e.contProb = ub_medium_cont_prob(s.sigmaS1[0], s.sigmaS1[1], s.sigmaS1[2], s.sigmaT1[0],
+                                     s.sigmaT1[1], s.sigmaT1[2]);
+    return e;
+}
+
+void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Image, 4>* layers,
+                    VolumeEstimateStats* stats) {
+    VolumeEstimateStats local;
+    VolumeEstimateStats& st = stats ? *stats : local;
+    st = VolumeEstimateStats();
+    const UpbpTechniques& t = in.techniques;
+    const std::vector<ub_photon_point>& photons = *in.photonPoints;
+    const std::vector<ub_beam>& beams = *in.photonBeams;
+    const size_t nPoints = in.queryPoints->size(), nBeams = in.queryBeams->size();
+
+    auto t0 = std::chrono::steady_clock::now();
+    HashGrid grid;
+    if (t.pp3d && !photons.empty()) {
+        grid.build(reinterpret_cast<const Vec3*>(photons.data()->pos), photons.size(), sizeof(ub_photon_point),
+                   in.radius[UB_TECH_PP3D]);
+    }
+    Bvh spheres;
+    if (t.pb2d) {
+        const float r = in.radius[UB_TECH_PB2D];
+        std::vector<Bounds3> boxes(photons.size());
+        for (size_t i = 0; i < photons.size(); ++i) {
+            const Vec3 p = vec(photons[i].pos);
+            boxes[i].extend(p - Vec3(r, r, r));
+            boxes[i].extend(p + Vec3(r, r, r));
+        }
+        spheres.build(boxes);
+    }
+    Bvh beamBvh;
+    std::vector<BeamPart> parts;
+    if (t.photonBeams()) {
+        const float r = std::max(t.bp2d ? in.radius[UB_TECH_BP2D] : 0.0f,
+                                 t.bb1d ? in.radius[UB_TECH_BB1D] : 0.0f);
+        std::vector<Bounds3> boxes;
+        for (uint32_t i = 0; i < beams.size(); ++i) {
+            const ub_beam& b = beams[i];
+            const int n = int(std::min(64.0f, std::max(1.0f, std::ceil(b.length / (4.0f * r)))));
+            for (int k = 0; k < n; ++k) {
+                const float a = b.length * float(k) / float(n);
+                const float e = k + 1 == n ? b.length : b.length * float(k + 1) / float(n);
+                parts.push_back({i, a, e});
+                boxes.push_back(cylinderBox(vec(b.origin), vec(b.dir), a, e, r));
+            }
+        }
+        beamBvh.build(boxes);
+    }
+    st.buildSeconds = secondsSince(t0);
+    st.lookupBytes = spheres.bytes() + beamBvh.bytes() + parts.size() * sizeof(BeamPart);
+
+    t0 = std::chrono::steady_clock::now();
+    std::vector<Rgb> perPoint[4], perBeam[4];
+    if (t.pp3d) {
+        perPoint[UB_TECH_PP3D].assign(nPoints, Rgb(0.0f));
+        estimatePP3D(in, grid, &perPoint[UB_TECH_PP3D], &st.pairs[UB_TECH_PP3D]);
+    }
+    if (t.bp2d) {
+        perPoint[UB_TECH_BP2D].assign(nPoints, Rgb(0.0f));
+        estimateBP2D(in, beamBvh, parts, &perPoint[UB_TECH_BP2D], &st.pairs[UB_TECH_BP2D]);
+    }
+    if (t.pb2d) {
+        perBeam[UB_TECH_PB2D].assign(nBeams, Rgb(0.0f));
+        estimatePB2D(in, spheres, &perBeam[UB_TECH_PB2D], &st.pairs[UB_TECH_PB2D]);
+    }
+    if (t.bb1d) {
+        perBeam[UB_TECH_BB1D].assign(nBeams, Rgb(0.0f));
+        estimateBB1D(in, beamBvh, parts, &perBeam[UB_TECH_BB1D], &st.pairs[UB_TECH_BB1D]);
+    }
+    st.estimateSeconds = secondsSince(t0);
+
+    // Accumulate in query order (deterministic).
+    const int width = image->width;
+    auto add = [&](uint32_t pixel, int tech, const Rgb& v) {
+        const int x = int(pixel % uint32_t(width)), y = int(pixel / uint32_t(width));
+        image->at(x, y) += v;
+        if (layers) (*layers)[size_t(tech)].at(x, y) += v;
+    };
+    for (int tech = 0; tech < 4; ++tech) {
+        if (!perPoint[tech].empty())
+            for (size_t i = 0; i < nPoints; ++i)
+                add((*in.queryPoints)[i].pixel, tech, perPoint[tech][i]);
+        if (!perBeam[tech].empty())
+            for (size_t i = 0; i < nBeams; ++i)
+                add((*in.queryBeams)[i].pixel, tech, perBeam[tech][i]);
+    }
+}
+
+}  // namespace ub

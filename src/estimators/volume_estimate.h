@@ -1,0 +1,83 @@
+// The estimate pass of UPBP: the volumetric estimators evaluated in batch over
+// the query points and query beams the camera pass recorded, against the photon
+// points and photon beams of the light pass (render/vcm.h, step 5 of an
+// iteration). This is the host twin of the pass the OpenCL backend runs; the
+// per-pair math is kernels/shared/ub_pp3d.h, ub_pb2d.h, ub_bp2d.h, ub_bb1d.h.
+//
+// Lookups, built per iteration:
+//   pp3d  hashed grid over photon points, cell 2 r (estimators/hash_grid.h);
+//   pb2d  BVH over photon points as boxes of their kernel sphere, traversed by
+//         each query beam (estimators/bvh.h);
+//   bp2d, bb1d  one BVH over photon-beam pieces diced along their axis into at
+//         most 64 parts of length >= 4 r, each part's box enclosing its cylinder
+//         of radius max(r_bp2d, r_bb1d); traversed by query points and query
+//         beams. A beam meets a query in several parts' boxes; only the part whose
+//         parameter range holds the closest-approach parameter counts it, so each
+//         pair is counted once without mailboxes.
+// The medium along a beam up to a point (transmittance, sigma_s, free-flight pdfs)
+// is evaluated by regular tracking (scene/medium.h evalMediumSegment): exact in
+// NanoVDB grids as in homogeneous media.
+//
+// Results: every query's estimate is computed in parallel into its own slot, then
+// added to its pixel in query order, so images do not depend on the thread count.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "core/image.h"
+#include "kernels/shared/ub_upbp_records.h"
+#include "render/upbp_techniques.h"
+
+namespace ub {
+
+class Scene;
+
+struct VolumeEstimateInput {
+    const Scene* scene = nullptr;
+    ub_mis_constants mis{};
+    UpbpTechniques techniques;
+    float radius[4] = {0, 0, 0, 0};  ///< UB_TECH_* radii of this iteration
+    float lightPathCount = 1;        ///< N_L
+    float beamPathCount = 1;         ///< N_B
+    int minLength = 0, maxLength = 1;
+    const std::vector<ub_photon_point>* photonPoints = nullptr;
+    const std::vector<ub_beam>* photonBeams = nullptr;
+    const std::vector<ub_query_point>* queryPoints = nullptr;
+    const std::vector<ub_beam>* queryBeams = nullptr;
+};
+
+/// Per-iteration counts and times of the estimate pass.
+struct VolumeEstimateStats {
+    size_t pairs[4] = {0, 0, 0, 0};  ///< photon-query pairs within the kernel, per technique
+    double buildSeconds = 0, estimateSeconds = 0;
+    size_t lookupBytes = 0;
+};
+
+/// The medium along beam b from its piece start to distance t.
+ub_segment_eval evalBeamMedium(const Scene& scene, const ub_beam& b, float t);
+
+/// Adds every enabled volumetric technique's estimate to its query's pixel of `image` (and
+/// of layers[UB_TECH_*] if layers is given; each layer the size of the image).
+void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Image, 4>* layers,
+                    VolumeEstimateStats* stats = nullptr);
+
+// The host twins, one per estimator (estimators/*_estimator.cpp): each adds its estimate of
+// query i to out[i].
+class HashGrid;
+class Bvh;
+struct BeamPart {
+    uint32_t beam;
+    float t0, t1;  ///< parameter range of the part on its beam
+};
+void estimatePP3D(const VolumeEstimateInput& in, const HashGrid& grid, std::vector<Rgb>* out,
+                  size_t* pairs);
+void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres, std::vector<Rgb>* out,
+                  size_t* pairs);
+void estimateBP2D(const VolumeEstimateInput& in, const Bvh& beamParts,
+                  const std::vector<BeamPart>& parts, std::vector<Rgb>* out, size_t* pairs);
+void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
+                  const std::vector<BeamPart>& parts, std::vector<Rgb>* out, size_t* pairs);
+
+}  // namespace ub
