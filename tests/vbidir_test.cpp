@@ -280,10 +280,11 @@ TEST(VolBidir, WithoutMediaVltIsLtAndVbptIsBpt) {
 }
 
 TEST(VolBidir, RejectsWhatItCannotRender) {
-    // Surface-only algorithms refuse media (the registry, render/integrator.cpp).
+    // Surface-only algorithms refuse media (the registry, render/integrator.cpp); vcm is
+    // upbp:bpt+surf there (tests/upbp_test.cpp).
     MediaSceneCase fog{"cornell-fog.json", 0, 0};
     auto scene = loadMediaScene(fog, 8);
-    for (const char* surfaceOnly : {"lt", "bpt", "vcm"}) {
+    for (const char* surfaceOnly : {"lt", "bpt", "bpm"}) {
         RenderOptions opt;
         opt.algorithm = surfaceOnly;
         try {

@@ -22,9 +22,8 @@
 /* Contribution of photon beam pb at t_l to query beam qb at t_c (ub_beam_beam_dist2),
  * sl / sc their media over [0, t_l] / [0, t_c]. normalization = 1 / (N_B 2 r). */
 UB_INLINE ub_float3 ub_bb1d_contribution(ub_mis_constants c, ub_beam pb, ub_beam qb,
-                                         ub_segment_eval sl, ub_segment_eval sc, float tl,
-                                         float tc, float sinTheta, float g,
-                                         float normalization) {
+                                         ub_segment_eval sl, ub_segment_eval sc, float tl, float tc,
+                                         float sinTheta, float g, float normalization) {
     ub_beam_point lp = ub_beam_at(c, pb, sl, tl, 1u);
     ub_beam_point cp = ub_beam_at(c, qb, sc, tc, 0u);
     ub_float3 wz = ub_f3_neg(ub_f3_from(qb.dir)), wy = ub_f3_neg(ub_f3_from(pb.dir));

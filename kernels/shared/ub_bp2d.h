@@ -22,8 +22,7 @@
 /* Contribution of photon beam pb at parameter t to query point q, the beam's medium over
  * [0, t] in s. normalization = 1 / (N_B pi r^2). */
 UB_INLINE ub_float3 ub_bp2d_contribution(ub_mis_constants c, ub_beam pb, ub_query_point q,
-                                         ub_segment_eval s, float t, float g,
-                                         float normalization) {
+                                         ub_segment_eval s, float t, float g, float normalization) {
     ub_beam_point lp = ub_beam_at(c, pb, s, t, 1u);
     ub_float3 wz = ub_f3_from(q.dirFix), wy = ub_f3_neg(ub_f3_from(pb.dir));
     float phase = ub_hg_eval_dirs(wz, wy, g);

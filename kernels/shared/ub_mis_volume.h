@@ -73,16 +73,15 @@
 
 /* Enables the volumetric techniques (radius <= 0: disabled). beamPathCount: N_B. */
 UB_INLINE ub_mis_constants ub_mis_enable_volume(ub_mis_constants c, float radiusPP3D,
-                                                    float radiusPB2D, float radiusBP2D,
-                                                    float radiusBB1D, float beamPathCount,
-                                                    ub_uint shortPhotonBeams,
-                                                    ub_uint shortQueryBeams) {
+                                                float radiusPB2D, float radiusBP2D,
+                                                float radiusBB1D, float beamPathCount,
+                                                ub_uint shortPhotonBeams, ub_uint shortQueryBeams) {
     float nL = c.lightSubPathCount;
     /* eta constants of UPBP Sec. 5.1 (box kernels, see the banner) */
     c.pp3dWeightFactor =
-        radiusPP3D > 0.0f ? ub_mis(c, nL * (4.0f / 3.0f) * UB_PI * radiusPP3D * radiusPP3D *
-                                          radiusPP3D)
-                          : 0.0f;
+        radiusPP3D > 0.0f
+            ? ub_mis(c, nL * (4.0f / 3.0f) * UB_PI * radiusPP3D * radiusPP3D * radiusPP3D)
+            : 0.0f;
     c.pb2dWeightFactor = radiusPB2D > 0.0f ? ub_mis(c, nL * UB_PI * radiusPB2D * radiusPB2D) : 0.0f;
     c.bp2dWeightFactor =
         radiusBP2D > 0.0f ? ub_mis(c, beamPathCount * UB_PI * radiusBP2D * radiusBP2D) : 0.0f;
@@ -123,7 +122,7 @@ typedef struct {
 } ub_mis_factor;
 
 UB_INLINE ub_mis_factor ub_mis_vertex_factor(ub_mis_constants c, int inMedium, int isDelta,
-                                                 int fromLight, float rIn, float sinTheta) {
+                                             int fromLight, float rIn, float sinTheta) {
     ub_mis_factor f;
     f.now = 0.0f;
     f.out = 0.0f;
@@ -156,7 +155,7 @@ typedef struct {
 } ub_mis_etas;
 
 UB_INLINE ub_mis_etas ub_mis_volume_etas(ub_mis_constants c, float rPhoton, float rQuery,
-                                             float sinTheta) {
+                                         float sinTheta) {
     ub_mis_etas e;
     float mP = ub_mis(c, rPhoton), mQ = ub_mis(c, rQuery);
     e.eta[UB_TECH_PP3D] = c.pp3dWeightFactor;
@@ -171,8 +170,8 @@ UB_INLINE ub_mis_etas ub_mis_volume_etas(ub_mis_constants c, float rPhoton, floa
  * camera's incoming direction sampling the light's, times the camera's continuation
  * probability; cameraRevPdfW: the reverse, times the light's continuation probability. */
 UB_INLINE float ub_mis_weight_volume(ub_mis_constants c, ub_mis_partials l, ub_mis_partials e,
-                                         float cameraDirPdfW, float cameraRevPdfW,
-                                         ub_mis_etas etas, ub_uint tech) {
+                                     float cameraDirPdfW, float cameraRevPdfW, ub_mis_etas etas,
+                                     ub_uint tech) {
     float own = etas.eta[tech];
     if (!(own > 0.0f)) return 0.0f;
     float other = 0.0f;

@@ -24,10 +24,9 @@
 
 /* Contribution of photon ph to query q (0 if out of range or in another medium).
  * g: the medium's HG asymmetry; normalization = 1 / (N_L (4/3) pi r^3). */
-UB_INLINE ub_float3 ub_pp3d_contribution(ub_mis_constants c, ub_photon_point ph,
-                                         ub_query_point q, float g, float radiusSqr,
-                                         float normalization, ub_uint minLength,
-                                         ub_uint maxLength) {
+UB_INLINE ub_float3 ub_pp3d_contribution(ub_mis_constants c, ub_photon_point ph, ub_query_point q,
+                                         float g, float radiusSqr, float normalization,
+                                         ub_uint minLength, ub_uint maxLength) {
     ub_float3 zero = ub_make_float3(0.0f, 0.0f, 0.0f);
     if (ph.mediumId != q.mediumId) return zero;
     ub_uint length = ph.pathLength + q.pathLength;
@@ -47,8 +46,8 @@ UB_INLINE ub_float3 ub_pp3d_contribution(ub_mis_constants c, ub_photon_point ph,
     e.dOut = 0.0f;
     float sinTheta = ub_f3_length(ub_f3_cross(wz, wy));
     ub_mis_etas etas = ub_mis_volume_etas(c, ph.rPhotonL, q.rQueryL, sinTheta);
-    float w = ub_mis_weight_volume(c, l, e, phase * q.contProb, phase * ph.contProb, etas,
-                                   UB_TECH_PP3D);
+    float w =
+        ub_mis_weight_volume(c, l, e, phase * q.contProb, phase * ph.contProb, etas, UB_TECH_PP3D);
     float s = phase * w * normalization;
     ub_float3 out;
     out.x = ph.sigmaS[0] > 0.0f ? q.throughput[0] * ph.throughput[0] / ph.sigmaS[0] * s : 0.0f;

@@ -90,8 +90,8 @@ typedef struct {
 
 /* A subpath at a point of one of its beams, as if it had sampled a vertex there. */
 typedef struct {
-    ub_mis_partials mis; /* completed at the point (ub_mis_at_hit_volume) */
-    float rInL;          /* R of this beam at the point (its kind) */
+    ub_mis_partials mis;  /* completed at the point (ub_mis_at_hit_volume) */
+    float rInL;           /* R of this beam at the point (its kind) */
     ub_float3 throughput; /* at the point: T / P of the piece for short beams, T for long */
 } ub_beam_point;
 
@@ -119,9 +119,9 @@ UB_INLINE ub_beam_point ub_beam_at(ub_mis_constants c, ub_beam b, ub_segment_eva
     p.dVM = b.dVM;
     p.dOut = b.dOut;
     /* R_out of x is the other kind of beam over the same chain, seen from the point */
-    out.mis = ub_mis_at_hit_volume(c, p, b.distBefore + t, 1.0f,
-                                   (b.flags & UB_BEAM_APPLY_DIST2) ? 1 : 0, stopFwd, stopRev,
-                                   ub_mis_beam_ratio(shortOther, passRev, stopRev));
+    out.mis =
+        ub_mis_at_hit_volume(c, p, b.distBefore + t, 1.0f, (b.flags & UB_BEAM_APPLY_DIST2) ? 1 : 0,
+                             stopFwd, stopRev, ub_mis_beam_ratio(shortOther, passRev, stopRev));
     out.rInL = ub_mis_beam_ratio(shortThis, passFwd, stopFwd);
     /* short beams cover t with probability passProb (of this piece; earlier pieces are in
      * b.throughput), long ones always */

@@ -205,14 +205,13 @@ int run(int argc, char** argv) {
                                  def + ")")
                 ->check(positiveReal())
                 ->type_name("R");
-        volumeAlphaOpt[t] =
-            render
-                ->add_option(std::string("--alpha-") + kTech[t], volumeAlpha[t],
-                             std::string("upbp: ") + kTech[t] +
-                                 " radius reduction, r_i = r_1 i^((alpha-1)/" + kDim[t] +
-                                 "), in (0, 1] (default 0.75)")
-                ->check(positiveReal(1.0))
-                ->type_name("A");
+        volumeAlphaOpt[t] = render
+                                ->add_option(std::string("--alpha-") + kTech[t], volumeAlpha[t],
+                                             std::string("upbp: ") + kTech[t] +
+                                                 " radius reduction, r_i = r_1 i^((alpha-1)/" +
+                                                 kDim[t] + "), in (0, 1] (default 0.75)")
+                                ->check(positiveReal(1.0))
+                                ->type_name("A");
     }
     render
         ->add_option("--photon-beams", ra.photonBeams,

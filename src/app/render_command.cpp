@@ -3,8 +3,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-
-#include "render/upbp_techniques.h"
 #include <cctype>
 #include <csignal>
 #include <cstdio>
@@ -19,6 +17,7 @@
 #include "core/image.h"
 #include "render/integrator.h"
 #include "render/progressive.h"
+#include "render/upbp_techniques.h"
 
 namespace ub::app {
 

@@ -45,8 +45,8 @@ void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
                         if (length > ub_uint(in.maxLength) || length < ub_uint(in.minLength))
                             return;
                         float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
-                        const float d2 = ub_beam_beam_dist2(o, d, ub_f3_from(pb.origin),
-                                                            ub_f3_from(pb.dir), &tc, &tl, &sinTheta);
+                        const float d2 = ub_beam_beam_dist2(
+                            o, d, ub_f3_from(pb.origin), ub_f3_from(pb.dir), &tc, &tl, &sinTheta);
                         if (d2 < 0.0f || d2 > r * r) return;
                         if (tc < 0.0f || tc > qb.length || tl < 0.0f || tl > pb.length) return;
                         if (tl < part.t0 || (tl >= part.t1 && part.t1 < pb.length)) return;

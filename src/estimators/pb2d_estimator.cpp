@@ -44,7 +44,8 @@ void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres, std::
                         if (length > ub_uint(in.maxLength) || length < ub_uint(in.minLength))
                             return;
                         float t = 0.0f;
-                        const float d2 = ub_point_beam_dist2(ub_f3_from(ph.pos), o, d, qb.length, &t);
+                        const float d2 =
+                            ub_point_beam_dist2(ub_f3_from(ph.pos), o, d, qb.length, &t);
                         if (d2 < 0.0f || d2 > r * r) return;
                         const ub_segment_eval s = evalBeamMedium(*in.scene, qb, t);
                         const ub_float3 c =

@@ -33,7 +33,8 @@ void estimatePP3D(const VolumeEstimateInput& in, const HashGrid& grid, std::vect
                               const ub_query_point& q = queries[i];
                               const float g = in.scene->media[q.mediumId].g;
                               Rgb sum(0.0f);
-                              grid.query(Vec3(q.pos[0], q.pos[1], q.pos[2]), reinterpret_cast<const Vec3*>(photons[0].pos),
+                              grid.query(Vec3(q.pos[0], q.pos[1], q.pos[2]),
+                                         reinterpret_cast<const Vec3*>(photons[0].pos),
                                          sizeof(ub_photon_point), [&](uint32_t j) {
                                              ub_float3 c = ub_pp3d_contribution(
                                                  in.mis, photons[j], q, g, r * r, normalization,

@@ -30,7 +30,9 @@ Bounds3 cylinderBox(const Vec3& o, const Vec3& d, float t0, float t1, float r) {
     return b;
 }
 
-Vec3 vec(const float v[3]) { return Vec3(v[0], v[1], v[2]); }
+Vec3 vec(const float v[3]) {
+    return Vec3(v[0], v[1], v[2]);
+}
 
 }  // namespace
 
@@ -63,8 +65,8 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     auto t0 = std::chrono::steady_clock::now();
     HashGrid grid;
     if (t.pp3d && !photons.empty()) {
-        grid.build(reinterpret_cast<const Vec3*>(photons.data()->pos), photons.size(), sizeof(ub_photon_point),
-                   in.radius[UB_TECH_PP3D]);
+        grid.build(reinterpret_cast<const Vec3*>(photons.data()->pos), photons.size(),
+                   sizeof(ub_photon_point), in.radius[UB_TECH_PP3D]);
     }
     Bvh spheres;
     if (t.pb2d) {

@@ -16,6 +16,13 @@ bool scatters(const Medium& m) {
     return m.type != MediumType::kHomogeneous || !isBlack(m.sigmaS);
 }
 
+/// Where a beam along an escaping ray (an unbounded last segment) ends: in a homogeneous
+/// medium where the largest transmittance has fallen below 1e-7 (t = ln(1e7) / min sigma_t;
+/// what lies beyond contributes less than 1e-7 of the beam's throughput), else where the ray
+/// leaves the scene's bounding sphere (grid media are empty outside their bounds, which the
+/// geometry encloses).
+float escapingBeamLength(const Scene& scene, const Medium& m, const Vec3& o, const Vec3& d);
+
 /// Distance along o + t d (unit d) at which the ray leaves the sphere; 0 if it never is
 /// inside it ahead of o.
 float sphereExit(const Vec3& o, const Vec3& d, const Vec3& centre, float radius) {
@@ -24,6 +31,15 @@ float sphereExit(const Vec3& o, const Vec3& d, const Vec3& centre, float radius)
     const float disc = b * b - c;
     if (disc <= 0.0f) return 0.0f;
     return std::max(0.0f, -b + std::sqrt(disc));
+}
+
+float escapingBeamLength(const Scene& scene, const Medium& m, const Vec3& o, const Vec3& d) {
+    if (m.type == MediumType::kHomogeneous) {
+        const Rgb st = m.sigmaA + m.sigmaS;
+        const float minSigma = std::min(st.x, std::min(st.y, st.z));
+        if (minSigma > 0.0f) return std::log(1e7f) / minSigma;
+    }
+    return sphereExit(o, d, scene.sceneSphere.center, scene.sceneSphere.radius * 1.01f);
 }
 
 }  // namespace
@@ -45,9 +61,7 @@ void appendChainBeams(const Scene& scene, const MediumTrace& trace, const Vec3& 
         const bool visited = k < visit.count && !(cv.scattered && k == cv.segment);
         if (seg.mediumId >= 0) {
             const Medium& medium = scene.media[size_t(seg.mediumId)];
-            if (length >= farLimit)  // an escaping ray: the beam ends at the scene's bounds
-                length = sphereExit(seg.origin, dir, scene.sceneSphere.center,
-                                    scene.sceneSphere.radius * 1.01f);
+            if (length >= farLimit) length = escapingBeamLength(scene, medium, seg.origin, dir);
             if (src.shortBeams && k == visit.count - 1 && cv.scattered)
                 length = visit.length[k];  // up to the vertex
             if (length > 0.0f && scatters(medium)) {
@@ -90,8 +104,10 @@ void appendChainBeams(const Scene& scene, const MediumTrace& trace, const Vec3& 
         revPdf *= (k == 0 && src.fromMedium) ? stopRevStart : pass;
         revPass *= pass;
         if (src.shortBeams) {
-            if (pass > 0.0f) weight *= transmittance / pass;
-            else weight = Rgb(0.0f);
+            if (pass > 0.0f)
+                weight *= transmittance / pass;
+            else
+                weight = Rgb(0.0f);
         } else {
             weight *= transmittance;
         }

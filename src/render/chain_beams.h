@@ -7,10 +7,12 @@
 //               it covers the segments the sampling visited, the last one up to
 //               the vertex; its throughput at a piece start is the walk's
 //               weight up to there (T / P per passed segment);
-//   long beam   runs to the chain's real surface (or, for an escaping ray, to
-//               where the ray leaves the scene's bounding sphere), through every
-//               medium segment; its throughput at a piece start is the product
-//               of the transmittances before it.
+//   long beam   runs to the chain's real surface through every medium segment;
+//               its throughput at a piece start is the product of the
+//               transmittances before it.
+// A beam along an escaping ray (an unbounded segment) ends where a homogeneous
+// medium's transmittance is below 1e-7 in every channel, else where the ray
+// leaves the scene's bounding sphere (render/chain_beams.cpp).
 //
 // Each piece records what ub_beam_at (kernels/shared/ub_upbp_records.h) needs to
 // complete the subpath's MIS partials at any point of it: the pending partials
@@ -33,10 +35,10 @@ class Scene;
 
 /// The subpath that emits the beams of one chain.
 struct ChainBeamSource {
-    Rgb throughput{1.0f};  ///< at x, after scattering there (before the chain)
-    ub_mis_partials mis{};  ///< after scattering at x (dOut pending)
-    uint32_t pathLength = 1;  ///< segments from the subpath start to a point of the chain
-    bool fromMedium = false;  ///< x is a medium vertex
+    Rgb throughput{1.0f};      ///< at x, after scattering there (before the chain)
+    ub_mis_partials mis{};     ///< after scattering at x (dOut pending)
+    uint32_t pathLength = 1;   ///< segments from the subpath start to a point of the chain
+    bool fromMedium = false;   ///< x is a medium vertex
     bool applyDistSqr = true;  ///< false on the first segment of a light at infinity
     bool shortBeams = true;
     uint32_t tag = 0;  ///< ub_beam::pixel

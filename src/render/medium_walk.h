@@ -53,9 +53,9 @@ struct ChainVertex {
 struct ChainVisit {
     int count = 0;  ///< segments visited: 0 .. count-1 (the last holds the vertex if scattered)
     float length[MediumTrace::kMaxSegments];
-    float passProb[MediumTrace::kMaxSegments];      ///< probPass of the visited part
+    float passProb[MediumTrace::kMaxSegments];       ///< probPass of the visited part
     float stopRevStartL[MediumTrace::kMaxSegments];  ///< pdfScatterRevL of the visited part
-    Rgb transmittance[MediumTrace::kMaxSegments];   ///< T of the visited part
+    Rgb transmittance[MediumTrace::kMaxSegments];    ///< T of the visited part
 };
 
 /// Samples the vertex that follows a chain traced along unit direction dir. prevInMedium:

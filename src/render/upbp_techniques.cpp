@@ -57,8 +57,8 @@ UpbpTechniques parseUpbpTechniques(const std::string& algorithm) {
             throw InputError("", "algorithm '" + algorithm + "': unknown technique '" + name +
                                      "' (valid: " + kValid + ")");
         if (*flag)
-            throw InputError("", "algorithm '" + algorithm + "': technique '" + name +
-                                     "' is given twice");
+            throw InputError(
+                "", "algorithm '" + algorithm + "': technique '" + name + "' is given twice");
         *flag = true;
         start = end + 1;
     }

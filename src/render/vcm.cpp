@@ -122,8 +122,8 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
                                                    std::to_string(options.alpha));
     }
     nullNotCounted_ = scene.settings.depthCounting == DepthCounting::kNonNullVertices;
-    const bool volumetric = options.algorithm == "vlt" || options.algorithm == "vbpt" ||
-                            algorithm_ == Algorithm::Upbp;
+    const bool volumetric =
+        options.algorithm == "vlt" || options.algorithm == "vbpt" || algorithm_ == Algorithm::Upbp;
     useMedia_ = volumetric && scene.hasMedia();
     if (useMedia_) {
         for (size_t m = 0; m < scene.media.size(); ++m)
@@ -285,8 +285,8 @@ bool VertexCM::traceToVertex(Rng& rng, SubPath& state, PathVertex* v, bool* esca
     scene_.traceMedia(state.ray, &state.stack, &trace, &v->hit);
     if (trace.overflow) return false;
     ChainVisit visit;
-    const ChainVertex cv = sampleChainVertex(scene_, trace, state.ray.dir, state.rayFromMedium,
-                                             rng, beams ? &visit : nullptr);
+    const ChainVertex cv = sampleChainVertex(scene_, trace, state.ray.dir, state.rayFromMedium, rng,
+                                             beams ? &visit : nullptr);
     if (beams) {
         ChainBeamSource src;
         src.throughput = state.throughput;

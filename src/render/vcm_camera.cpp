@@ -185,10 +185,9 @@ Rgb VertexCM::directIllumination(Rng& rng, const SubPath& state, const PathVerte
                                                       length(cross(state.ray.dir, dirToLight)));
     const float merge =
         ub_mis_factor_total(mis_, factor, ub_mis_photon_ratio(mis_, sh.probPass, distPdfToZ));
-    const float weight = ub_mis_weight_nee_media(mis_, state.mis, bsdfDirPdfW, bsdfRevPdfW,
-                                                 lightPickProb_, directPdfW, emissionPdfW,
-                                                 cosToLight, cosAtLight, sh.probPass, distPdfToZ,
-                                                 merge);
+    const float weight = ub_mis_weight_nee_media(
+        mis_, state.mis, bsdfDirPdfW, bsdfRevPdfW, lightPickProb_, directPdfW, emissionPdfW,
+        cosToLight, cosAtLight, sh.probPass, distPdfToZ, merge);
     return le * f * sh.transmittance * (weight * cosToLight / (lightPickProb_ * directPdfW));
 }
 
@@ -245,18 +244,18 @@ Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const
     ub_mis_partials lightMis = {lv.dVCM, lv.dVC, lv.dVM, 0.0f};
     // Merging factors of both ends; R_out of each is the other kind of beam along the
     // connecting chain (ub_mis_volume.h).
-    const ub_mis_factor lightFactor = ub_mis_vertex_factor(mis_, lv.inMedium(), 0, 1, lv.rInL,
-                                                           length(cross(lv.dirFix, dir)));
+    const ub_mis_factor lightFactor =
+        ub_mis_vertex_factor(mis_, lv.inMedium(), 0, 1, lv.rInL, length(cross(lv.dirFix, dir)));
     const ub_mis_factor cameraFactor = ub_mis_vertex_factor(
         mis_, v.inMedium, 0, 0, ratioIn(state, v), length(cross(state.ray.dir, dir)));
-    const float lightMerge = ub_mis_factor_total(
-        mis_, lightFactor, ub_mis_query_ratio(mis_, passProb, distPdfToLight));
+    const float lightMerge =
+        ub_mis_factor_total(mis_, lightFactor, ub_mis_query_ratio(mis_, passProb, distPdfToLight));
     const float cameraMerge = ub_mis_factor_total(
         mis_, cameraFactor, ub_mis_photon_ratio(mis_, passProb, distPdfToCamera));
     // Weight of [TR (40), (41)].
     const float weight =
-        ub_mis_weight_connect(mis_, lightMis, state.mis, cameraDirPdfA, lightRevPdfW,
-                              lightDirPdfA, cameraRevPdfW, lightMerge, cameraMerge);
+        ub_mis_weight_connect(mis_, lightMis, state.mis, cameraDirPdfA, lightRevPdfW, lightDirPdfA,
+                              cameraRevPdfW, lightMerge, cameraMerge);
     const Rgb contrib = fCamera * fLight * transmittance * (weight * geometry);
     if (isBlack(contrib)) return Rgb(0.0f);
     if (!useMedia_ && scene_.occluded(v.pos, v.hit.geoNormal, lv.position, lv.geoNormal))

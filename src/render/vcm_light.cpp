@@ -178,11 +178,10 @@ void VertexCM::connectToCamera(const SubPath& state, const PathVertex& v,
 
     // Light tracing alone has no MIS; otherwise the weight of [TR (46), (47)], with the
     // merging factor of v whose R_out is that of the camera ray (ub_mis_volume.h).
-    const ub_mis_factor factor =
-        ub_mis_vertex_factor(mis_, v.inMedium, 0, 1, ratioIn(state, v),
-                             length(cross(state.ray.dir, dirToCamera)));
-    const float merge = ub_mis_factor_total(
-        mis_, factor, ub_mis_query_ratio(mis_, passToVertex, distPdfToVertex));
+    const ub_mis_factor factor = ub_mis_vertex_factor(mis_, v.inMedium, 0, 1, ratioIn(state, v),
+                                                      length(cross(state.ray.dir, dirToCamera)));
+    const float merge =
+        ub_mis_factor_total(mis_, factor, ub_mis_query_ratio(mis_, passToVertex, distPdfToVertex));
     const float weight = lightTraceOnly_ ? 1.0f
                                          : ub_mis_weight_light_trace(mis_, state.mis, cameraPdfA,
                                                                      bsdfRevPdfW, merge);
