@@ -277,3 +277,34 @@ TEST(Upbp, RejectsBadOptions) {
     ASSERT_NE(engine, nullptr);
     EXPECT_EQ(engine->upbpTechniques().describe(), "bpt+surf");
 }
+
+// The technique layers of an iteration sum to its image (up to float rounding of the
+// different summation order), and each enabled technique has one.
+TEST(Upbp, TechniqueLayersSumToTheImage) {
+    auto scene = loadJsonFile(std::string(UNIBEAM_SOURCE_DIR) + "/scenes", "cornell-fog.json", 24);
+    for (const char* set : {"upbp", "upbp:pp3d+bb1d"}) {
+        RenderOptions opt;
+        opt.algorithm = set;
+        opt.seed = 12;
+        auto integrator = makeIntegrator(*scene, opt);
+        Image img;
+        integrator->renderIteration(0, img);
+        const std::vector<std::string> names = integrator->layerNames();
+        const std::vector<Image>* layers = integrator->iterationLayers();
+        ASSERT_NE(layers, nullptr);
+        ASSERT_EQ(layers->size(), names.size());
+        EXPECT_EQ(names.size(), std::string(set) == "upbp" ? 6u : 3u) << set;
+        double total = 0, nonzeroLayers = 0;
+        for (const Image& l : *layers) nonzeroLayers += average(l.mean()) > 0.0f;
+        for (size_t i = 0; i < img.pixels.size(); ++i)
+            for (int c = 0; c < 3; ++c) {
+                double sum = 0;
+                for (const Image& l : *layers) sum += l.pixels[i][c];
+                ASSERT_NEAR(sum, img.pixels[i][c], 1e-5 * std::fabs(img.pixels[i][c]) + 1e-7)
+                    << set << " pixel " << i;
+                total += img.pixels[i][c];
+            }
+        EXPECT_GT(total, 0.0);
+        EXPECT_GE(nonzeroLayers, double(names.size()) - 1.0) << set;
+    }
+}

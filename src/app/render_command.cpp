@@ -164,8 +164,13 @@ int runRender(const RenderArgs& args) {
     meta["maxPathLength"] = std::to_string(options.maxPathLength);
     meta["mis"] = args.mis;
     meta["interrupted"] = result.interrupted ? "true" : "false";
+    if (!result.layers.empty()) {
+        std::string names;
+        for (const auto& l : result.layers) names += (names.empty() ? "" : ",") + l.first;
+        meta["layers"] = names;
+    }
     if (!exrPath.empty()) {
-        writeExr(exrPath, result.image, meta);
+        writeExr(exrPath, result.image, meta, result.layers);
         std::fprintf(stderr, "unibeam: wrote %s\n", exrPath.c_str());
     }
     if (!args.variancePath.empty()) {
@@ -183,6 +188,21 @@ int runRender(const RenderArgs& args) {
         writePng(args.pngPath, result.image, args.exposure);
         std::fprintf(stderr, "unibeam: wrote %s\n", args.pngPath.c_str());
     }
+    if (!result.layers.empty()) {
+        // Each technique's share of the image (layer mean over image mean, channel average).
+        const double total = average(result.image.mean());
+        std::string shares;
+        for (const auto& l : result.layers) {
+            char buf[64];
+            std::snprintf(buf, sizeof(buf), "%s%s %.1f%%", shares.empty() ? "" : ", ",
+                          l.first.c_str(),
+                          total > 0.0 ? 100.0 * double(average(l.second.mean())) / total : 0.0);
+            shares += buf;
+        }
+        std::fprintf(stderr, "unibeam: technique shares of the image: %s\n", shares.c_str());
+    }
+    const std::string summary = integrator->iterationSummary();
+    if (!summary.empty()) std::fprintf(stderr, "unibeam: %s\n", summary.c_str());
     std::fprintf(stderr, "unibeam: %d iterations in %s (%.3f s/iteration)\n", result.iterations,
                  formatSeconds(result.seconds).c_str(),
                  result.iterations > 0 ? result.seconds / result.iterations : 0.0);

@@ -99,19 +99,32 @@ Image readExr(const std::string& path, ImageMetadata* metadata) {
 }
 
 void writeExr(const std::string& path, const Image& img, const ImageMetadata& metadata) {
+    writeExr(path, img, metadata, {});
+}
+
+void writeExr(const std::string& path, const Image& img, const ImageMetadata& metadata,
+              const std::vector<std::pair<std::string, Image>>& layers) {
     Imf::Header h(img.width, img.height);
-    h.channels().insert("R", Imf::Channel(Imf::FLOAT));
-    h.channels().insert("G", Imf::Channel(Imf::FLOAT));
-    h.channels().insert("B", Imf::Channel(Imf::FLOAT));
+    std::vector<std::pair<std::string, const Image*>> all = {{"", &img}};
+    for (const auto& l : layers) {
+        if (l.second.width != img.width || l.second.height != img.height)
+            throw std::invalid_argument("writeExr: layer '" + l.first + "' has another size");
+        all.emplace_back(l.first + ".", &l.second);
+    }
+    for (const auto& [prefix, im] : all)
+        for (const char* c : {"R", "G", "B"})
+            h.channels().insert(prefix + c, Imf::Channel(Imf::FLOAT));
     for (const auto& [k, v] : metadata) h.insert(k, Imf::StringAttribute(v));
     try {
         Imf::OutputFile file(path.c_str(), h);
         Imf::FrameBuffer fb;
-        char* base = const_cast<char*>(reinterpret_cast<const char*>(img.pixels.data()));
         size_t xs = sizeof(Rgb), ys = sizeof(Rgb) * img.width;
-        fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
-        fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
-        fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+        for (const auto& [prefix, im] : all) {
+            char* base = const_cast<char*>(reinterpret_cast<const char*>(im->pixels.data()));
+            fb.insert(prefix + "R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+            fb.insert(prefix + "G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+            fb.insert(prefix + "B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+        }
         file.setFrameBuffer(fb);
         file.writePixels(img.height);
     } catch (const std::exception& e) {

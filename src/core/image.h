@@ -4,7 +4,9 @@
 #pragma once
 
 #include <map>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/vec.h"
@@ -38,6 +40,10 @@ float srgbToLinear(float encoded);
 /// Writes 32-bit float RGB with the given string attributes. Throws std::runtime_error on I/O
 /// failure.
 void writeExr(const std::string& path, const Image& img, const ImageMetadata& metadata = {});
+/// The same with extra layers, written as channels NAME.R, NAME.G, NAME.B (each layer the size
+/// of img).
+void writeExr(const std::string& path, const Image& img, const ImageMetadata& metadata,
+              const std::vector<std::pair<std::string, Image>>& layers);
 /// Writes an 8-bit sRGB PNG of img * 2^exposure (clamped). Throws std::runtime_error on failure.
 void writePng(const std::string& path, const Image& img, float exposure = 0.0f);
 

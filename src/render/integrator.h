@@ -47,6 +47,13 @@ class Integrator {
     /// Renders iteration `iteration` (0-based) into `out` (width x height of the camera),
     /// overwriting it with this iteration's estimate (one sample per pixel).
     virtual void renderIteration(int iteration, Image& out) = 0;
+    /// Names of the per-technique layers the integrator splits its image into (UPBP: its
+    /// techniques); empty if none. The layers of an iteration sum to its image.
+    virtual std::vector<std::string> layerNames() const { return {}; }
+    /// The last iteration's layers, in layerNames() order (nullptr if none).
+    virtual const std::vector<Image>* iterationLayers() const { return nullptr; }
+    /// One line about the last iteration's work (counts of records etc.), or empty.
+    virtual std::string iterationSummary() const { return ""; }
 };
 
 /// Names accepted by makeIntegrator, for help texts and error messages.

@@ -48,6 +48,8 @@ ProgressiveResult renderProgressive(Integrator& integrator, int width, int heigh
 
     Film film(width, height);
     Image iterationImage(width, height);
+    const std::vector<std::string> layerNames = integrator.layerNames();
+    std::vector<Film> layerFilms(layerNames.size(), Film(width, height));
     ProgressiveResult result;
     // Welford's running mean and sum of squared deviations, per pixel and channel.
     std::vector<double> wMean, wM2;
@@ -66,6 +68,9 @@ ProgressiveResult renderProgressive(Integrator& integrator, int width, int heigh
         }
         integrator.renderIteration(it, iterationImage);
         film.addIteration(iterationImage);
+        if (const std::vector<Image>* layers = integrator.iterationLayers())
+            for (size_t l = 0; l < layerFilms.size() && l < layers->size(); ++l)
+                layerFilms[l].addIteration((*layers)[l]);
         if (options.computeVariance) {
             for (size_t i = 0; i < iterationImage.pixels.size(); ++i)
                 for (int c = 0; c < 3; ++c) {
@@ -97,6 +102,8 @@ ProgressiveResult renderProgressive(Integrator& integrator, int width, int heigh
     result.iterations = film.iterations();
     result.seconds = elapsed();
     result.image = film.average();
+    for (size_t l = 0; l < layerFilms.size(); ++l)
+        result.layers.emplace_back(layerNames[l], layerFilms[l].average());
     if (options.computeVariance && result.iterations >= 2) {
         result.variance = Image(width, height);
         for (size_t i = 0; i < result.variance.pixels.size(); ++i)

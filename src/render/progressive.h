@@ -19,6 +19,9 @@
 
 #include <atomic>
 #include <functional>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "core/image.h"
 #include "render/integrator.h"
@@ -52,6 +55,8 @@ struct ProgressiveResult {
     /// variance of the iteration images, sum (x_i - mean)^2 / (n - 1) (Welford's update in
     /// double precision). The variance of `image` is variance / iterations.
     Image variance;
+    /// The integrator's per-technique layers (Integrator::layerNames), averaged like image.
+    std::vector<std::pair<std::string, Image>> layers;
     int iterations = 0;
     double seconds = 0;        ///< wall-clock time of the iterations
     bool interrupted = false;  ///< stopped by the stop flag before the target was reached

@@ -5,7 +5,9 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "core/error.h"
@@ -148,6 +150,14 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
         for (const Light& light : scene.lights)
             lightStacks_.push_back(lightStartStack(scene, light));
     }
+    if (algorithm_ == Algorithm::Upbp) {
+        layerNames_.push_back(upbp_.bpt ? "bpt" : "emitted");
+        if (upbp_.surf) layerNames_.push_back("surf");
+        if (upbp_.pp3d) layerNames_.push_back("pp3d");
+        if (upbp_.pb2d) layerNames_.push_back("pb2d");
+        if (upbp_.bp2d) layerNames_.push_back("bp2d");
+        if (upbp_.bb1d) layerNames_.push_back("bb1d");
+    }
     baseRadius_ = options.radius * (options.radiusIsRelative ? scene.sceneSphere.radius : 1.0f);
     lightPickProb_ = scene.lights.empty() ? 0.0f : 1.0f / float(scene.lights.size());
     splats_.reset(scene.camera.width(), scene.camera.height());
@@ -227,18 +237,45 @@ void VertexCM::renderIteration(int iteration, Image& out) {
 
     // (3) Camera pass: one subpath per pixel (lt traces only the primary ray, for
     // directly visible emitters). Each pixel has its own random stream.
+    const bool layered = !layerNames_.empty();
     cameraRows_.resize(size_t(height));
     tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
         for (int y = r.begin(); y != r.end(); ++y) {
             CameraRecords& rec = cameraRows_[size_t(y)];
             rec.points.clear();
             rec.beams.clear();
+            if (layered && useVM_) rec.surf.assign(size_t(width), Rgb(0.0f));
             for (int x = 0; x < width; ++x) out.at(x, y) = traceCameraPath(x, y, iteration, &rec);
         }
     });
 
-    // (4) Light-tracing splats, added in a fixed order.
-    splats_.resolve(out);
+    // (4) Light-tracing splats, added in a fixed order. UPBP layers: the camera pass without
+    // surface merging plus the splats is the first layer, surface merging its own.
+    Image* volumeLayers[4] = {nullptr, nullptr, nullptr, nullptr};
+    if (layered) {
+        layers_.resize(layerNames_.size());
+        for (Image& l : layers_) l = Image(width, height);
+        Image& first = layers_[0];
+        first = out;
+        // Resolved into both (rather than once and copied), so that the beauty image gets the
+        // same additions in the same order as without layers (upbp:bpt is vbpt bit for bit).
+        splats_.resolve(first);
+        splats_.resolve(out);
+        size_t next = 1;
+        Image* surf = useVM_ ? &layers_[next++] : nullptr;
+        const bool on[4] = {upbp_.pp3d, upbp_.pb2d, upbp_.bp2d, upbp_.bb1d};
+        for (int t = 0; t < 4; ++t)
+            if (on[t]) volumeLayers[t] = &layers_[next++];
+        if (surf)
+            for (int y = 0; y < height; ++y)
+                for (int x = 0; x < width; ++x) {
+                    const Rgb m = cameraRows_[size_t(y)].surf[size_t(x)];
+                    surf->at(x, y) = m;
+                    out.at(x, y) += m;
+                }
+    } else {
+        splats_.resolve(out);
+    }
 
     // (5) UPBP estimate pass: the volumetric estimators over the recorded queries, added to
     // their pixels in query order (estimators/volume_estimate.h).
@@ -262,7 +299,18 @@ void VertexCM::renderIteration(int iteration, Image& out) {
         in.photonBeams = &photonBeams_;
         in.queryPoints = &queryPoints_;
         in.queryBeams = &queryBeams_;
-        estimateVolume(in, &out, nullptr);
+        std::array<Image, 4> perTech;
+        if (layered)
+            for (int t = 0; t < 4; ++t)
+                if (volumeLayers[t]) perTech[size_t(t)] = Image(width, height);
+        VolumeEstimateStats stats;
+        estimateVolume(in, &out, layered ? &perTech : nullptr, &stats);
+        for (int t = 0; t < 4; ++t) {
+            if (volumeLayers[t]) *volumeLayers[t] = std::move(perTech[size_t(t)]);
+            lastPairs_[t] = stats.pairs[t];
+        }
+        lastBuildSeconds_ = stats.buildSeconds;
+        lastEstimateSeconds_ = stats.estimateSeconds;
     }
 }
 
@@ -385,6 +433,20 @@ bool VertexCM::sampleScattering(Rng& rng, const VertexScatter& scatter, const Pa
     state.rayFromMedium = v.inMedium;
     if (nullEvent) --state.pathLength;  // not a vertex of the path's length
     return true;
+}
+
+std::string VertexCM::iterationSummary() const {
+    if (algorithm_ != Algorithm::Upbp) return "";
+    char buf[512];
+    std::snprintf(buf, sizeof(buf),
+                  "upbp (%s), last iteration: %zu light vertices, %zu photon points, %zu photon "
+                  "beam pieces (%d beam paths), %zu query points, %zu query beam pieces; kernel "
+                  "pairs pp3d %zu, pb2d %zu, bp2d %zu, bb1d %zu; lookups %.3f s, estimates %.3f s",
+                  upbp_.describe().c_str(), lightVertices_.size(), photonPoints_.size(),
+                  photonBeams_.size(), beamPaths_, queryPoints_.size(), queryBeams_.size(),
+                  lastPairs_[0], lastPairs_[1], lastPairs_[2], lastPairs_[3], lastBuildSeconds_,
+                  lastEstimateSeconds_);
+    return buf;
 }
 
 float VertexCM::ratioIn(const SubPath& state, const PathVertex& v) const {

@@ -80,6 +80,13 @@ class VertexCM : public Integrator {
     /// media set-up vlt/vbpt cannot render (see above).
     VertexCM(const Scene& scene, const RenderOptions& options);
     void renderIteration(int iteration, Image& out) override;
+    /// UPBP: one layer per technique run ("bpt", or "emitted" without bpt: what the camera
+    /// pass adds besides merging; "surf", "pp3d", "pb2d", "bp2d", "bb1d").
+    std::vector<std::string> layerNames() const override { return layerNames_; }
+    const std::vector<Image>* iterationLayers() const override {
+        return layerNames_.empty() ? nullptr : &layers_;
+    }
+    std::string iterationSummary() const override;
 
     Algorithm algorithm() const { return algorithm_; }
     /// True if subpaths are traced through participating media (vlt/vbpt on a scene with
@@ -164,6 +171,7 @@ class VertexCM : public Integrator {
     struct CameraRecords {
         std::vector<ub_query_point> points;
         std::vector<ub_beam> beams;
+        std::vector<Rgb> surf;  ///< UPBP layers: surface merging per pixel of the row
     };
 
     // Light pass (vcm_light.cpp): traces light subpaths [begin, end) of an iteration.
@@ -218,6 +226,10 @@ class VertexCM : public Integrator {
     std::vector<ub_query_point> queryPoints_;
     std::vector<ub_beam> queryBeams_;
     float volumeRadius_[4] = {0, 0, 0, 0};  ///< this iteration's radii (UB_TECH_*), 0: off
+    std::vector<std::string> layerNames_;   ///< UPBP technique layers
+    std::vector<Image> layers_;             ///< the last iteration's layers
+    double lastBuildSeconds_ = 0, lastEstimateSeconds_ = 0;
+    size_t lastPairs_[4] = {0, 0, 0, 0};
     SplatBuffer splats_;
 };
 

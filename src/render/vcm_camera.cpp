@@ -109,7 +109,11 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
             }
         }
         if (!atLimit && !scatter.isDelta() && useVM_ && !v.inMedium) {
-            color += state.throughput * mergeVertices(state, v.hit, scatter.bsdf());
+            const Rgb merged = state.throughput * mergeVertices(state, v.hit, scatter.bsdf());
+            if (!records->surf.empty())  // UPBP layers: kept apart, added by the caller
+                records->surf[size_t(x)] += merged;
+            else
+                color += merged;
             if (ppm_) break;  // PPM merges at the first non-specular camera vertex only
         }
         if (!sampleScattering(rng, scatter, v, state, atLimit)) break;
