@@ -25,10 +25,13 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/rng.h"
+#include "estimators/beam_medium.h"
 #include "render/integrator.h"
 #include "render/upbp_techniques.h"
 #include "render/vcm.h"
 #include "scene/io/json_loader.h"
+#include "scene/medium.h"
 #include "scene/vdb_grid.h"
 #include "tests/support/render_stats.h"
 #include "tests/support/volume_scenes.h"
@@ -307,4 +310,44 @@ TEST(Upbp, TechniqueLayersSumToTheImage) {
         EXPECT_GT(total, 0.0);
         EXPECT_GE(nonzeroLayers, double(names.size()) - 1.0) << set;
     }
+}
+
+// The tabulated medium along a beam (estimators/beam_medium.h) gives what a walk from the
+// beam start to t gives (scene/medium.h evalMediumSegment), to float rounding, in a grid
+// (the smoke plume), at random t and at both ends.
+TEST(Upbp, TabulatedBeamMediumEqualsTheWalk) {
+    auto scene = loadJsonFile(std::string(UNIBEAM_SOURCE_DIR) + "/scenes", "cornell-smoke.json", 8);
+    ASSERT_EQ(scene->media[0].type, MediumType::kGrid);
+    ub::Rng rng(5, 9);
+    int compared = 0;
+    for (int n = 0; n < 200; ++n) {
+        ub_beam b{};
+        const Vec3 o(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() * 1.2f - 0.6f);
+        const Vec3 d =
+            normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f));
+        for (int a = 0; a < 3; ++a) {
+            b.origin[a] = o[a];
+            b.dir[a] = d[a];
+        }
+        b.length = 2.0f * rng.uniform();
+        b.mediumId = 0;
+        BeamMedium bm;
+        bm.reset(*scene, b);
+        bm.build();
+        for (int k = 0; k < 10; ++k) {
+            const float t = k == 0 ? 0.0f : (k == 9 ? b.length : b.length * rng.uniform());
+            const ub_segment_eval e = bm.eval(t);
+            const MediumSegment s = evalMediumSegment(scene->media[0], o, d, t);
+            auto near = [](float a, float b) {
+                return std::fabs(a - b) <= 1e-4f * std::fabs(b) + 1e-6f;
+            };
+            ASSERT_TRUE(near(e.transmittance[0], s.transmittance[0])) << n << " t " << t;
+            ASSERT_TRUE(near(e.stopFwdL, s.pdfScatterFwdL())) << n << " t " << t;
+            ASSERT_TRUE(near(e.stopRevStartL, s.pdfScatterRevL())) << n << " t " << t;
+            ASSERT_TRUE(near(e.passProb, s.probPass())) << n << " t " << t;
+            for (int a = 0; a < 3; ++a) ASSERT_TRUE(near(e.sigmaS[a], s.sigmaS1[a])) << n;
+            ++compared;
+        }
+    }
+    EXPECT_EQ(compared, 2000);
 }

@@ -12,6 +12,7 @@
 
 #include <atomic>
 
+#include "estimators/beam_medium.h"
 #include "estimators/bvh.h"
 #include "estimators/volume_estimate.h"
 #include "kernels/shared/ub_bb1d.h"
@@ -20,7 +21,8 @@
 namespace ub {
 
 void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
-                  const std::vector<BeamPart>& parts, std::vector<Rgb>* out, size_t* pairs) {
+                  const std::vector<BeamPart>& parts, const std::vector<BeamMedium>& photonMedia,
+                  std::vector<Rgb>* out, size_t* pairs) {
     const std::vector<ub_beam>& beams = *in.photonBeams;
     const std::vector<ub_beam>& queries = *in.queryBeams;
     if (beams.empty() || queries.empty()) return;
@@ -35,6 +37,8 @@ void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
                 const ub_beam& qb = queries[i];
                 const float g = in.scene->media[qb.mediumId].g;
                 const ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
+                BeamMedium queryMedium;  // tabulated when the first pair is found
+                queryMedium.reset(*in.scene, qb);
                 Rgb sum(0.0f);
                 beamParts.querySegment(
                     Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length, [&](uint32_t k) {
@@ -50,8 +54,9 @@ void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
                         if (d2 < 0.0f || d2 > r * r) return;
                         if (tc < 0.0f || tc > qb.length || tl < 0.0f || tl > pb.length) return;
                         if (tl < part.t0 || (tl >= part.t1 && part.t1 < pb.length)) return;
-                        const ub_segment_eval sl = evalBeamMedium(*in.scene, pb, tl);
-                        const ub_segment_eval sc = evalBeamMedium(*in.scene, qb, tc);
+                        if (!queryMedium.built()) queryMedium.build();
+                        const ub_segment_eval sl = photonMedia[part.beam].eval(tl);
+                        const ub_segment_eval sc = queryMedium.eval(tc);
                         const ub_float3 c = ub_bb1d_contribution(in.mis, pb, qb, sl, sc, tl, tc,
                                                                  sinTheta, g, normalization);
                         sum += Rgb(c.x, c.y, c.z);

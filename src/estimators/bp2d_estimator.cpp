@@ -10,6 +10,7 @@
 
 #include <atomic>
 
+#include "estimators/beam_medium.h"
 #include "estimators/bvh.h"
 #include "estimators/volume_estimate.h"
 #include "kernels/shared/ub_bp2d.h"
@@ -18,7 +19,8 @@
 namespace ub {
 
 void estimateBP2D(const VolumeEstimateInput& in, const Bvh& beamParts,
-                  const std::vector<BeamPart>& parts, std::vector<Rgb>* out, size_t* pairs) {
+                  const std::vector<BeamPart>& parts, const std::vector<BeamMedium>& photonMedia,
+                  std::vector<Rgb>* out, size_t* pairs) {
     const std::vector<ub_beam>& beams = *in.photonBeams;
     const std::vector<ub_query_point>& queries = *in.queryPoints;
     if (beams.empty() || queries.empty()) return;
@@ -46,7 +48,7 @@ void estimateBP2D(const VolumeEstimateInput& in, const Bvh& beamParts,
                     if (d2 < 0.0f || d2 > r * r) return;
                     // The part holding the projection counts the beam (once per beam).
                     if (t < part.t0 || (t >= part.t1 && part.t1 < pb.length)) return;
-                    const ub_segment_eval s = evalBeamMedium(*in.scene, pb, t);
+                    const ub_segment_eval s = photonMedia[part.beam].eval(t);
                     const ub_float3 c = ub_bp2d_contribution(in.mis, pb, q, s, t, g, normalization);
                     sum += Rgb(c.x, c.y, c.z);
                     ++n;

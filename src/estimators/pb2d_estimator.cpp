@@ -12,6 +12,7 @@
 
 #include <atomic>
 
+#include "estimators/beam_medium.h"
 #include "estimators/bvh.h"
 #include "estimators/volume_estimate.h"
 #include "kernels/shared/ub_pb2d.h"
@@ -35,6 +36,8 @@ void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres, std::
                 const ub_beam& qb = queries[i];
                 const float g = in.scene->media[qb.mediumId].g;
                 const ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
+                BeamMedium queryMedium;  // tabulated when the first pair is found
+                queryMedium.reset(*in.scene, qb);
                 Rgb sum(0.0f);
                 photonSpheres.querySegment(
                     Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length, [&](uint32_t j) {
@@ -47,7 +50,8 @@ void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres, std::
                         const float d2 =
                             ub_point_beam_dist2(ub_f3_from(ph.pos), o, d, qb.length, &t);
                         if (d2 < 0.0f || d2 > r * r) return;
-                        const ub_segment_eval s = evalBeamMedium(*in.scene, qb, t);
+                        if (!queryMedium.built()) queryMedium.build();
+                        const ub_segment_eval s = queryMedium.eval(t);
                         const ub_float3 c =
                             ub_pb2d_contribution(in.mis, ph, qb, s, t, g, normalization);
                         sum += Rgb(c.x, c.y, c.z);

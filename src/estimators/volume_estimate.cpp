@@ -2,10 +2,13 @@
 // volume_estimate.h). The estimators themselves are in *_estimator.cpp.
 #include "estimators/volume_estimate.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
+#include "estimators/beam_medium.h"
 #include "estimators/bvh.h"
 #include "estimators/hash_grid.h"
 #include "scene/medium.h"
@@ -35,22 +38,6 @@ Vec3 vec(const float v[3]) {
 }
 
 }  // namespace
-
-ub_segment_eval evalBeamMedium(const Scene& scene, const ub_beam& b, float t) {
-    const Medium& m = scene.media[b.mediumId];
-    const MediumSegment s = evalMediumSegment(m, vec(b.origin), vec(b.dir), t);
-    ub_segment_eval e;
-    for (int a = 0; a < 3; ++a) {
-        e.transmittance[a] = s.transmittance[a];
-        e.sigmaS[a] = s.sigmaS1[a];
-    }
-    e.stopFwdL = s.pdfScatterFwdL();
-    e.stopRevStartL = s.pdfScatterRevL();
-    e.passProb = s.probPass();
-    e.contProb = ub_medium_cont_prob(s.sigmaS1[0], s.sigmaS1[1], s.sigmaS1[2], s.sigmaT1[0],
-                                     s.sigmaT1[1], s.sigmaT1[2]);
-    return e;
-}
 
 void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Image, 4>* layers,
                     VolumeEstimateStats* stats) {
@@ -97,8 +84,15 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         }
         beamBvh.build(boxes);
     }
+    // The medium along every photon beam, tabulated once (estimators/beam_medium.h).
+    std::vector<BeamMedium> photonMedia(t.photonBeams() ? beams.size() : 0);
+    tbb::parallel_for(size_t(0), photonMedia.size(), [&](size_t i) {
+        photonMedia[i].reset(*in.scene, beams[i]);
+        photonMedia[i].build();
+    });
+    for (const BeamMedium& m : photonMedia) st.lookupBytes += m.bytes();
     st.buildSeconds = secondsSince(t0);
-    st.lookupBytes = spheres.bytes() + beamBvh.bytes() + parts.size() * sizeof(BeamPart);
+    st.lookupBytes += spheres.bytes() + beamBvh.bytes() + parts.size() * sizeof(BeamPart);
 
     t0 = std::chrono::steady_clock::now();
     std::vector<Rgb> perPoint[4], perBeam[4];
@@ -108,7 +102,8 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     }
     if (t.bp2d) {
         perPoint[UB_TECH_BP2D].assign(nPoints, Rgb(0.0f));
-        estimateBP2D(in, beamBvh, parts, &perPoint[UB_TECH_BP2D], &st.pairs[UB_TECH_BP2D]);
+        estimateBP2D(in, beamBvh, parts, photonMedia, &perPoint[UB_TECH_BP2D],
+                     &st.pairs[UB_TECH_BP2D]);
     }
     if (t.pb2d) {
         perBeam[UB_TECH_PB2D].assign(nBeams, Rgb(0.0f));
@@ -116,7 +111,8 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     }
     if (t.bb1d) {
         perBeam[UB_TECH_BB1D].assign(nBeams, Rgb(0.0f));
-        estimateBB1D(in, beamBvh, parts, &perBeam[UB_TECH_BB1D], &st.pairs[UB_TECH_BB1D]);
+        estimateBB1D(in, beamBvh, parts, photonMedia, &perBeam[UB_TECH_BB1D],
+                     &st.pairs[UB_TECH_BB1D]);
     }
     st.estimateSeconds = secondsSince(t0);
 

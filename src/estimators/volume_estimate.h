@@ -55,9 +55,6 @@ struct VolumeEstimateStats {
     size_t lookupBytes = 0;
 };
 
-/// The medium along beam b from its piece start to distance t.
-ub_segment_eval evalBeamMedium(const Scene& scene, const ub_beam& b, float t);
-
 /// Adds every enabled volumetric technique's estimate to its query's pixel of `image` (and
 /// of layers[UB_TECH_*] if layers is given; each layer the size of the image).
 void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Image, 4>* layers,
@@ -67,6 +64,7 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
 // query i to out[i].
 class HashGrid;
 class Bvh;
+class BeamMedium;
 struct BeamPart {
     uint32_t beam;
     float t0, t1;  ///< parameter range of the part on its beam
@@ -75,9 +73,12 @@ void estimatePP3D(const VolumeEstimateInput& in, const HashGrid& grid, std::vect
                   size_t* pairs);
 void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres, std::vector<Rgb>* out,
                   size_t* pairs);
+/// photonMedia[i]: the medium along photon beam i, built (estimators/beam_medium.h).
 void estimateBP2D(const VolumeEstimateInput& in, const Bvh& beamParts,
-                  const std::vector<BeamPart>& parts, std::vector<Rgb>* out, size_t* pairs);
+                  const std::vector<BeamPart>& parts, const std::vector<BeamMedium>& photonMedia,
+                  std::vector<Rgb>* out, size_t* pairs);
 void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
-                  const std::vector<BeamPart>& parts, std::vector<Rgb>* out, size_t* pairs);
+                  const std::vector<BeamPart>& parts, const std::vector<BeamMedium>& photonMedia,
+                  std::vector<Rgb>* out, size_t* pairs);
 
 }  // namespace ub

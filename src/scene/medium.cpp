@@ -221,6 +221,16 @@ MediumCoefficients mediumCoefficientsAt(const Medium& m, const Vec3& p) {
     return c;
 }
 
+bool gridPieces(const Medium& m, const Vec3& origin, const Vec3& dir, float length,
+                const std::function<void(float, float, float)>& visit) {
+    if (m.type != MediumType::kGrid || m.filter == GridFilter::kTrilinear) return false;
+    forEachPiece(m, origin, dir, length, [&](float ta, float tb, const Rgb& sigmaT, const Rgb&) {
+        visit(ta, tb, sigmaT.x);  // grid extinction is grey (density x scale)
+        return true;
+    });
+    return true;
+}
+
 Rgb transmittance(const Medium& m, const Vec3& origin, const Vec3& dir, float length) {
     if (m.type == MediumType::kGrid && m.filter == GridFilter::kTrilinear)
         return trilinearTransmittance(m, origin, dir, length);

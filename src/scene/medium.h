@@ -46,6 +46,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 
 #include "core/vec.h"
@@ -155,6 +156,12 @@ struct MediumSegment {
 
 /// Evaluates the segment by regular tracking (exact for the piecewise-constant grid).
 MediumSegment evalMediumSegment(const Medium& m, const Vec3& origin, const Vec3& dir, float length);
+/// The pieces of constant extinction of a grid medium along [0, length] of a ray, in order
+/// (regular tracking, the walk evalMediumSegment makes): visit(ta, tb, sigmaT) per piece.
+/// Returns false, visiting nothing, for media that are not piecewise constant along rays
+/// (homogeneous media, where one closed form serves every length, and trilinear grids).
+bool gridPieces(const Medium& m, const Vec3& origin, const Vec3& dir, float length,
+                const std::function<void(float, float, float)>& visit);
 /// Transmittance only (the cheaper query, for shadow rays and photon beams).
 Rgb transmittance(const Medium& m, const Vec3& origin, const Vec3& dir, float length);
 

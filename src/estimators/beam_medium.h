@@ -1,0 +1,44 @@
+// The medium along one beam, evaluated at many parameters t: what the beam
+// estimators need at each photon-query pair (estimators/volume_estimate.h).
+//
+// In a grid medium (nearest filtering) the extinction is constant on the pieces
+// regular tracking visits, so the optical depth along the beam is piecewise
+// linear in t: one walk over the whole beam gives a table of pieces (start t,
+// extinction, optical depth at the start), and every later evaluation is a
+// binary search plus an exponential -- the same values as a walk from the beam
+// start to t (scene/medium.h evalMediumSegment), up to the rounding of the sum,
+// at O(log pieces) instead of O(voxels). Homogeneous media use their closed form,
+// trilinear grids evalMediumSegment itself.
+#pragma once
+
+#include <vector>
+
+#include "kernels/shared/ub_upbp_records.h"
+
+namespace ub {
+
+class Scene;
+struct Medium;
+
+class BeamMedium {
+  public:
+    /// Prepares for beam b; build() must follow before eval (query loops call it when they
+    /// find the beam's first pair, so beams without pairs cost nothing).
+    void reset(const Scene& scene, const ub_beam& b);
+    void build();
+    bool built() const { return built_; }
+    /// The medium from the beam's piece start to distance t in [0, b.length] (after build()).
+    ub_segment_eval eval(float t) const;
+    size_t bytes() const { return pieces_.capacity() * sizeof(Piece); }
+
+  private:
+    struct Piece {
+        float t0, sigmaT, tau0;
+    };
+    const Medium* medium_ = nullptr;
+    const ub_beam* beam_ = nullptr;
+    bool tabulated_ = false, built_ = false;
+    std::vector<Piece> pieces_;
+};
+
+}  // namespace ub
