@@ -26,6 +26,7 @@ UB_INLINE ub_float3 ub_bb1d_contribution(ub_mis_constants c, ub_beam pb, ub_beam
                                          float sinTheta, float g, float normalization) {
     ub_beam_point lp = ub_beam_at(c, pb, sl, tl, 1u);
     ub_beam_point cp = ub_beam_at(c, qb, sc, tc, 0u);
+    if (!lp.valid || !cp.valid) return ub_make_float3(0.0f, 0.0f, 0.0f);
     ub_float3 wz = ub_f3_neg(ub_f3_from(qb.dir)), wy = ub_f3_neg(ub_f3_from(pb.dir));
     float phase = ub_hg_eval_dirs(wz, wy, g);
     ub_mis_etas etas = ub_mis_volume_etas(c, lp.rInL, cp.rInL, sinTheta);

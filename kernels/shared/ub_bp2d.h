@@ -24,6 +24,7 @@
 UB_INLINE ub_float3 ub_bp2d_contribution(ub_mis_constants c, ub_beam pb, ub_query_point q,
                                          ub_segment_eval s, float t, float g, float normalization) {
     ub_beam_point lp = ub_beam_at(c, pb, s, t, 1u);
+    if (!lp.valid) return ub_make_float3(0.0f, 0.0f, 0.0f);
     ub_float3 wz = ub_f3_from(q.dirFix), wy = ub_f3_neg(ub_f3_from(pb.dir));
     float phase = ub_hg_eval_dirs(wz, wy, g);
     ub_mis_partials e;

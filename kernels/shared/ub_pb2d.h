@@ -27,6 +27,7 @@
 UB_INLINE ub_float3 ub_pb2d_contribution(ub_mis_constants c, ub_photon_point ph, ub_beam qb,
                                          ub_segment_eval s, float t, float g, float normalization) {
     ub_beam_point cp = ub_beam_at(c, qb, s, t, 0u);
+    if (!cp.valid) return ub_make_float3(0.0f, 0.0f, 0.0f);
     ub_float3 wz = ub_f3_neg(ub_f3_from(qb.dir)), wy = ub_f3_from(ph.dirFix);
     float phase = ub_hg_eval_dirs(wz, wy, g);
     ub_mis_partials l;

@@ -90,6 +90,8 @@ typedef struct {
 
 /* A subpath at a point of one of its beams, as if it had sampled a vertex there. */
 typedef struct {
+    ub_uint valid;        /* 0: the point's free-flight densities underflow (T below ~1e-18);
+                             it contributes nothing measurable and its MIS is not evaluated */
     ub_mis_partials mis;  /* completed at the point (ub_mis_at_hit_volume) */
     float rInL;           /* R of this beam at the point (its kind) */
     ub_float3 throughput; /* at the point: T / P of the piece for short beams, T for long */
@@ -112,6 +114,15 @@ UB_INLINE ub_beam_point ub_beam_at(ub_mis_constants c, ub_beam b, ub_segment_eva
     } else {
         stopRev = s.passProb * b.revPdfBeforeL;
         passRev = s.passProb * b.revPassBefore;
+    }
+    /* Below this density the squares of the power heuristic underflow float (pdf^2 < 1e-36)
+     * and 0 * inf would poison the weight; such points carry T < 1e-18. */
+    out.valid = stopFwd > 1e-18f && stopRev > 1e-18f && s.passProb > 0.0f;
+    if (!out.valid) {
+        out.mis.dVCM = out.mis.dVC = out.mis.dVM = out.mis.dOut = 0.0f;
+        out.rInL = 0.0f;
+        out.throughput = ub_make_float3(0.0f, 0.0f, 0.0f);
+        return out;
     }
     ub_mis_partials p;
     p.dVCM = b.dVCM;

@@ -53,9 +53,8 @@ ub_segment_eval BeamMedium::eval(float t) const {
                                [](float x, const Piece& p) { return x < p.t0; });
     const Piece& p = it == pieces_.begin() ? pieces_.front() : *(it - 1);
     // The walk to t ends in the piece before a boundary at exactly t.
-    const Piece& last = (it != pieces_.begin() && p.t0 == t && it - 1 != pieces_.begin())
-                            ? *(it - 2)
-                            : p;
+    const Piece& last =
+        (it != pieces_.begin() && p.t0 == t && it - 1 != pieces_.begin()) ? *(it - 2) : p;
     const float tau = last.tau0 + last.sigmaT * (t - last.t0);
     const float T = std::exp(-tau);
     const float sigmaT0 = pieces_.front().sigmaT, sigmaT1 = last.sigmaT;
@@ -68,8 +67,8 @@ ub_segment_eval BeamMedium::eval(float t) const {
     e.stopFwdL = sigmaT1 * T;
     e.stopRevStartL = sigmaT0 * T;
     e.passProb = T;
-    e.contProb = ub_medium_cont_prob(e.sigmaS[0], e.sigmaS[1], e.sigmaS[2], sigmaT1, sigmaT1,
-                                     sigmaT1);
+    e.contProb =
+        ub_medium_cont_prob(e.sigmaS[0], e.sigmaS[1], e.sigmaS[2], sigmaT1, sigmaT1, sigmaT1);
     return e;
 }
 

@@ -62,6 +62,10 @@ void appendChainBeams(const Scene& scene, const MediumTrace& trace, const Vec3& 
         if (seg.mediumId >= 0) {
             const Medium& medium = scene.media[size_t(seg.mediumId)];
             if (length >= farLimit) length = escapingBeamLength(scene, medium, seg.origin, dir);
+            // A long beam in a homogeneous medium ends where its transmittance is below 1e-7
+            // in every channel (what lies beyond adds less than 1e-7 of its throughput).
+            if (!src.shortBeams && medium.type == MediumType::kHomogeneous)
+                length = std::min(length, escapingBeamLength(scene, medium, seg.origin, dir));
             if (src.shortBeams && k == visit.count - 1 && cv.scattered)
                 length = visit.length[k];  // up to the vertex
             if (length > 0.0f && scatters(medium)) {

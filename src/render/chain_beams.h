@@ -10,9 +10,9 @@
 //   long beam   runs to the chain's real surface through every medium segment;
 //               its throughput at a piece start is the product of the
 //               transmittances before it.
-// A beam along an escaping ray (an unbounded segment) ends where a homogeneous
-// medium's transmittance is below 1e-7 in every channel, else where the ray
-// leaves the scene's bounding sphere (render/chain_beams.cpp).
+// A long beam in a homogeneous medium ends where its transmittance is below 1e-7
+// in every channel; along an escaping ray (an unbounded segment) in a grid medium
+// it ends where the ray leaves the scene's bounding sphere (render/chain_beams.cpp).
 //
 // Each piece records what ub_beam_at (kernels/shared/ub_upbp_records.h) needs to
 // complete the subpath's MIS partials at any point of it: the pending partials

@@ -30,7 +30,8 @@ struct RenderOptions {
     bool radiusIsRelative = true;
     float alpha = 0.75f;  ///< progressive radius reduction exponent
     /// UPBP's volumetric estimators (render/upbp_techniques.h, docs/algorithms.md): initial
-    /// radii (fractions of the scene bounding-sphere radius if radiusIsRelative) and
+    /// radii (if radiusIsRelative, fractions of the radius of the media: half the diagonal of
+    /// the bounding box of the medium boundaries, or the scene radius with a global medium) and
     /// reduction exponents, r_i = r_1 i^((alpha - 1) / k) for a k-dimensional kernel.
     float radiusPP3D = 0.01f, radiusPB2D = 0.005f, radiusBP2D = 0.005f, radiusBB1D = 0.005f;
     float alphaPP3D = 0.75f, alphaPB2D = 0.75f, alphaBP2D = 0.75f, alphaBB1D = 0.75f;

@@ -150,6 +150,17 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
         for (const Light& light : scene.lights)
             lightStacks_.push_back(lightStartStack(scene, light));
     }
+    // UPBP radii are relative to the size of the media (the bounding sphere of the medium
+    // boundaries, or of the scene with a global medium): a kernel must be small against the
+    // medium it blurs, whatever else the scene holds (a room around a candle).
+    mediaRadius_ = scene.sceneSphere.radius;
+    if (scene.globalMediumId < 0) {
+        Bounds3 media;
+        for (const ShapeInfo& sh : scene.shapes)
+            if (sh.isMediumBoundary && (sh.interiorMediumId >= 0 || sh.exteriorMediumId >= 0))
+                media.extend(sh.bounds);
+        if (!media.empty()) mediaRadius_ = std::max(0.5f * length(media.hi - media.lo), 1e-6f);
+    }
     if (algorithm_ == Algorithm::Upbp) {
         layerNames_.push_back(upbp_.bpt ? "bpt" : "emitted");
         if (upbp_.surf) layerNames_.push_back("surf");
@@ -171,7 +182,7 @@ float VertexCM::volumeRadiusAt(int tech, int iteration) const {
     const float alpha[4] = {options_.alphaPP3D, options_.alphaPB2D, options_.alphaBP2D,
                             options_.alphaBB1D};
     const float dims[4] = {3.0f, 2.0f, 2.0f, 1.0f};
-    const float scale = options_.radiusIsRelative ? scene_.sceneSphere.radius : 1.0f;
+    const float scale = options_.radiusIsRelative ? mediaRadius_ : 1.0f;
     float r = r1[tech] * scale * std::pow(float(iteration + 1), (alpha[tech] - 1.0f) / dims[tech]);
     return std::max(r, 1e-7f);
 }

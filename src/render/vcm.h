@@ -206,6 +206,7 @@ class VertexCM : public Integrator {
     bool useMedia_ = false;  ///< vlt/vbpt/upbp on a scene with media
     UpbpTechniques upbp_;    ///< UPBP techniques (Algorithm::Upbp)
     int beamPaths_ = 0;      ///< N_B
+    float mediaRadius_ = 1;  ///< what relative UPBP radii are fractions of
     /// DepthCounting::kNonNullVertices: null-lobe vertices do not count towards the length.
     bool nullNotCounted_ = false;
     std::vector<MediumStack> lightStacks_;  ///< media where each light's subpaths start

@@ -1,0 +1,137 @@
+// Benchmark: time per iteration and peak memory of `upbp` and of each of its estimators
+// alone (upbp:bpt, upbp:pp3d, upbp:pb2d, upbp:bp2d, upbp:bb1d, upbp:surf...), with SmallUPBP's
+// settings by default: 256x256 (65,536 light subpaths per iteration), 4,000 of them emitting
+// photon beams, radius 0.001 of the scene radius for pp3d/pb2d/bp2d/bb1d (constant), 0.0015
+// with alpha 0.75 for surf, short photon beams, long query beams, maximum path length 12
+// (candle 4), as issue #10 lists them.
+//
+// Each (scene, technique set) runs in a child process (fork), so that its peak resident
+// memory (getrusage of the child) is its own: one warm-up iteration, then the median of
+// `runs` timed iterations (each a fresh, independent one). Also prints the photon, beam and
+// query counts of the last iteration and the image mean (a sanity check). Not run by ctest.
+//
+// Usage: bench_upbp [--runs N] [--sets s1,s2,...] [--resolution WxH] [SCENE ...]
+//   default scenes: cornell-fog, cornell-smoke, forward-scattering (scenes/) and the SmallUPBP
+//   candle, mirrorballs, bunny (scenes/smallupbp/)
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "render/integrator.h"
+#include "scene/io/scene_loader.h"
+
+using namespace ub;
+
+namespace {
+
+std::vector<std::string> splitList(const std::string& list) {
+    std::vector<std::string> out;
+    for (size_t p = 0; p <= list.size();) {
+        size_t q = list.find(',', p);
+        if (q == std::string::npos) q = list.size();
+        if (q > p) out.push_back(list.substr(p, q - p));
+        p = q + 1;
+    }
+    return out;
+}
+
+int runOne(const std::string& path, const std::string& set, int runs, int width, int height) {
+    std::vector<Diagnostic> warnings;
+    std::unique_ptr<Scene> scene = loadScene(path, &warnings);
+    scene->camera = scene->camera.resized(width, height, scene->settings.keepHorizontalFov);
+    RenderOptions opt;
+    opt.algorithm = set;
+    const bool candle = path.find("candle") != std::string::npos;
+    opt.maxPathLength = candle ? 4 : 12;
+    opt.seed = 1234;
+    opt.radius = 0.0015f;
+    opt.alpha = 0.75f;
+    opt.radiusPP3D = opt.radiusPB2D = opt.radiusBP2D = opt.radiusBB1D = 0.001f;
+    opt.alphaPP3D = opt.alphaPB2D = opt.alphaBP2D = opt.alphaBB1D = 1.0f;
+    opt.shortPhotonBeams = true;
+    opt.shortQueryBeams = false;
+    opt.beamPaths = 4000;
+    std::unique_ptr<Integrator> integrator = makeIntegrator(*scene, opt);
+    Image img;
+    integrator->renderIteration(0, img);
+    std::vector<double> times;
+    for (int r = 0; r < runs; ++r) {
+        const auto t0 = std::chrono::steady_clock::now();
+        integrator->renderIteration(r + 1, img);
+        times.push_back(
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
+    std::sort(times.begin(), times.end());
+    const Rgb mean = img.mean();
+    std::printf("%-14s %-16s %9.3f s/it  mean %.4g %.4g %.4g\n", std::filesystem::path(path).stem().string().c_str(),
+                set.c_str(), times[times.size() / 2], mean.x, mean.y, mean.z);
+    const std::string summary = integrator->iterationSummary();
+    if (!summary.empty()) std::printf("    %s\n", summary.c_str());
+    std::fflush(stdout);
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    int runs = 3, width = 256, height = 256;
+    std::vector<std::string> scenes,
+        sets = {"upbp:bpt", "upbp:pp3d", "upbp:pb2d", "upbp:bp2d", "upbp:bb1d", "upbp"};
+    for (int i = 1; i < argc; ++i) {
+        std::string a = argv[i];
+        if (a == "--runs" && i + 1 < argc) {
+            runs = std::max(1, std::atoi(argv[++i]));
+        } else if (a == "--sets" && i + 1 < argc) {
+            sets = splitList(argv[++i]);
+        } else if (a == "--resolution" && i + 1 < argc) {
+            if (std::sscanf(argv[++i], "%dx%d", &width, &height) != 2 || width < 1 || height < 1) {
+                std::fprintf(stderr, "bench_upbp: --resolution expects WxH\n");
+                return 2;
+            }
+        } else {
+            scenes.push_back(a);
+        }
+    }
+    const std::string dir = std::string(UNIBEAM_SOURCE_DIR) + "/scenes/";
+    if (scenes.empty()) {
+        for (const char* s : {"cornell-fog", "cornell-smoke", "forward-scattering"})
+            scenes.push_back(dir + s + ".json");
+        for (const char* s : {"candle", "mirrorballs", "bunny"})
+            scenes.push_back(dir + "smallupbp/" + s + "/" + s + ".obj");
+    }
+    std::printf("bench_upbp: %dx%d, median of %d iterations, peak resident memory per run\n",
+                width, height, runs);
+    for (const std::string& scene : scenes)
+        for (const std::string& set : sets) {
+            std::fflush(stdout);
+            const pid_t pid = fork();
+            if (pid < 0) {
+                std::perror("fork");
+                return 1;
+            }
+            if (pid == 0) {
+                try {
+                    std::_Exit(runOne(scene, set, runs, width, height));
+                } catch (const std::exception& e) {
+                    std::fprintf(stderr, "bench_upbp: %s %s: %s\n", scene.c_str(), set.c_str(),
+                                 e.what());
+                    std::_Exit(1);
+                }
+            }
+            int status = 0;
+            rusage ru{};
+            wait4(pid, &status, 0, &ru);
+            std::printf("    peak memory %.0f MB%s\n", double(ru.ru_maxrss) / 1024.0,
+                        WIFEXITED(status) && WEXITSTATUS(status) == 0 ? "" : " (failed)");
+        }
+    return 0;
+}
