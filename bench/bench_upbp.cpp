@@ -72,8 +72,9 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
     }
     std::sort(times.begin(), times.end());
     const Rgb mean = img.mean();
-    std::printf("%-14s %-16s %9.3f s/it  mean %.4g %.4g %.4g\n", std::filesystem::path(path).stem().string().c_str(),
-                set.c_str(), times[times.size() / 2], mean.x, mean.y, mean.z);
+    std::printf("%-14s %-16s %9.3f s/it  mean %.4g %.4g %.4g\n",
+                std::filesystem::path(path).stem().string().c_str(), set.c_str(),
+                times[times.size() / 2], mean.x, mean.y, mean.z);
     const std::string summary = integrator->iterationSummary();
     if (!summary.empty()) std::printf("    %s\n", summary.c_str());
     std::fflush(stdout);
@@ -108,8 +109,8 @@ int main(int argc, char** argv) {
         for (const char* s : {"candle", "mirrorballs", "bunny"})
             scenes.push_back(dir + "smallupbp/" + s + "/" + s + ".obj");
     }
-    std::printf("bench_upbp: %dx%d, median of %d iterations, peak resident memory per run\n",
-                width, height, runs);
+    std::printf("bench_upbp: %dx%d, median of %d iterations, peak resident memory per run\n", width,
+                height, runs);
     for (const std::string& scene : scenes)
         for (const std::string& set : sets) {
             std::fflush(stdout);

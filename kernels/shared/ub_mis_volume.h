@@ -98,9 +98,14 @@ UB_INLINE int ub_mis_uses_beams(ub_mis_constants c) {
 
 /* R = cover / T of a beam of the given kind over a segment chain: stopPdf is the free-flight
  * density of stopping at the point, passProb that of passing it (UPBP Sec. 5.1, the
- * beam's probability of covering the point over the pdf it replaces). */
+ * beam's probability of covering the point over the pdf it replaces).
+ * R is capped at 1e12 (power heuristic: Mis(R) <= 1e24): where T is that small, R times the
+ * T that the recursion multiplies it with would otherwise overflow float as inf * 0 = NaN.
+ * Both subpaths compute R of a segment from the same two numbers, so a capped R is the same
+ * on both sides and the weights of every path still sum to 1. */
 UB_INLINE float ub_mis_beam_ratio(ub_uint shortBeam, float passProb, float stopPdf) {
-    return stopPdf > 0.0f ? (shortBeam ? passProb : 1.0f) / stopPdf : 0.0f;
+    if (!(stopPdf > 0.0f)) return 0.0f;
+    return ub_fmin((shortBeam ? passProb : 1.0f) / stopPdf, 1e12f);
 }
 
 /* R of a photon beam, and of a query beam, reaching a point (stopPdf, passProb as above). */

@@ -22,10 +22,11 @@ struct UsageError : std::runtime_error {
 struct RenderArgs {
     std::string scene;
     std::string algorithm = "pt";
-    double timeLimit = 0;  ///< -t, 0 if not given
-    int iterations = 0;    ///< -i, 0 if not given
-    std::string exrPath;   ///< -o
-    std::string pngPath;   ///< --png
+    double timeLimit = 0;    ///< -t, 0 if not given
+    int iterations = 0;      ///< -i, 0 if not given
+    std::string exrPath;     ///< -o
+    std::string pngPath;     ///< --png
+    bool pngLayers = false;  ///< --png-layers: also one PNG per technique layer
     float exposure = 0;
     int threads = 0;  ///< 0: all cores
     std::optional<uint64_t> seed;

@@ -147,6 +147,9 @@ int run(int argc, char** argv) {
                      "current directory unless only --png is given")
         ->type_name("FILE.exr");
     render->add_option("--png", ra.pngPath, "Also write an 8-bit sRGB PNG")->type_name("FILE.png");
+    render->add_flag("--png-layers", ra.pngLayers,
+                     "With --png and upbp: also write each technique's layer as "
+                     "FILE.TECHNIQUE.png, with the exposure of the image");
     render
         ->add_option("--exposure", ra.exposure,
                      "PNG exposure in stops, in [-64, 64] (PNG = 2^EV x image)")

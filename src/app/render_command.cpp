@@ -98,6 +98,8 @@ int runRender(const RenderArgs& args) {
         exrPath = fs::path(args.scene).stem().string() + ".exr";
     if (!exrPath.empty()) checkOutputPath(exrPath, ".exr", "-o/--output");
     if (!args.pngPath.empty()) checkOutputPath(args.pngPath, ".png", "--png");
+    if (args.pngLayers && args.pngPath.empty())
+        throw UsageError("--png-layers: needs --png FILE.png (the layers go beside it)");
     if (!args.variancePath.empty()) checkOutputPath(args.variancePath, ".exr", "--variance");
     if (!fs::exists(args.scene)) throw UsageError("scene file '" + args.scene + "' does not exist");
 
@@ -187,6 +189,14 @@ int runRender(const RenderArgs& args) {
     if (!args.pngPath.empty()) {
         writePng(args.pngPath, result.image, args.exposure);
         std::fprintf(stderr, "unibeam: wrote %s\n", args.pngPath.c_str());
+        if (args.pngLayers)
+            for (const auto& l : result.layers) {
+                const fs::path p(args.pngPath);
+                const std::string path =
+                    (p.parent_path() / (p.stem().string() + "." + l.first + ".png")).string();
+                writePng(path, l.second, args.exposure);
+                std::fprintf(stderr, "unibeam: wrote %s\n", path.c_str());
+            }
     }
     if (!result.layers.empty()) {
         // Each technique's share of the image (layer mean over image mean, channel average).
