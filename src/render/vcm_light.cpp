@@ -1,6 +1,6 @@
-// VertexCM light pass: light subpaths, their stored vertices with MIS partials,
-// and light tracing (connections of light vertices to the pinhole camera,
-// splatted onto the film). See vcm.h and kernels/shared/ub_mis.h.
+// VertexCM light pass: light subpaths, their stored vertices with MIS partials, UPBP's
+// photon points and photon beams, and light tracing (estimators/light_tracing.cpp).
+// See vcm.h and kernels/shared/ub_mis.h.
 #include <cmath>
 
 #include "core/rng.h"
@@ -137,59 +137,6 @@ void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuf
         }
         pathEnds[pathIndex - begin] = uint32_t(vertices.size());
     }
-}
-
-void VertexCM::connectToCamera(const SubPath& state, const PathVertex& v,
-                               const VertexScatter& scatter, SplatBuffer::Chunk& splats) const {
-    const Camera& camera = scene_.camera;
-    Vec2 raster;
-    if (!camera.worldToRaster(v.pos, &raster)) return;
-    Vec3 dirToCamera = camera.position() - v.pos;
-    const float distSqr = lengthSqr(dirToCamera);
-    const float distance = std::sqrt(distSqr);
-    dirToCamera /= distance;
-
-    float cosToCamera = 0.0f, bsdfRevPdfW = 0.0f;
-    Rgb f = scatter.evaluate(dirToCamera, &cosToCamera, nullptr, &bsdfRevPdfW);
-    if (isBlack(f)) return;
-    bsdfRevPdfW *= scatter.continuationProb();
-
-    const float cosAtCamera = dot(camera.forward(), -dirToCamera);
-    if (cosAtCamera <= 0.0f) return;
-    // Image-plane area (unit pixel area) to surface area at v.pos [TR Sec. 5.2]:
-    // p_cam,W = d_img^2 / cos^3, and p_cam,A = p_cam,W cos_y / d^2 (cos_y = 1 in a medium).
-    const float imagePointToCameraDist = camera.imagePlaneDist() / cosAtCamera;
-    const float imageToSolidAngle = imagePointToCameraDist * imagePointToCameraDist / cosAtCamera;
-    const float imageToSurface = imageToSolidAngle * cosToCamera / distSqr;
-
-    // Visibility, and with media the transmittance of the chain from the camera (walked from
-    // the camera's media) with the pdf of the camera ray stopping at v (ub_mis.h, MEDIA).
-    Rgb transmittance(1.0f);
-    float distPdfToVertex = 1.0f, passToVertex = 1.0f;
-    if (useMedia_) {
-        const MediumShadow sh = scene_.shadowTransmittance(
-            camera.position(), Vec3(0.0f), scene_.cameraMediumStack, v.pos, v.geoNormal());
-        if (sh.blocked || isBlack(sh.transmittance)) return;
-        transmittance = sh.transmittance;
-        distPdfToVertex = v.inMedium ? sh.pdfScatterFwdL : sh.probPass;
-        passToVertex = sh.probPass;
-    }
-    const float cameraPdfA = imageToSurface * distPdfToVertex;
-
-    // Light tracing alone has no MIS; otherwise the weight of [TR (46), (47)], with the
-    // merging factor of v whose R_out is that of the camera ray (ub_mis_volume.h).
-    const ub_mis_factor factor = ub_mis_vertex_factor(mis_, v.inMedium, 0, 1, ratioIn(state, v),
-                                                      length(cross(state.ray.dir, dirToCamera)));
-    const float merge =
-        ub_mis_factor_total(mis_, factor, ub_mis_query_ratio(mis_, passToVertex, distPdfToVertex));
-    const float weight = lightTraceOnly_ ? 1.0f
-                                         : ub_mis_weight_light_trace(mis_, state.mis, cameraPdfA,
-                                                                     bsdfRevPdfW, merge);
-    const Rgb contrib =
-        state.throughput * f * transmittance * (weight * imageToSurface / lightSubPathCount_);
-    if (isBlack(contrib)) return;
-    if (!useMedia_ && scene_.occluded(v.pos, v.geoNormal(), camera.position(), Vec3(0.0f))) return;
-    splats.add(raster, contrib);
 }
 
 }  // namespace ub
