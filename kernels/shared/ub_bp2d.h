@@ -27,11 +27,7 @@ UB_INLINE ub_float3 ub_bp2d_contribution(ub_mis_constants c, ub_beam pb, ub_quer
     if (!lp.valid) return ub_make_float3(0.0f, 0.0f, 0.0f);
     ub_float3 wz = ub_f3_from(q.dirFix), wy = ub_f3_neg(ub_f3_from(pb.dir));
     float phase = ub_hg_eval_dirs(wz, wy, g);
-    ub_mis_partials e;
-    e.dVCM = q.dVCM;
-    e.dVC = 0.0f;
-    e.dVM = q.dVM;
-    e.dOut = 0.0f;
+    ub_mis_partials e = ub_mis_merge_partials(q.dVCM, q.dVM);
     float sinTheta = ub_f3_length(ub_f3_cross(wz, wy));
     ub_mis_etas etas = ub_mis_volume_etas(c, lp.rInL, q.rQueryL, sinTheta);
     float w = ub_mis_weight_volume(c, lp.mis, e, phase * q.contProb, phase * s.contProb, etas,

@@ -95,6 +95,16 @@ typedef struct {
     float dOut;
 } ub_mis_partials;
 
+/* The partials a merge needs (dVCM, dVM), as stored in a UPBP record. */
+UB_INLINE ub_mis_partials ub_mis_merge_partials(float dVCM, float dVM) {
+    ub_mis_partials p;
+    p.dVCM = dVCM;
+    p.dVC = 0.0f; /* merges use dVCM and dVM only */
+    p.dVM = dVM;
+    p.dOut = 0.0f;
+    return p;
+}
+
 /* Per-iteration constants. */
 typedef struct {
     float vmWeightFactor;     /* Mis(eta_surf) if surface merging is enabled, else 0 [TR (20)] */

@@ -30,11 +30,7 @@ UB_INLINE ub_float3 ub_pb2d_contribution(ub_mis_constants c, ub_photon_point ph,
     if (!cp.valid) return ub_make_float3(0.0f, 0.0f, 0.0f);
     ub_float3 wz = ub_f3_neg(ub_f3_from(qb.dir)), wy = ub_f3_from(ph.dirFix);
     float phase = ub_hg_eval_dirs(wz, wy, g);
-    ub_mis_partials l;
-    l.dVCM = ph.dVCM;
-    l.dVC = 0.0f;
-    l.dVM = ph.dVM;
-    l.dOut = 0.0f;
+    ub_mis_partials l = ub_mis_merge_partials(ph.dVCM, ph.dVM);
     float sinTheta = ub_f3_length(ub_f3_cross(wz, wy));
     ub_mis_etas etas = ub_mis_volume_etas(c, ph.rPhotonL, cp.rInL, sinTheta);
     float w = ub_mis_weight_volume(c, l, cp.mis, phase * s.contProb, phase * ph.contProb, etas,

@@ -35,15 +35,8 @@ UB_INLINE ub_float3 ub_pp3d_contribution(ub_mis_constants c, ub_photon_point ph,
     if (ub_f3_dot(d, d) > radiusSqr) return zero;
     ub_float3 wz = ub_f3_from(q.dirFix), wy = ub_f3_from(ph.dirFix);
     float phase = ub_hg_eval_dirs(wz, wy, g); /* = pdf in both directions */
-    ub_mis_partials l, e;
-    l.dVCM = ph.dVCM;
-    l.dVC = 0.0f;
-    l.dVM = ph.dVM;
-    l.dOut = 0.0f;
-    e.dVCM = q.dVCM;
-    e.dVC = 0.0f;
-    e.dVM = q.dVM;
-    e.dOut = 0.0f;
+    ub_mis_partials l = ub_mis_merge_partials(ph.dVCM, ph.dVM);
+    ub_mis_partials e = ub_mis_merge_partials(q.dVCM, q.dVM);
     float sinTheta = ub_f3_length(ub_f3_cross(wz, wy));
     ub_mis_etas etas = ub_mis_volume_etas(c, ph.rPhotonL, q.rQueryL, sinTheta);
     float w =

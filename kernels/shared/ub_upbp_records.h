@@ -124,10 +124,7 @@ UB_INLINE ub_beam_point ub_beam_at(ub_mis_constants c, ub_beam b, ub_segment_eva
         out.throughput = ub_make_float3(0.0f, 0.0f, 0.0f);
         return out;
     }
-    ub_mis_partials p;
-    p.dVCM = b.dVCM;
-    p.dVC = 0.0f; /* merges use dVCM and dVM only */
-    p.dVM = b.dVM;
+    ub_mis_partials p = ub_mis_merge_partials(b.dVCM, b.dVM);
     p.dOut = b.dOut;
     /* R_out of x is the other kind of beam over the same chain, seen from the point */
     out.mis =

@@ -7,10 +7,6 @@
 // diced beam parts, traversed by the query beam's segment; a photon beam counts
 // in the part whose parameter range holds its closest-approach parameter.
 // Both beams' media up to the closest approach are evaluated exactly.
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
-#include <atomic>
 
 #include "estimators/beam_medium.h"
 #include "estimators/bvh.h"
@@ -28,45 +24,36 @@ void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
     if (beams.empty() || queries.empty()) return;
     const float r = in.radius[UB_TECH_BB1D];
     const float normalization = 1.0f / (in.beamPathCount * 2.0f * r);  // K1 / N_B
-    std::atomic<size_t> found{0};
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, queries.size(), 16),
-        [&](const tbb::blocked_range<size_t>& range) {
-            size_t n = 0;
-            for (size_t i = range.begin(); i != range.end(); ++i) {
-                const ub_beam& qb = queries[i];
-                const float g = in.scene->media[qb.mediumId].g;
-                const ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
-                BeamMedium queryMedium;  // tabulated when the first pair is found
-                queryMedium.reset(*in.scene, qb);
-                Rgb sum(0.0f);
-                beamParts.querySegment(
-                    Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length, [&](uint32_t k) {
-                        const BeamPart& part = parts[k];
-                        const ub_beam& pb = beams[part.beam];
-                        if (pb.mediumId != qb.mediumId) return;
-                        const ub_uint length = pb.pathLength + qb.pathLength;
-                        if (length > ub_uint(in.maxLength) || length < ub_uint(in.minLength))
-                            return;
-                        float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
-                        const float d2 = ub_beam_beam_dist2(
-                            o, d, ub_f3_from(pb.origin), ub_f3_from(pb.dir), &tc, &tl, &sinTheta);
-                        if (d2 < 0.0f || d2 > r * r) return;
-                        if (tc < 0.0f || tc > qb.length || tl < 0.0f || tl > pb.length) return;
-                        if (tl < part.t0 || (tl >= part.t1 && part.t1 < pb.length)) return;
-                        if (!queryMedium.built()) queryMedium.build();
-                        const ub_segment_eval sl = photonMedia[part.beam].eval(tl);
-                        const ub_segment_eval sc = queryMedium.eval(tc);
-                        const ub_float3 c = ub_bb1d_contribution(in.mis, pb, qb, sl, sc, tl, tc,
-                                                                 sinTheta, g, normalization);
-                        sum += Rgb(c.x, c.y, c.z);
-                        ++n;
-                    });
-                (*out)[i] = sum;
-            }
-            found += n;
-        });
-    *pairs = found;
+    forEachQuery(queries.size(), 16, out, pairs, [&](size_t i, size_t* found) {
+        const ub_beam& qb = queries[i];
+        const float g = in.scene->media[qb.mediumId].g;
+        const ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
+        BeamMedium queryMedium;  // tabulated when the first pair is found
+        queryMedium.reset(*in.scene, qb);
+        Rgb sum(0.0f);
+        beamParts.querySegment(
+            Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length, [&](uint32_t k) {
+                const BeamPart& part = parts[k];
+                const ub_beam& pb = beams[part.beam];
+                if (pb.mediumId != qb.mediumId) return;
+                const ub_uint length = pb.pathLength + qb.pathLength;
+                if (length > ub_uint(in.maxLength) || length < ub_uint(in.minLength)) return;
+                float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
+                const float d2 = ub_beam_beam_dist2(o, d, ub_f3_from(pb.origin), ub_f3_from(pb.dir),
+                                                    &tc, &tl, &sinTheta);
+                if (d2 < 0.0f || d2 > r * r) return;
+                if (tc < 0.0f || tc > qb.length || tl < 0.0f || tl > pb.length) return;
+                if (tl < part.t0 || (tl >= part.t1 && part.t1 < pb.length)) return;
+                if (!queryMedium.built()) queryMedium.build();
+                const ub_segment_eval sl = photonMedia[part.beam].eval(tl);
+                const ub_segment_eval sc = queryMedium.eval(tc);
+                const ub_float3 c = ub_bb1d_contribution(in.mis, pb, qb, sl, sc, tl, tc, sinTheta,
+                                                         g, normalization);
+                sum += Rgb(c.x, c.y, c.z);
+                ++*found;
+            });
+        return sum;
+    });
 }
 
 }  // namespace ub

@@ -5,10 +5,6 @@
 // per-pair value, MIS weight and normalisation 1 / (N_B pi r^2) in
 // kernels/shared/ub_bp2d.h). Lookup: BVH over the diced beam parts; a beam counts
 // in the part whose parameter range holds z's projection (volume_estimate.h).
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
-#include <atomic>
 
 #include "estimators/beam_medium.h"
 #include "estimators/bvh.h"
@@ -26,38 +22,30 @@ void estimateBP2D(const VolumeEstimateInput& in, const Bvh& beamParts,
     if (beams.empty() || queries.empty()) return;
     const float r = in.radius[UB_TECH_BP2D];
     const float normalization = 1.0f / (in.beamPathCount * kPi * r * r);  // K2 / N_B
-    std::atomic<size_t> found{0};
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, queries.size(), 64),
-        [&](const tbb::blocked_range<size_t>& range) {
-            size_t n = 0;
-            for (size_t i = range.begin(); i != range.end(); ++i) {
-                const ub_query_point& q = queries[i];
-                const float g = in.scene->media[q.mediumId].g;
-                const ub_float3 p = ub_f3_from(q.pos);
-                Rgb sum(0.0f);
-                beamParts.queryPoint(Vec3(p.x, p.y, p.z), [&](uint32_t k) {
-                    const BeamPart& part = parts[k];
-                    const ub_beam& pb = beams[part.beam];
-                    if (pb.mediumId != q.mediumId) return;
-                    const ub_uint length = pb.pathLength + q.pathLength;
-                    if (length > ub_uint(in.maxLength) || length < ub_uint(in.minLength)) return;
-                    float t = 0.0f;
-                    const float d2 = ub_point_beam_dist2(p, ub_f3_from(pb.origin),
-                                                         ub_f3_from(pb.dir), pb.length, &t);
-                    if (d2 < 0.0f || d2 > r * r) return;
-                    // The part holding the projection counts the beam (once per beam).
-                    if (t < part.t0 || (t >= part.t1 && part.t1 < pb.length)) return;
-                    const ub_segment_eval s = photonMedia[part.beam].eval(t);
-                    const ub_float3 c = ub_bp2d_contribution(in.mis, pb, q, s, t, g, normalization);
-                    sum += Rgb(c.x, c.y, c.z);
-                    ++n;
-                });
-                (*out)[i] = sum;
-            }
-            found += n;
+    forEachQuery(queries.size(), 64, out, pairs, [&](size_t i, size_t* found) {
+        const ub_query_point& q = queries[i];
+        const float g = in.scene->media[q.mediumId].g;
+        const ub_float3 p = ub_f3_from(q.pos);
+        Rgb sum(0.0f);
+        beamParts.queryPoint(Vec3(p.x, p.y, p.z), [&](uint32_t k) {
+            const BeamPart& part = parts[k];
+            const ub_beam& pb = beams[part.beam];
+            if (pb.mediumId != q.mediumId) return;
+            const ub_uint length = pb.pathLength + q.pathLength;
+            if (length > ub_uint(in.maxLength) || length < ub_uint(in.minLength)) return;
+            float t = 0.0f;
+            const float d2 =
+                ub_point_beam_dist2(p, ub_f3_from(pb.origin), ub_f3_from(pb.dir), pb.length, &t);
+            if (d2 < 0.0f || d2 > r * r) return;
+            // The part holding the projection counts the beam (once per beam).
+            if (t < part.t0 || (t >= part.t1 && part.t1 < pb.length)) return;
+            const ub_segment_eval s = photonMedia[part.beam].eval(t);
+            const ub_float3 c = ub_bp2d_contribution(in.mis, pb, q, s, t, g, normalization);
+            sum += Rgb(c.x, c.y, c.z);
+            ++*found;
         });
-    *pairs = found;
+        return sum;
+    });
 }
 
 }  // namespace ub

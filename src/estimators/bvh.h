@@ -65,6 +65,9 @@ class Bvh {
         }
         return true;
     }
+    /// Depth-first walk: visit(i) for the primitives of every leaf whose path accept()s.
+    template <class Accept, class Visit>
+    void traverse(Accept&& accept, Visit&& visit) const;
     uint32_t buildNode(const std::vector<Bounds3>& boxes, std::vector<Vec3>& centres,
                        uint32_t begin, uint32_t end);
 
@@ -72,19 +75,19 @@ class Bvh {
     std::vector<uint32_t> prims_;
 };
 
-template <class Visit>
-void Bvh::queryPoint(const Vec3& p, Visit&& visit) const {
+template <class Accept, class Visit>
+void Bvh::traverse(Accept&& accept, Visit&& visit) const {
     if (nodes_.empty()) return;
-    uint32_t stack[64];
+    uint32_t stack[64];  // median splits: depth <= log2(n) + 1 (bvh.cpp)
     int top = 0;
     stack[top++] = 0;
     while (top > 0) {
-        const BvhNode& n = nodes_[stack[--top]];
-        if (!contains(n, p)) continue;
+        const uint32_t self = stack[--top];
+        const BvhNode& n = nodes_[self];
+        if (!accept(n)) continue;
         if (n.count > 0) {
             for (uint32_t i = n.first; i < n.first + n.count; ++i) visit(prims_[i]);
         } else {
-            const uint32_t self = uint32_t(&n - nodes_.data());
             stack[top++] = n.first;
             stack[top++] = self + 1;
         }
@@ -92,23 +95,14 @@ void Bvh::queryPoint(const Vec3& p, Visit&& visit) const {
 }
 
 template <class Visit>
+void Bvh::queryPoint(const Vec3& p, Visit&& visit) const {
+    traverse([&](const BvhNode& n) { return contains(n, p); }, visit);
+}
+
+template <class Visit>
 void Bvh::querySegment(const Vec3& o, const Vec3& d, float len, Visit&& visit) const {
-    if (nodes_.empty()) return;
     const Vec3 invD(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
-    uint32_t stack[64];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-        const BvhNode& n = nodes_[stack[--top]];
-        if (!meets(n, o, invD, len)) continue;
-        if (n.count > 0) {
-            for (uint32_t i = n.first; i < n.first + n.count; ++i) visit(prims_[i]);
-        } else {
-            const uint32_t self = uint32_t(&n - nodes_.data());
-            stack[top++] = n.first;
-            stack[top++] = self + 1;
-        }
-    }
+    traverse([&](const BvhNode& n) { return meets(n, o, invD, len); }, visit);
 }
 
 }  // namespace ub

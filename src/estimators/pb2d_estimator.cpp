@@ -7,10 +7,6 @@
 // Lookup: BVH over the photon points as boxes of their kernel sphere, traversed by
 // the beam's segment (estimators/bvh.h). The medium along the query beam up to the
 // photon's projection is evaluated exactly (regular tracking).
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
-#include <atomic>
 
 #include "estimators/beam_medium.h"
 #include "estimators/bvh.h"
@@ -27,41 +23,30 @@ void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres, std::
     if (photons.empty() || queries.empty()) return;
     const float r = in.radius[UB_TECH_PB2D];
     const float normalization = 1.0f / (in.lightPathCount * kPi * r * r);  // K2 / N_L
-    std::atomic<size_t> found{0};
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, queries.size(), 16),
-        [&](const tbb::blocked_range<size_t>& range) {
-            size_t n = 0;
-            for (size_t i = range.begin(); i != range.end(); ++i) {
-                const ub_beam& qb = queries[i];
-                const float g = in.scene->media[qb.mediumId].g;
-                const ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
-                BeamMedium queryMedium;  // tabulated when the first pair is found
-                queryMedium.reset(*in.scene, qb);
-                Rgb sum(0.0f);
-                photonSpheres.querySegment(
-                    Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length, [&](uint32_t j) {
-                        const ub_photon_point& ph = photons[j];
-                        if (ph.mediumId != qb.mediumId) return;
-                        const ub_uint length = ph.pathLength + qb.pathLength;
-                        if (length > ub_uint(in.maxLength) || length < ub_uint(in.minLength))
-                            return;
-                        float t = 0.0f;
-                        const float d2 =
-                            ub_point_beam_dist2(ub_f3_from(ph.pos), o, d, qb.length, &t);
-                        if (d2 < 0.0f || d2 > r * r) return;
-                        if (!queryMedium.built()) queryMedium.build();
-                        const ub_segment_eval s = queryMedium.eval(t);
-                        const ub_float3 c =
-                            ub_pb2d_contribution(in.mis, ph, qb, s, t, g, normalization);
-                        sum += Rgb(c.x, c.y, c.z);
-                        ++n;
-                    });
-                (*out)[i] = sum;
-            }
-            found += n;
-        });
-    *pairs = found;
+    forEachQuery(queries.size(), 16, out, pairs, [&](size_t i, size_t* found) {
+        const ub_beam& qb = queries[i];
+        const float g = in.scene->media[qb.mediumId].g;
+        const ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
+        BeamMedium queryMedium;  // tabulated when the first pair is found
+        queryMedium.reset(*in.scene, qb);
+        Rgb sum(0.0f);
+        photonSpheres.querySegment(
+            Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length, [&](uint32_t j) {
+                const ub_photon_point& ph = photons[j];
+                if (ph.mediumId != qb.mediumId) return;
+                const ub_uint length = ph.pathLength + qb.pathLength;
+                if (length > ub_uint(in.maxLength) || length < ub_uint(in.minLength)) return;
+                float t = 0.0f;
+                const float d2 = ub_point_beam_dist2(ub_f3_from(ph.pos), o, d, qb.length, &t);
+                if (d2 < 0.0f || d2 > r * r) return;
+                if (!queryMedium.built()) queryMedium.build();
+                const ub_segment_eval s = queryMedium.eval(t);
+                const ub_float3 c = ub_pb2d_contribution(in.mis, ph, qb, s, t, g, normalization);
+                sum += Rgb(c.x, c.y, c.z);
+                ++*found;
+            });
+        return sum;
+    });
 }
 
 }  // namespace ub

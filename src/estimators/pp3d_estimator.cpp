@@ -5,10 +5,6 @@
 // value, its MIS weight and normalisation 1 / (N_L (4/3) pi r^3) are
 // kernels/shared/ub_pp3d.h). Lookup: hashed grid of cell 2 r over the photon
 // points, 8 cells per query (estimators/hash_grid.h).
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
-#include <atomic>
 
 #include "estimators/hash_grid.h"
 #include "estimators/volume_estimate.h"
@@ -25,28 +21,20 @@ void estimatePP3D(const VolumeEstimateInput& in, const HashGrid& grid, std::vect
     const float r = in.radius[UB_TECH_PP3D];
     // UPBP Table 1: K3 = 1 / ((4/3) pi r^3), over N_L light subpaths.
     const float normalization = 1.0f / (in.lightPathCount * (4.0f / 3.0f) * kPi * r * r * r);
-    std::atomic<size_t> found{0};
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, queries.size(), 64),
-                      [&](const tbb::blocked_range<size_t>& range) {
-                          size_t n = 0;
-                          for (size_t i = range.begin(); i != range.end(); ++i) {
-                              const ub_query_point& q = queries[i];
-                              const float g = in.scene->media[q.mediumId].g;
-                              Rgb sum(0.0f);
-                              grid.query(Vec3(q.pos[0], q.pos[1], q.pos[2]),
-                                         reinterpret_cast<const Vec3*>(photons[0].pos),
-                                         sizeof(ub_photon_point), [&](uint32_t j) {
-                                             ub_float3 c = ub_pp3d_contribution(
-                                                 in.mis, photons[j], q, g, r * r, normalization,
-                                                 ub_uint(in.minLength), ub_uint(in.maxLength));
-                                             sum += Rgb(c.x, c.y, c.z);
-                                             ++n;
-                                         });
-                              (*out)[i] = sum;
-                          }
-                          found += n;
-                      });
-    *pairs = found;
+    forEachQuery(queries.size(), 64, out, pairs, [&](size_t i, size_t* found) {
+        const ub_query_point& q = queries[i];
+        const float g = in.scene->media[q.mediumId].g;
+        Rgb sum(0.0f);
+        grid.query(
+            Vec3(q.pos[0], q.pos[1], q.pos[2]), reinterpret_cast<const Vec3*>(photons[0].pos),
+            sizeof(ub_photon_point), [&](uint32_t j) {
+                ub_float3 c = ub_pp3d_contribution(in.mis, photons[j], q, g, r * r, normalization,
+                                                   ub_uint(in.minLength), ub_uint(in.maxLength));
+                sum += Rgb(c.x, c.y, c.z);
+                ++*found;
+            });
+        return sum;
+    });
 }
 
 }  // namespace ub

@@ -22,7 +22,11 @@
 // added to its pixel in query order, so images do not depend on the thread count.
 #pragma once
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <vector>
 
@@ -59,6 +63,23 @@ struct VolumeEstimateStats {
 /// of layers[UB_TECH_*] if layers is given; each layer the size of the image).
 void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Image, 4>* layers,
                     VolumeEstimateStats* stats = nullptr);
+
+/// Runs estimate(i, &found) for every query i in [0, n) in parallel (TBB, chunks of
+/// `grain`), writing its result to (*out)[i]; *pairs gets the sum of what the calls add to
+/// `found` (the kernel pairs they evaluated).
+template <class Estimate>
+void forEachQuery(size_t n, size_t grain, std::vector<Rgb>* out, size_t* pairs,
+                  Estimate&& estimate) {
+    std::atomic<size_t> total{0};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain),
+                      [&](const tbb::blocked_range<size_t>& range) {
+                          size_t found = 0;
+                          for (size_t i = range.begin(); i != range.end(); ++i)
+                              (*out)[i] = estimate(i, &found);
+                          total += found;
+                      });
+    *pairs = total;
+}
 
 // The host twins, one per estimator (estimators/*_estimator.cpp): each adds its estimate of
 // query i to out[i].
