@@ -196,6 +196,11 @@ TEST(Cli, BadFlagsExitTwoWithMessage) {
         {{"render", kScene, "-a", "upbp", "--photon-beams", "medium", "-o", out}, "--photon-beams"},
         {{"render", kScene, "-a", "upbp", "--query-beams", "x", "-o", out}, "--query-beams"},
         {{"render", kScene, "-a", "upbp", "--beam-paths", "0", "-o", out}, "--beam-paths"},
+        {{"render", kScene, "-a", "upbp", "--backend", "gpu", "-o", out}, "--backend"},
+        {{"render", kScene, "-a", "upbp", "--cl-device", "x", "-o", out},
+         "--cl-device: expected PLATFORM:DEVICE"},
+        {{"render", kScene, "-a", "upbp", "--backend", "opencl", "--cl-device", "9:9", "-o", out},
+         "no device 9:9"},
         {{"render"}, "scene"},
         {{"frobnicate"}, "frobnicate"},
         {{}, "subcommand"},
@@ -232,6 +237,15 @@ TEST(Cli, MissingOrBadSceneExitsTwo) {
     EXPECT_EQ(rb.exitCode, 2) << rb.err;
     EXPECT_NE(rb.err.find("bad.json"), std::string::npos) << rb.err;
     EXPECT_FALSE(fs::exists(dir / "o.exr"));
+    fs::remove_all(dir);
+}
+
+TEST(Cli, DevicesListsTheOpenClDevices) {
+    fs::path dir = tempDir();
+    RunResult r = runUnibeam({"devices"}, dir);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.out.find("0:0"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("compute units"), std::string::npos) << r.out;
     fs::remove_all(dir);
 }
 

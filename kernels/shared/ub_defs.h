@@ -30,6 +30,7 @@ typedef uint ub_uint;
 #define ub_atan2(y, x) atan2(y, x)
 #define ub_acos(x) acos(x)
 #define ub_log(x) log(x)
+#define ub_floor(x) floor(x)
 #else
 #include <cmath>
 #include <cstdint>
@@ -48,6 +49,7 @@ typedef uint32_t ub_uint;
 #define ub_atan2(y, x) std::atan2(y, x)
 #define ub_acos(x) std::acos(x)
 #define ub_log(x) std::log(x)
+#define ub_floor(x) std::floor(x)
 #endif
 
 #define UB_PI 3.14159265358979323846f

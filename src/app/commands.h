@@ -40,6 +40,8 @@ struct RenderArgs {
     std::optional<float> volumeRadius[4], volumeAlpha[4];
     std::string photonBeams, queryBeams;  ///< "short" / "long", empty: default
     std::optional<int> beamPaths;
+    std::string backend = "auto";                ///< --backend host|opencl|auto
+    std::string clDevice;                        ///< --cl-device PLATFORM:DEVICE
     std::map<std::string, std::string> defines;  ///< -D name=value (Mitsuba XML parameters)
     std::string variancePath;                    ///< --variance: per-iteration variance EXR
 };
@@ -57,6 +59,8 @@ constexpr int kDefaultIterations = 16;
 
 int runRender(const RenderArgs& args);
 int runInfo(const std::string& scenePath, const std::map<std::string, std::string>& defines = {});
+/// `unibeam devices`: the OpenCL platforms and devices; exit 2 if there is none.
+int runDevices();
 /// `unibeam compare --ztest`: 0 pass, 1 fail, 2 bad input (UsageError / InputError).
 int runCompareZTest(const CompareArgs& args);
 /// Parses the values of -D flags ("name=value"); throws UsageError on a malformed one.

@@ -236,6 +236,19 @@ int run(int argc, char** argv) {
             ->check(positiveInteger())
             ->type_name("N");
 
+    render
+        ->add_option("--backend", ra.backend,
+                     "upbp: where the estimate pass runs: opencl (kernels; error without a "
+                     "working device), host (C++), auto (OpenCL if a device works, else the "
+                     "host; default). Kernels exist for pp3d; the other estimators run on the "
+                     "host")
+        ->check(CLI::IsMember({"host", "opencl", "auto"}).description(""))
+        ->type_name("opencl|host|auto");
+    render
+        ->add_option("--cl-device", ra.clDevice,
+                     "upbp: OpenCL device PLATFORM:DEVICE as 'unibeam devices' lists them "
+                     "(default: the first)")
+        ->type_name("P:D");
     std::vector<std::string> renderDefines, infoDefines;
     render
         ->add_option("-D,--define", renderDefines,
@@ -257,6 +270,9 @@ int run(int argc, char** argv) {
                      "Scene parameter NAME=VALUE: overrides a Mitsuba XML <default> (repeatable)")
         ->type_name("NAME=VALUE")
         ->allow_extra_args(false);
+
+    // ---- devices ----
+    CLI::App* devices = app.add_subcommand("devices", "List the OpenCL platforms and devices");
 
     // ---- compare ----
     ub::app::CompareArgs ca;
@@ -300,11 +316,13 @@ int run(int argc, char** argv) {
         ->type_name("R");
 
     if (argc >= 2 && argv[1][0] != '-' && std::string(argv[1]) != "render" &&
-        std::string(argv[1]) != "info" && std::string(argv[1]) != "compare") {
-        std::fprintf(stderr,
-                     "unibeam: error: unknown command '%s' (valid: render, info, compare)\n"
-                     "Run 'unibeam --help' for usage.\n",
-                     argv[1]);
+        std::string(argv[1]) != "info" && std::string(argv[1]) != "compare" &&
+        std::string(argv[1]) != "devices") {
+        std::fprintf(
+            stderr,
+            "unibeam: error: unknown command '%s' (valid: render, info, compare, devices)\n"
+            "Run 'unibeam --help' for usage.\n",
+            argv[1]);
         return kExitBadInput;
     }
     try {
@@ -342,6 +360,7 @@ int run(int argc, char** argv) {
             return ub::app::runRender(ra);
         }
         if (*info) return ub::app::runInfo(infoScene, ub::app::parseDefines(infoDefines));
+        if (*devices) return ub::app::runDevices();
         if (*compare) {
             ca.reference = ztestFiles.at(0);
             ca.referenceVariance = ztestFiles.at(1);

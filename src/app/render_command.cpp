@@ -131,7 +131,21 @@ int runRender(const RenderArgs& args) {
     if (!args.photonBeams.empty()) options.shortPhotonBeams = args.photonBeams == "short";
     if (!args.queryBeams.empty()) options.shortQueryBeams = args.queryBeams == "short";
     if (args.beamPaths) options.beamPaths = *args.beamPaths;
+    options.backend = args.backend;
+    if (!args.clDevice.empty()) {
+        int p = -1, d = -1;
+        char tail = 0;
+        if (std::sscanf(args.clDevice.c_str(), "%d:%d%c", &p, &d, &tail) != 2 || p < 0 || d < 0)
+            throw UsageError(
+                "--cl-device: expected PLATFORM:DEVICE (two indices >= 0, as "
+                "'unibeam devices' lists them), got '" +
+                args.clDevice + "'");
+        options.clPlatform = p;
+        options.clDevice = d;
+    }
     std::unique_ptr<Integrator> integrator = makeIntegrator(*scene, options);
+    if (!integrator->setupNote().empty())
+        std::fprintf(stderr, "unibeam: %s\n", integrator->setupNote().c_str());
 
     ProgressiveOptions prog;
     prog.iterations = args.iterations;

@@ -8,18 +8,20 @@ namespace ub {
 void HashGrid::build(const Vec3* positions, size_t count, size_t stride, float radius,
                      size_t cellCount) {
     radius_ = radius;
-    radiusSqr_ = radius * radius;
-    invCellSize_ = 1.0f / (2.0f * radius);
     if (cellCount == 0) cellCount = count > 0 ? count : 1;
     cellEnds_.assign(cellCount, 0);
     indices_.resize(count);
-    lo_ = Vec3(kInf);
-    for (size_t i = 0; i < count; ++i) lo_ = vmin(lo_, at(positions, stride, i));
+    Vec3 lo(kInf);
+    for (size_t i = 0; i < count; ++i) lo = vmin(lo, at(positions, stride, i));
+    params_ = ub_hash_grid{};
+    for (int a = 0; a < 3; ++a) params_.lo[a] = lo[a];
+    params_.invCellSize = 1.0f / (2.0f * radius);
+    params_.radiusSqr = radius * radius;
+    params_.cellCount = uint32_t(cellCount);
     if (count == 0) return;
 
     auto bucketOf = [&](const Vec3& p) {
-        Vec3 d = (p - lo_) * invCellSize_;
-        return cellIndex(int(std::floor(d.x)), int(std::floor(d.y)), int(std::floor(d.z)));
+        return ub_hash_point(params_, ub_make_float3(p.x, p.y, p.z));
     };
     // Histogram, exclusive prefix sum, scatter (stable: indices stay ascending per bucket).
     for (size_t i = 0; i < count; ++i) ++cellEnds_[bucketOf(at(positions, stride, i))];

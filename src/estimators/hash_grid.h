@@ -4,7 +4,8 @@
 // as used by SmallVCM and Georgiev et al. 2012 for VCM.
 //
 // Cells have edge 2r, so the ball of radius r around a query point overlaps at
-// most the 2x2x2 block of cells nearest to it. Cells are hashed into `cellCount`
+// most the 2x2x2 block of cells nearest to it (cell hashing and bucket choice are
+// kernels/shared/ub_hash_grid.h, shared with the OpenCL kernels). Cells are hashed into `cellCount`
 // buckets; a counting sort lays the point indices out bucket by bucket. Unlike a
 // plain hashed lookup, a query visits each distinct bucket of its 8 cells only
 // once (two cells may hash to the same bucket), so every point within r is
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "core/vec.h"
+#include "kernels/shared/ub_hash_grid.h"
 
 namespace ub {
 
@@ -45,20 +47,18 @@ class HashGrid {
 
     float radius() const { return radius_; }
     size_t cellCount() const { return cellEnds_.size(); }
+    /// The flat data the OpenCL kernels read (kernels/shared/ub_hash_grid.h).
+    const ub_hash_grid& params() const { return params_; }
+    const std::vector<uint32_t>& cellEnds() const { return cellEnds_; }
+    const std::vector<uint32_t>& indices() const { return indices_; }
 
   private:
-    /// Hash of integer cell coordinates (Teschner et al. 2003) into [0, cellCount).
-    uint32_t cellIndex(int x, int y, int z) const {
-        uint32_t h =
-            (uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ (uint32_t(z) * 83492791u);
-        return h % uint32_t(cellEnds_.size());
-    }
     static const Vec3& at(const Vec3* base, size_t stride, size_t i) {
         return *reinterpret_cast<const Vec3*>(reinterpret_cast<const char*>(base) + i * stride);
     }
 
-    Vec3 lo_;  ///< bounding box corner of the points
-    float radius_ = 0, radiusSqr_ = 0, invCellSize_ = 0;
+    ub_hash_grid params_{};
+    float radius_ = 0;
     std::vector<uint32_t> indices_;   ///< point indices sorted by bucket
     std::vector<uint32_t> cellEnds_;  ///< end offset in indices_ of each bucket
 };
@@ -66,27 +66,14 @@ class HashGrid {
 template <class Visit>
 void HashGrid::query(const Vec3& q, const Vec3* positions, size_t stride, Visit&& visit) const {
     if (indices_.empty()) return;
-    // Cell coordinates relative to lo_; the 2x2x2 block whose centre is nearest q.
-    Vec3 d = (q - lo_) * invCellSize_;
-    int base[3];
-    for (int a = 0; a < 3; ++a) {
-        float f = std::floor(d[a]);
-        base[a] = int(f) - (d[a] - f < 0.5f ? 1 : 0);
-    }
     uint32_t buckets[8];
-    int nb = 0;
-    for (int k = 0; k < 8; ++k) {
-        uint32_t b = cellIndex(base[0] + (k & 1), base[1] + ((k >> 1) & 1), base[2] + (k >> 2));
-        bool seen = false;
-        for (int j = 0; j < nb; ++j) seen |= buckets[j] == b;
-        if (!seen) buckets[nb++] = b;
-    }
+    const int nb = ub_hash_buckets(params_, ub_make_float3(q.x, q.y, q.z), buckets);
     for (int j = 0; j < nb; ++j) {
         uint32_t b = buckets[j];
         uint32_t begin = b == 0 ? 0 : cellEnds_[b - 1], end = cellEnds_[b];
         for (uint32_t i = begin; i < end; ++i) {
             uint32_t idx = indices_[i];
-            if (lengthSqr(at(positions, stride, idx) - q) <= radiusSqr_) visit(idx);
+            if (lengthSqr(at(positions, stride, idx) - q) <= params_.radiusSqr) visit(idx);
         }
     }
 }

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "cl/cl_runtime.h"
 #include "estimators/beam_medium.h"
 #include "estimators/bvh.h"
 #include "estimators/hash_grid.h"
@@ -98,7 +99,17 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     std::vector<Rgb> perPoint[4], perBeam[4];
     if (t.pp3d) {
         perPoint[UB_TECH_PP3D].assign(nPoints, Rgb(0.0f));
-        estimatePP3D(in, grid, &perPoint[UB_TECH_PP3D], &st.pairs[UB_TECH_PP3D]);
+        if (in.cl) {
+            std::vector<float> mediumG;
+            for (const Medium& m : in.scene->media) mediumG.push_back(m.g);
+            const float r = in.radius[UB_TECH_PP3D];
+            in.cl->estimatePP3D(photons, *in.queryPoints, grid, in.mis, mediumG,
+                                1.0f / (in.lightPathCount * (4.0f / 3.0f) * kPi * r * r * r),
+                                uint32_t(in.minLength), uint32_t(in.maxLength),
+                                &perPoint[UB_TECH_PP3D]);
+        } else {
+            estimatePP3D(in, grid, &perPoint[UB_TECH_PP3D], &st.pairs[UB_TECH_PP3D]);
+        }
     }
     if (t.bp2d) {
         perPoint[UB_TECH_BP2D].assign(nPoints, Rgb(0.0f));

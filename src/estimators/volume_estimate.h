@@ -37,6 +37,7 @@
 namespace ub {
 
 class Scene;
+class ClRuntime;
 
 struct VolumeEstimateInput {
     const Scene* scene = nullptr;
@@ -50,6 +51,7 @@ struct VolumeEstimateInput {
     const std::vector<ub_beam>* photonBeams = nullptr;
     const std::vector<ub_query_point>* queryPoints = nullptr;
     const std::vector<ub_beam>* queryBeams = nullptr;
+    ClRuntime* cl = nullptr;  ///< the OpenCL backend (kernels for what it has), or host only
 };
 
 /// Per-iteration counts and times of the estimate pass.

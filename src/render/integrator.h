@@ -40,6 +40,10 @@ struct RenderOptions {
     /// Light subpaths per iteration that emit photon beams (N_B, the first ones by index);
     /// 0: N_L / 16, at least 1 (SmallUPBP's -pbc).
     int beamPaths = 0;
+    /// Where UPBP's estimate pass runs: "host" (the C++ twins), "opencl" (kernels; an error if
+    /// no device works), "auto" (OpenCL when a device works, else the host, saying why).
+    std::string backend = "host";
+    int clPlatform = -1, clDevice = -1;  ///< OpenCL device (-1, -1: the first one)
 };
 
 class Integrator {
@@ -55,6 +59,8 @@ class Integrator {
     virtual const std::vector<Image>* iterationLayers() const { return nullptr; }
     /// One line about the last iteration's work (counts of records etc.), or empty.
     virtual std::string iterationSummary() const { return ""; }
+    /// One line about how the integrator was set up (UPBP: where its estimate pass runs).
+    virtual std::string setupNote() const { return ""; }
 };
 
 /// Names accepted by makeIntegrator, for help texts and error messages.

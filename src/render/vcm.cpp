@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <string>
 
+#include "cl/cl_runtime.h"
 #include "core/error.h"
 #include "core/rng.h"
 #include "estimators/volume_estimate.h"
@@ -104,6 +105,9 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
                                      " radius reduction alpha must be in (0, 1], got " +
                                      std::to_string(alphas[t]));
         }
+        if (options.backend != "host" && options.backend != "opencl" && options.backend != "auto")
+            throw InputError("",
+                             "backend must be host, opencl or auto, got '" + options.backend + "'");
         if (options.beamPaths < 0)
             throw InputError(scene.sourceFile, "beam paths must be >= 0 (0: N_L / 16), got " +
                                                    std::to_string(options.beamPaths));
@@ -169,10 +173,29 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
         if (upbp_.bp2d) layerNames_.push_back("bp2d");
         if (upbp_.bb1d) layerNames_.push_back("bb1d");
     }
+    if (algorithm_ == Algorithm::Upbp) {
+        // The estimate pass: OpenCL kernels for what has one (pp3d), the host for the rest.
+        backendNote_ = "estimate pass on the host";
+        if (options.backend != "host" && upbp_.pp3d) {
+            try {
+                cl_ = std::make_unique<ClRuntime>(options.clPlatform, options.clDevice);
+                backendNote_ = "estimate pass: pp3d on OpenCL device '" + cl_->device().device +
+                               "' (" + cl_->device().platform + "), pb2d/bp2d/bb1d on the host";
+            } catch (const ClError& e) {
+                if (options.backend == "opencl") throw InputError("", e.what());
+                backendNote_ =
+                    std::string("estimate pass on the host (backend auto: ") + e.what() + ")";
+            }
+        } else if (options.backend != "host") {
+            backendNote_ = "estimate pass on the host (no technique with a kernel: pp3d has one)";
+        }
+    }
     baseRadius_ = options.radius * (options.radiusIsRelative ? scene.sceneSphere.radius : 1.0f);
     lightPickProb_ = scene.lights.empty() ? 0.0f : 1.0f / float(scene.lights.size());
     splats_.reset(scene.camera.width(), scene.camera.height());
 }
+
+VertexCM::~VertexCM() = default;
 
 float VertexCM::volumeRadiusAt(int tech, int iteration) const {
     // r_i = r_1 i^((alpha - 1) / k) for a k-dimensional kernel (Knaus & Zwicker 2011, eq. 19
@@ -310,6 +333,7 @@ void VertexCM::renderIteration(int iteration, Image& out) {
         in.photonBeams = &photonBeams_;
         in.queryPoints = &queryPoints_;
         in.queryBeams = &queryBeams_;
+        in.cl = cl_.get();
         std::array<Image, 4> perTech;
         if (layered)
             for (int t = 0; t < 4; ++t)

@@ -68,6 +68,7 @@
 namespace ub {
 
 class Rng;
+class ClRuntime;
 class VertexScatter;
 struct ChainVertex;
 
@@ -79,6 +80,7 @@ class VertexCM : public Integrator {
     /// another name, a thin-lens camera with lt/bpt/vcm/vlt/vbpt, a bad radius/alpha, or a
     /// media set-up vlt/vbpt cannot render (see above).
     VertexCM(const Scene& scene, const RenderOptions& options);
+    ~VertexCM() override;
     void renderIteration(int iteration, Image& out) override;
     /// UPBP: one layer per technique run ("bpt", or "emitted" without bpt: what the camera
     /// pass adds besides merging; "surf", "pp3d", "pb2d", "bp2d", "bb1d").
@@ -87,6 +89,8 @@ class VertexCM : public Integrator {
         return layerNames_.empty() ? nullptr : &layers_;
     }
     std::string iterationSummary() const override;
+    /// Where the estimate pass runs, in words (UPBP; empty otherwise).
+    std::string setupNote() const override { return backendNote_; }
 
     Algorithm algorithm() const { return algorithm_; }
     /// True if subpaths are traced through participating media (vlt/vbpt on a scene with
@@ -203,10 +207,12 @@ class VertexCM : public Integrator {
     RenderOptions options_;
     Algorithm algorithm_;
     bool useVC_ = false, useVM_ = false, lightTraceOnly_ = false, ppm_ = false;
-    bool useMedia_ = false;  ///< vlt/vbpt/upbp on a scene with media
-    UpbpTechniques upbp_;    ///< UPBP techniques (Algorithm::Upbp)
-    int beamPaths_ = 0;      ///< N_B
-    float mediaRadius_ = 1;  ///< what relative UPBP radii are fractions of
+    bool useMedia_ = false;          ///< vlt/vbpt/upbp on a scene with media
+    UpbpTechniques upbp_;            ///< UPBP techniques (Algorithm::Upbp)
+    int beamPaths_ = 0;              ///< N_B
+    float mediaRadius_ = 1;          ///< what relative UPBP radii are fractions of
+    std::unique_ptr<ClRuntime> cl_;  ///< OpenCL backend of the estimate pass, or null
+    std::string backendNote_;
     /// DepthCounting::kNonNullVertices: null-lobe vertices do not count towards the length.
     bool nullNotCounted_ = false;
     std::vector<MediumStack> lightStacks_;  ///< media where each light's subpaths start

@@ -1,0 +1,52 @@
+/* pp3d estimate kernel: one work-item per query point, gathering the photon points of
+ * the hashed grid's buckets around it. All math is kernels/shared/ub_pp3d.h (the host twin
+ * src/estimators/pp3d_estimator.cpp runs the same per-pair function over the same buffers
+ * in the same order). out: 3 floats per query. */
+#include "ub_hash_grid.h"
+#include "ub_pp3d.h"
+
+__kernel void ub_pp3d_estimate(__global const ub_photon_point* photons,
+                               __global const ub_query_point* queries, uint queryCount,
+                               __global const uint* cellEnds, __global const uint* indices,
+                               ub_hash_grid grid, ub_mis_constants mis,
+                               __global const float* mediumG, float normalization,
+                               uint minLength, uint maxLength, __global float* out) {
+    uint i = get_global_id(0);
+    if (i >= queryCount) return;
+    ub_query_point q = queries[i];
+    float g = mediumG[q.mediumId];
+    ub_uint buckets[8];
+    int nb = ub_hash_buckets(grid, ub_f3_from(q.pos), buckets);
+    float sx = 0.0f, sy = 0.0f, sz = 0.0f;
+    for (int k = 0; k < nb; ++k) {
+        uint b = buckets[k];
+        uint begin = b == 0 ? 0u : cellEnds[b - 1], end = cellEnds[b];
+        for (uint j = begin; j < end; ++j) {
+            ub_photon_point ph = photons[indices[j]];
+            ub_float3 c = ub_pp3d_contribution(mis, ph, q, g, grid.radiusSqr, normalization,
+                                               minLength, maxLength);
+            sx += c.x;
+            sy += c.y;
+            sz += c.z;
+        }
+    }
+    out[3 * i + 0] = sx;
+    out[3 * i + 1] = sy;
+    out[3 * i + 2] = sz;
+}
+
+/* Layout probe: the device's sizes and offsets of the shared records, compared with the
+ * host's at start-up (src/cl/cl_runtime.cpp): a mismatch is an error, never garbage. */
+__kernel void ub_layout_probe(__global uint* out) {
+    ub_photon_point ph;
+    ub_query_point q;
+    ub_beam b;
+    out[0] = (uint)sizeof(ub_photon_point);
+    out[1] = (uint)sizeof(ub_query_point);
+    out[2] = (uint)sizeof(ub_beam);
+    out[3] = (uint)sizeof(ub_hash_grid);
+    out[4] = (uint)sizeof(ub_mis_constants);
+    out[5] = (uint)((__private char*)&ph.dVCM - (__private char*)&ph);
+    out[6] = (uint)((__private char*)&q.pixel - (__private char*)&q);
+    out[7] = (uint)((__private char*)&b.fwdPassBefore - (__private char*)&b);
+}

@@ -1,0 +1,60 @@
+/* The hashed uniform grid of the point estimators (pp3d, surface merging): cell
+ * hashing and the buckets a range query visits, shared by the host build and
+ * query (src/estimators/hash_grid.h) and the OpenCL kernels, so that both visit
+ * the same photons in the same order. After Teschner et al. 2003, "Optimized
+ * Spatial Hashing for Collision Detection of Deformable Objects", as in SmallVCM.
+ *
+ * Cells have edge 2r; the ball of radius r around a query point lies in the
+ * 2x2x2 block of cells nearest to it. Cells hash into cellCount buckets; the
+ * points' indices are laid out bucket by bucket (cellEnds[b] is the end of bucket
+ * b, its start cellEnds[b-1] or 0).
+ */
+#ifndef UB_HASH_GRID_H
+#define UB_HASH_GRID_H
+
+#include "ub_vec3.h"
+
+typedef struct {
+    float lo[3];       /* corner of the points' bounding box */
+    float invCellSize; /* 1 / (2 r) */
+    float radiusSqr;
+    ub_uint cellCount; /* buckets, >= 1 */
+    ub_uint pad0, pad1;
+} ub_hash_grid;
+
+/* Bucket of integer cell (x, y, z) (Teschner et al. 2003). */
+UB_INLINE ub_uint ub_hash_cell(ub_hash_grid g, int x, int y, int z) {
+    ub_uint h = ((ub_uint)(x)*73856093u) ^ ((ub_uint)(y)*19349663u) ^ ((ub_uint)(z)*83492791u);
+    return h % g.cellCount;
+}
+
+/* Bucket of a point. */
+UB_INLINE ub_uint ub_hash_point(ub_hash_grid g, ub_float3 p) {
+    return ub_hash_cell(g, (int)ub_floor((p.x - g.lo[0]) * g.invCellSize),
+                        (int)ub_floor((p.y - g.lo[1]) * g.invCellSize),
+                        (int)ub_floor((p.z - g.lo[2]) * g.invCellSize));
+}
+
+/* The distinct buckets of the 2x2x2 block of cells nearest to q (two cells may hash to the
+ * same bucket: each is visited once); returns how many (<= 8). */
+UB_INLINE int ub_hash_buckets(ub_hash_grid g, ub_float3 q, UB_PRIVATE ub_uint* buckets) {
+    float d[3];
+    int base[3];
+    d[0] = (q.x - g.lo[0]) * g.invCellSize;
+    d[1] = (q.y - g.lo[1]) * g.invCellSize;
+    d[2] = (q.z - g.lo[2]) * g.invCellSize;
+    for (int a = 0; a < 3; ++a) {
+        float f = ub_floor(d[a]);
+        base[a] = (int)f - (d[a] - f < 0.5f ? 1 : 0);
+    }
+    int nb = 0;
+    for (int k = 0; k < 8; ++k) {
+        ub_uint b = ub_hash_cell(g, base[0] + (k & 1), base[1] + ((k >> 1) & 1), base[2] + (k >> 2));
+        int seen = 0;
+        for (int j = 0; j < nb; ++j) seen |= buckets[j] == b;
+        if (!seen) buckets[nb++] = b;
+    }
+    return nb;
+}
+
+#endif /* UB_HASH_GRID_H */

@@ -1,0 +1,288 @@
+// OpenCL runtime (see cl_runtime.h).
+#include "cl/cl_runtime.h"
+
+#include <cstddef>
+#include <cstring>
+#include <set>
+#include <sstream>
+
+#include "cl/embedded_kernels.h"
+#include "estimators/hash_grid.h"
+
+namespace ub {
+
+namespace {
+
+std::string clString(cl_device_id d, cl_device_info what) {
+    size_t n = 0;
+    if (clGetDeviceInfo(d, what, 0, nullptr, &n) != CL_SUCCESS || n == 0) return "";
+    std::string s(n, '\0');
+    clGetDeviceInfo(d, what, n, &s[0], nullptr);
+    while (!s.empty() && s.back() == '\0') s.pop_back();
+    return s;
+}
+
+std::string platformString(cl_platform_id p, cl_platform_info what) {
+    size_t n = 0;
+    if (clGetPlatformInfo(p, what, 0, nullptr, &n) != CL_SUCCESS || n == 0) return "";
+    std::string s(n, '\0');
+    clGetPlatformInfo(p, what, n, &s[0], nullptr);
+    while (!s.empty() && s.back() == '\0') s.pop_back();
+    return s;
+}
+
+void check(cl_int err, const char* what) {
+    if (err == CL_SUCCESS) return;
+    std::string msg = std::string("OpenCL: ") + what + " failed (error " + std::to_string(err) + ")";
+    if (err == CL_OUT_OF_RESOURCES || err == CL_MEM_OBJECT_ALLOCATION_FAILURE ||
+        err == CL_OUT_OF_HOST_MEMORY)
+        msg += ": the device is out of resources (a smaller --resolution needs less)";
+    throw ClError(msg);
+}
+
+const char* findEmbedded(const std::string& name) {
+    for (size_t i = 0; i < kEmbeddedKernelFileCount; ++i)
+        if (name == kEmbeddedKernelFiles[i].name) return kEmbeddedKernelFiles[i].text;
+    return nullptr;
+}
+
+void expandIncludes(const std::string& name, std::set<std::string>& done, std::string& out) {
+    if (!done.insert(name).second) return;
+    const char* text = findEmbedded(name);
+    if (!text) throw ClError("OpenCL: no embedded kernel source '" + name + "'");
+    std::istringstream in(text);
+    std::string line;
+    while (std::getline(in, line)) {
+        const size_t p = line.find("#include \"");
+        if (p != std::string::npos && line.find_first_not_of(" \t") == p) {
+            const size_t q = line.find('"', p + 10);
+            expandIncludes(line.substr(p + 10, q - p - 10), done, out);
+            continue;
+        }
+        out += line;
+        out += '\n';
+    }
+}
+
+/// A device buffer copied from host data (at least one element, so empty inputs work).
+cl_mem upload(cl_context ctx, const void* data, size_t bytes) {
+    cl_int err = CL_SUCCESS;
+    static const uint32_t dummy = 0;
+    cl_mem m = clCreateBuffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                              bytes > 0 ? bytes : sizeof(dummy),
+                              const_cast<void*>(bytes > 0 ? data : &dummy), &err);
+    check(err, "clCreateBuffer");
+    return m;
+}
+
+}  // namespace
+
+std::vector<ClDeviceDescription> listClDevices(std::string* error) {
+    std::vector<ClDeviceDescription> out;
+    cl_uint np = 0;
+    if (clGetPlatformIDs(0, nullptr, &np) != CL_SUCCESS || np == 0) {
+        if (error)
+            *error =
+                "no OpenCL platform found (scripts/setup.sh installs PoCL, pocl-opencl-icd; "
+                "check /etc/OpenCL/vendors)";
+        return out;
+    }
+    std::vector<cl_platform_id> platforms(np);
+    clGetPlatformIDs(np, platforms.data(), nullptr);
+    for (cl_uint p = 0; p < np; ++p) {
+        cl_uint nd = 0;
+        if (clGetDeviceIDs(platforms[p], CL_DEVICE_TYPE_ALL, 0, nullptr, &nd) != CL_SUCCESS)
+            continue;
+        std::vector<cl_device_id> devices(nd);
+        clGetDeviceIDs(platforms[p], CL_DEVICE_TYPE_ALL, nd, devices.data(), nullptr);
+        for (cl_uint d = 0; d < nd; ++d) {
+            ClDeviceDescription desc;
+            desc.platformIndex = int(p);
+            desc.deviceIndex = int(d);
+            desc.platform = platformString(platforms[p], CL_PLATFORM_NAME);
+            desc.device = clString(devices[d], CL_DEVICE_NAME);
+            desc.version = clString(devices[d], CL_DEVICE_VERSION);
+            desc.driver = clString(devices[d], CL_DRIVER_VERSION);
+            cl_device_type type = 0;
+            clGetDeviceInfo(devices[d], CL_DEVICE_TYPE, sizeof(type), &type, nullptr);
+            desc.type = (type & CL_DEVICE_TYPE_GPU)   ? "GPU"
+                        : (type & CL_DEVICE_TYPE_CPU) ? "CPU"
+                                                      : "other";
+            cl_uint cu = 0;
+            clGetDeviceInfo(devices[d], CL_DEVICE_MAX_COMPUTE_UNITS, sizeof(cu), &cu, nullptr);
+            desc.computeUnits = cu;
+            cl_ulong mem = 0, alloc = 0;
+            clGetDeviceInfo(devices[d], CL_DEVICE_GLOBAL_MEM_SIZE, sizeof(mem), &mem, nullptr);
+            clGetDeviceInfo(devices[d], CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof(alloc), &alloc,
+                            nullptr);
+            desc.globalMemBytes = mem;
+            desc.maxAllocBytes = alloc;
+            out.push_back(desc);
+        }
+    }
+    if (out.empty() && error) *error = "OpenCL platforms found, but no device";
+    return out;
+}
+
+std::string clProgramSource(const std::string& file) {
+    std::set<std::string> done;
+    std::string out;
+    expandIncludes(file, done, out);
+    return out;
+}
+
+ClRuntime::ClRuntime(int platform, int device) {
+    std::string why;
+    std::vector<ClDeviceDescription> all = listClDevices(&why);
+    if (all.empty()) throw ClError("OpenCL: " + why);
+    const ClDeviceDescription* pick = nullptr;
+    for (const auto& d : all)
+        if ((platform < 0 && device < 0) ||
+            (d.platformIndex == platform && d.deviceIndex == device)) {
+            pick = &d;
+            break;
+        }
+    if (!pick) {
+        std::string list;
+        for (const auto& d : all)
+            list += " " + std::to_string(d.platformIndex) + ":" + std::to_string(d.deviceIndex);
+        throw ClError("OpenCL: no device " + std::to_string(platform) + ":" +
+                      std::to_string(device) + " (devices:" + list + ")");
+    }
+    desc_ = *pick;
+    cl_uint np = 0;
+    clGetPlatformIDs(0, nullptr, &np);
+    std::vector<cl_platform_id> platforms(np);
+    clGetPlatformIDs(np, platforms.data(), nullptr);
+    cl_uint nd = 0;
+    clGetDeviceIDs(platforms[size_t(desc_.platformIndex)], CL_DEVICE_TYPE_ALL, 0, nullptr, &nd);
+    std::vector<cl_device_id> devices(nd);
+    clGetDeviceIDs(platforms[size_t(desc_.platformIndex)], CL_DEVICE_TYPE_ALL, nd, devices.data(),
+                   nullptr);
+    cl_device_id dev = devices[size_t(desc_.deviceIndex)];
+    cl_int err = CL_SUCCESS;
+    context_ = clCreateContext(nullptr, 1, &dev, nullptr, nullptr, &err);
+    check(err, "clCreateContext");
+    queue_ = clCreateCommandQueue(context_, dev, 0, &err);
+    check(err, "clCreateCommandQueue");
+    const std::string src = clProgramSource("pp3d.cl");
+    const char* text = src.c_str();
+    const size_t len = src.size();
+    program_ = clCreateProgramWithSource(context_, 1, &text, &len, &err);
+    check(err, "clCreateProgramWithSource");
+    const char* options = "-cl-std=CL1.2";
+    if (clBuildProgram(program_, 1, &dev, options, nullptr, nullptr) != CL_SUCCESS) {
+        size_t n = 0;
+        clGetProgramBuildInfo(program_, dev, CL_PROGRAM_BUILD_LOG, 0, nullptr, &n);
+        std::string log(n, '\0');
+        clGetProgramBuildInfo(program_, dev, CL_PROGRAM_BUILD_LOG, n, &log[0], nullptr);
+        throw ClError("OpenCL: building kernels/pp3d.cl for " + desc_.device + " with '" +
+                      options + "' failed:\n" + log);
+    }
+    pp3d_ = clCreateKernel(program_, "ub_pp3d_estimate", &err);
+    check(err, "clCreateKernel(ub_pp3d_estimate)");
+    checkLayout();
+}
+
+void ClRuntime::checkLayout() {
+    cl_int err = CL_SUCCESS;
+    cl_kernel probe = clCreateKernel(program_, "ub_layout_probe", &err);
+    check(err, "clCreateKernel(ub_layout_probe)");
+    cl_mem out = clCreateBuffer(context_, CL_MEM_WRITE_ONLY, 8 * sizeof(cl_uint), nullptr, &err);
+    if (err != CL_SUCCESS) clReleaseKernel(probe);
+    check(err, "clCreateBuffer(layout probe)");
+    cl_uint device[8] = {};
+    const size_t one = 1;
+    err = clSetKernelArg(probe, 0, sizeof(cl_mem), &out);
+    if (err == CL_SUCCESS)
+        err = clEnqueueNDRangeKernel(queue_, probe, 1, nullptr, &one, &one, 0, nullptr, nullptr);
+    if (err == CL_SUCCESS)
+        err = clEnqueueReadBuffer(queue_, out, CL_TRUE, 0, sizeof(device), device, 0, nullptr,
+                                  nullptr);
+    clReleaseMemObject(out);
+    clReleaseKernel(probe);
+    check(err, "running the layout probe");
+    const cl_uint host[8] = {cl_uint(sizeof(ub_photon_point)),
+                             cl_uint(sizeof(ub_query_point)),
+                             cl_uint(sizeof(ub_beam)),
+                             cl_uint(sizeof(ub_hash_grid)),
+                             cl_uint(sizeof(ub_mis_constants)),
+                             cl_uint(offsetof(ub_photon_point, dVCM)),
+                             cl_uint(offsetof(ub_query_point, pixel)),
+                             cl_uint(offsetof(ub_beam, fwdPassBefore))};
+    const char* what[8] = {"sizeof(ub_photon_point)", "sizeof(ub_query_point)",
+                           "sizeof(ub_beam)",         "sizeof(ub_hash_grid)",
+                           "sizeof(ub_mis_constants)", "offsetof(ub_photon_point, dVCM)",
+                           "offsetof(ub_query_point, pixel)",
+                           "offsetof(ub_beam, fwdPassBefore)"};
+    for (int i = 0; i < 8; ++i)
+        if (device[i] != host[i])
+            throw ClError("OpenCL: device '" + desc_.device + "' lays out the shared records "
+                          "differently from the host: " + what[i] + " is " +
+                          std::to_string(device[i]) + " on the device, " +
+                          std::to_string(host[i]) + " on the host");
+}
+
+ClRuntime::~ClRuntime() {
+    if (pp3d_) clReleaseKernel(pp3d_);
+    if (program_) clReleaseProgram(program_);
+    if (queue_) clReleaseCommandQueue(queue_);
+    if (context_) clReleaseContext(context_);
+}
+
+void ClRuntime::estimatePP3D(const std::vector<ub_photon_point>& photons,
+                             const std::vector<ub_query_point>& queries, const HashGrid& grid,
+                             const ub_mis_constants& mis, const std::vector<float>& mediumG,
+                             float normalization, uint32_t minLength, uint32_t maxLength,
+                             std::vector<Rgb>* out) {
+    out->assign(queries.size(), Rgb(0.0f));
+    if (queries.empty() || photons.empty()) return;
+    struct Buffers {
+        std::vector<cl_mem> mems;
+        ~Buffers() {
+            for (cl_mem m : mems) clReleaseMemObject(m);
+        }
+    } b;
+    cl_mem ph = upload(context_, photons.data(), photons.size() * sizeof(ub_photon_point));
+    b.mems.push_back(ph);
+    cl_mem qs = upload(context_, queries.data(), queries.size() * sizeof(ub_query_point));
+    b.mems.push_back(qs);
+    cl_mem ends = upload(context_, grid.cellEnds().data(), grid.cellEnds().size() * 4);
+    b.mems.push_back(ends);
+    cl_mem idx = upload(context_, grid.indices().data(), grid.indices().size() * 4);
+    b.mems.push_back(idx);
+    cl_mem gs = upload(context_, mediumG.data(), mediumG.size() * 4);
+    b.mems.push_back(gs);
+    cl_int err = CL_SUCCESS;
+    cl_mem res =
+        clCreateBuffer(context_, CL_MEM_WRITE_ONLY, queries.size() * 3 * sizeof(float), nullptr, &err);
+    check(err, "clCreateBuffer(results)");
+    b.mems.push_back(res);
+    const cl_uint count = cl_uint(queries.size());
+    const ub_hash_grid params = grid.params();
+    int a = 0;
+    check(clSetKernelArg(pp3d_, a++, sizeof(cl_mem), &ph), "clSetKernelArg");
+    check(clSetKernelArg(pp3d_, a++, sizeof(cl_mem), &qs), "clSetKernelArg");
+    check(clSetKernelArg(pp3d_, a++, sizeof(cl_uint), &count), "clSetKernelArg");
+    check(clSetKernelArg(pp3d_, a++, sizeof(cl_mem), &ends), "clSetKernelArg");
+    check(clSetKernelArg(pp3d_, a++, sizeof(cl_mem), &idx), "clSetKernelArg");
+    check(clSetKernelArg(pp3d_, a++, sizeof(ub_hash_grid), &params), "clSetKernelArg");
+    check(clSetKernelArg(pp3d_, a++, sizeof(ub_mis_constants), &mis), "clSetKernelArg");
+    check(clSetKernelArg(pp3d_, a++, sizeof(cl_mem), &gs), "clSetKernelArg");
+    check(clSetKernelArg(pp3d_, a++, sizeof(float), &normalization), "clSetKernelArg");
+    check(clSetKernelArg(pp3d_, a++, sizeof(cl_uint), &minLength), "clSetKernelArg");
+    check(clSetKernelArg(pp3d_, a++, sizeof(cl_uint), &maxLength), "clSetKernelArg");
+    check(clSetKernelArg(pp3d_, a++, sizeof(cl_mem), &res), "clSetKernelArg");
+    const size_t local = 64;
+    const size_t global = (queries.size() + local - 1) / local * local;
+    check(clEnqueueNDRangeKernel(queue_, pp3d_, 1, nullptr, &global, &local, 0, nullptr, nullptr),
+          "clEnqueueNDRangeKernel(ub_pp3d_estimate)");
+    std::vector<float> host(queries.size() * 3);
+    check(clEnqueueReadBuffer(queue_, res, CL_TRUE, 0, host.size() * sizeof(float), host.data(), 0,
+                              nullptr, nullptr),
+          "clEnqueueReadBuffer(results)");
+    for (size_t i = 0; i < queries.size(); ++i)
+        (*out)[i] = Rgb(host[3 * i], host[3 * i + 1], host[3 * i + 2]);
+}
+
+}  // namespace ub

@@ -1,0 +1,78 @@
+// OpenCL runtime of UPBP's estimate pass: device discovery, the program built from
+// the embedded kernel sources (kernels/*.cl with kernels/shared/*.h, the same headers
+// the host twins compile; cmake/EmbedKernels.cmake), buffers and kernel launches.
+//
+// Status: the pp3d estimator runs as a kernel (kernels/pp3d.cl); pb2d, bp2d and bb1d
+// run on the host (their beam medium tabulation and BVH traversal are not in
+// kernels/shared yet). Results come back one per query and are added to pixels on the
+// host in query order, so no float atomics are needed and images are deterministic.
+#pragma once
+
+#define CL_TARGET_OPENCL_VERSION 120
+#include <CL/cl.h>
+
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/vec.h"
+#include "kernels/shared/ub_upbp_records.h"
+
+namespace ub {
+
+class HashGrid;
+
+/// An OpenCL problem (no platform, bad device index, build failure, out of resources):
+/// the message says what and, for build failures, includes the build log and options.
+class ClError : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+struct ClDeviceDescription {
+    int platformIndex = 0, deviceIndex = 0;
+    std::string platform, device, type, version, driver;
+    unsigned computeUnits = 0;
+    uint64_t globalMemBytes = 0, maxAllocBytes = 0;
+};
+
+/// Every device of every platform (empty, with *error set, if there is no platform).
+std::vector<ClDeviceDescription> listClDevices(std::string* error);
+
+/// The embedded source of kernels/`file` with every #include "x.h" replaced by the
+/// embedded kernels/shared/x.h, each header once. Throws ClError for an unknown file.
+std::string clProgramSource(const std::string& file);
+
+class ClRuntime {
+  public:
+    /// Opens device `device` of platform `platform` (both -1: the first device found) and
+    /// builds the estimate kernels. Throws ClError.
+    ClRuntime(int platform, int device);
+    ~ClRuntime();
+    ClRuntime(const ClRuntime&) = delete;
+    ClRuntime& operator=(const ClRuntime&) = delete;
+
+    const ClDeviceDescription& device() const { return desc_; }
+
+    /// pp3d (kernels/pp3d.cl) over the given records and grid: (*out)[i] is query i's
+    /// estimate, as estimatePP3D on the host computes it.
+    void estimatePP3D(const std::vector<ub_photon_point>& photons,
+                      const std::vector<ub_query_point>& queries, const HashGrid& grid,
+                      const ub_mis_constants& mis, const std::vector<float>& mediumG,
+                      float normalization, uint32_t minLength, uint32_t maxLength,
+                      std::vector<Rgb>* out);
+
+  private:
+    /// Runs the layout probe (kernels/pp3d.cl) and compares with the host; throws ClError.
+    void checkLayout();
+
+    ClDeviceDescription desc_;
+    cl_context context_ = nullptr;
+    cl_command_queue queue_ = nullptr;
+    cl_program program_ = nullptr;
+    cl_kernel pp3d_ = nullptr;
+};
+
+}  // namespace ub
