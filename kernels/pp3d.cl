@@ -9,8 +9,8 @@ __kernel void ub_pp3d_estimate(__global const ub_photon_point* photons,
                                __global const ub_query_point* queries, uint queryCount,
                                __global const uint* cellEnds, __global const uint* indices,
                                ub_hash_grid grid, ub_mis_constants mis,
-                               __global const float* mediumG, float normalization,
-                               uint minLength, uint maxLength, __global float* out) {
+                               __global const float* mediumG, float normalization, uint minLength,
+                               uint maxLength, __global float* out) {
     uint i = get_global_id(0);
     if (i >= queryCount) return;
     ub_query_point q = queries[i];

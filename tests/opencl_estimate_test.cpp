@@ -71,8 +71,8 @@ TEST(OpenClEstimate, Pp3dKernelEqualsHostTwinPerQuery) {
                sizeof(ub_photon_point), r);
     VolumeEstimateInput in;
     in.scene = scene.get();
-    in.mis = ub_mis_enable_volume(
-        ub_mis_make_constants(0.01f, 1024.0f, 1, 0, UB_MIS_POWER), r, 0, 0, 0, 64.0f, 1, 0);
+    in.mis = ub_mis_enable_volume(ub_mis_make_constants(0.01f, 1024.0f, 1, 0, UB_MIS_POWER), r, 0,
+                                  0, 0, 64.0f, 1, 0);
     in.techniques.pp3d = true;
     in.radius[UB_TECH_PP3D] = r;
     in.lightPathCount = 1024.0f;

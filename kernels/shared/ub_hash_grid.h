@@ -49,7 +49,8 @@ UB_INLINE int ub_hash_buckets(ub_hash_grid g, ub_float3 q, UB_PRIVATE ub_uint* b
     }
     int nb = 0;
     for (int k = 0; k < 8; ++k) {
-        ub_uint b = ub_hash_cell(g, base[0] + (k & 1), base[1] + ((k >> 1) & 1), base[2] + (k >> 2));
+        ub_uint b =
+            ub_hash_cell(g, base[0] + (k & 1), base[1] + ((k >> 1) & 1), base[2] + (k >> 2));
         int seen = 0;
         for (int j = 0; j < nb; ++j) seen |= buckets[j] == b;
         if (!seen) buckets[nb++] = b;

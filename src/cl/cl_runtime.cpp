@@ -33,7 +33,8 @@ std::string platformString(cl_platform_id p, cl_platform_info what) {
 
 void check(cl_int err, const char* what) {
     if (err == CL_SUCCESS) return;
-    std::string msg = std::string("OpenCL: ") + what + " failed (error " + std::to_string(err) + ")";
+    std::string msg =
+        std::string("OpenCL: ") + what + " failed (error " + std::to_string(err) + ")";
     if (err == CL_OUT_OF_RESOURCES || err == CL_MEM_OBJECT_ALLOCATION_FAILURE ||
         err == CL_OUT_OF_HOST_MEMORY)
         msg += ": the device is out of resources (a smaller --resolution needs less)";
@@ -176,8 +177,8 @@ ClRuntime::ClRuntime(int platform, int device) {
         clGetProgramBuildInfo(program_, dev, CL_PROGRAM_BUILD_LOG, 0, nullptr, &n);
         std::string log(n, '\0');
         clGetProgramBuildInfo(program_, dev, CL_PROGRAM_BUILD_LOG, n, &log[0], nullptr);
-        throw ClError("OpenCL: building kernels/pp3d.cl for " + desc_.device + " with '" +
-                      options + "' failed:\n" + log);
+        throw ClError("OpenCL: building kernels/pp3d.cl for " + desc_.device + " with '" + options +
+                      "' failed:\n" + log);
     }
     pp3d_ = clCreateKernel(program_, "ub_pp3d_estimate", &err);
     check(err, "clCreateKernel(ub_pp3d_estimate)");
@@ -210,16 +211,20 @@ void ClRuntime::checkLayout() {
                              cl_uint(offsetof(ub_photon_point, dVCM)),
                              cl_uint(offsetof(ub_query_point, pixel)),
                              cl_uint(offsetof(ub_beam, fwdPassBefore))};
-    const char* what[8] = {"sizeof(ub_photon_point)", "sizeof(ub_query_point)",
-                           "sizeof(ub_beam)",         "sizeof(ub_hash_grid)",
-                           "sizeof(ub_mis_constants)", "offsetof(ub_photon_point, dVCM)",
+    const char* what[8] = {"sizeof(ub_photon_point)",
+                           "sizeof(ub_query_point)",
+                           "sizeof(ub_beam)",
+                           "sizeof(ub_hash_grid)",
+                           "sizeof(ub_mis_constants)",
+                           "offsetof(ub_photon_point, dVCM)",
                            "offsetof(ub_query_point, pixel)",
                            "offsetof(ub_beam, fwdPassBefore)"};
     for (int i = 0; i < 8; ++i)
         if (device[i] != host[i])
-            throw ClError("OpenCL: device '" + desc_.device + "' lays out the shared records "
-                          "differently from the host: " + what[i] + " is " +
-                          std::to_string(device[i]) + " on the device, " +
+            throw ClError("OpenCL: device '" + desc_.device +
+                          "' lays out the shared records "
+                          "differently from the host: " +
+                          what[i] + " is " + std::to_string(device[i]) + " on the device, " +
                           std::to_string(host[i]) + " on the host");
 }
 
@@ -254,8 +259,8 @@ void ClRuntime::estimatePP3D(const std::vector<ub_photon_point>& photons,
     cl_mem gs = upload(context_, mediumG.data(), mediumG.size() * 4);
     b.mems.push_back(gs);
     cl_int err = CL_SUCCESS;
-    cl_mem res =
-        clCreateBuffer(context_, CL_MEM_WRITE_ONLY, queries.size() * 3 * sizeof(float), nullptr, &err);
+    cl_mem res = clCreateBuffer(context_, CL_MEM_WRITE_ONLY, queries.size() * 3 * sizeof(float),
+                                nullptr, &err);
     check(err, "clCreateBuffer(results)");
     b.mems.push_back(res);
     const cl_uint count = cl_uint(queries.size());

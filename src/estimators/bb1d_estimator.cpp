@@ -43,7 +43,7 @@ void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
                                                     &tc, &tl, &sinTheta);
                 if (d2 < 0.0f || d2 > r * r) return;
                 if (tc < 0.0f || tc > qb.length || tl < 0.0f || tl > pb.length) return;
-                if (tl < part.t0 || (tl >= part.t1 && part.t1 < pb.length)) return;
+                if (!ub_beam_part_holds(part, tl, pb.length)) return;
                 if (!queryMedium.built()) queryMedium.build();
                 const ub_segment_eval sl = photonMedia[part.beam].eval(tl);
                 const ub_segment_eval sc = queryMedium.eval(tc);

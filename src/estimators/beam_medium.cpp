@@ -16,6 +16,19 @@ void BeamMedium::reset(const Scene& scene, const ub_beam& b) {
     tabulated_ = medium_->type == MediumType::kGrid && medium_->filter != GridFilter::kTrilinear;
     built_ = false;
     pieces_.clear();
+    info_ = mediumInfo(*medium_);
+}
+
+ub_medium_info mediumInfo(const Medium& m) {
+    ub_medium_info info{};
+    const Rgb st = m.sigmaA + m.sigmaS;
+    for (int a = 0; a < 3; ++a) {
+        info.sigmaT[a] = st[a];
+        info.sigmaS[a] = m.sigmaS[a];
+    }
+    info.g = m.g;
+    info.homogeneous = m.type == MediumType::kHomogeneous ? 1u : 0u;
+    return info;
 }
 
 void BeamMedium::build() {
@@ -33,6 +46,7 @@ void BeamMedium::build() {
 ub_segment_eval BeamMedium::eval(float t) const {
     const Vec3 o(beam_->origin[0], beam_->origin[1], beam_->origin[2]);
     const Vec3 d(beam_->dir[0], beam_->dir[1], beam_->dir[2]);
+    if (medium_->type == MediumType::kHomogeneous) return ub_homogeneous_segment(info_, t);
     if (!tabulated_ || pieces_.empty()) {
         const MediumSegment s = evalMediumSegment(*medium_, o, d, t);
         ub_segment_eval e;

@@ -13,6 +13,7 @@
 
 #include <vector>
 
+#include "kernels/shared/ub_medium_homogeneous.h"
 #include "kernels/shared/ub_upbp_records.h"
 
 namespace ub {
@@ -39,6 +40,10 @@ class BeamMedium {
     const ub_beam* beam_ = nullptr;
     bool tabulated_ = false, built_ = false;
     std::vector<Piece> pieces_;
+    ub_medium_info info_{};  ///< homogeneous media: the closed form of the kernels
 };
+
+/// What the kernels know of a medium (kernels/shared/ub_medium_homogeneous.h).
+ub_medium_info mediumInfo(const Medium& m);
 
 }  // namespace ub

@@ -38,7 +38,7 @@ void estimateBP2D(const VolumeEstimateInput& in, const Bvh& beamParts,
                 ub_point_beam_dist2(p, ub_f3_from(pb.origin), ub_f3_from(pb.dir), pb.length, &t);
             if (d2 < 0.0f || d2 > r * r) return;
             // The part holding the projection counts the beam (once per beam).
-            if (t < part.t0 || (t >= part.t1 && part.t1 < pb.length)) return;
+            if (!ub_beam_part_holds(part, t, pb.length)) return;
             const ub_segment_eval s = photonMedia[part.beam].eval(t);
             const ub_float3 c = ub_bp2d_contribution(in.mis, pb, q, s, t, g, normalization);
             sum += Rgb(c.x, c.y, c.z);

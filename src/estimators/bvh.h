@@ -19,15 +19,13 @@
 #include <vector>
 
 #include "core/vec.h"
+#include "kernels/shared/ub_bvh.h"
 
 namespace ub {
 
-struct BvhNode {
-    float lo[3];
-    uint32_t first;  ///< leaf: first index into Bvh::prims; inner: index of the right child
-    float hi[3];
-    uint32_t count;  ///< leaf: primitive count (> 0); inner: 0 (left child = this + 1)
-};
+/// The flat node (kernels/shared/ub_bvh.h): leaf count > 0 at prims[first ..], inner nodes
+/// count 0 with the left child next and the right child at `first`.
+using BvhNode = ub_bvh_node;
 static_assert(sizeof(BvhNode) == 32, "BvhNode layout");
 
 class Bvh {
@@ -39,6 +37,8 @@ class Bvh {
     bool empty() const { return nodes_.empty(); }
     size_t nodeCount() const { return nodes_.size(); }
     size_t bytes() const { return nodes_.size() * sizeof(BvhNode) + prims_.size() * 4; }
+    const std::vector<BvhNode>& nodes() const { return nodes_; }
+    const std::vector<uint32_t>& prims() const { return prims_; }
 
     /// visit(i) for every primitive whose box contains p.
     template <class Visit>
@@ -48,23 +48,6 @@ class Bvh {
     void querySegment(const Vec3& o, const Vec3& d, float len, Visit&& visit) const;
 
   private:
-    static bool contains(const BvhNode& n, const Vec3& p) {
-        return p.x >= n.lo[0] && p.x <= n.hi[0] && p.y >= n.lo[1] && p.y <= n.hi[1] &&
-               p.z >= n.lo[2] && p.z <= n.hi[2];
-    }
-    /// Slab test of the segment against the node's box (invD = 1 / d per axis, inf for 0).
-    static bool meets(const BvhNode& n, const Vec3& o, const Vec3& invD, float len) {
-        float t0 = 0.0f, t1 = len;
-        for (int a = 0; a < 3; ++a) {
-            float ta = (n.lo[a] - o[a]) * invD[a], tb = (n.hi[a] - o[a]) * invD[a];
-            if (ta > tb) std::swap(ta, tb);
-            // NaN (0 * inf: origin on a slab plane of a flat box) keeps the interval.
-            if (ta > t0) t0 = ta;
-            if (tb < t1) t1 = tb;
-            if (t0 > t1) return false;
-        }
-        return true;
-    }
     /// Depth-first walk: visit(i) for the primitives of every leaf whose path accept()s.
     template <class Accept, class Visit>
     void traverse(Accept&& accept, Visit&& visit) const;
@@ -96,13 +79,15 @@ void Bvh::traverse(Accept&& accept, Visit&& visit) const {
 
 template <class Visit>
 void Bvh::queryPoint(const Vec3& p, Visit&& visit) const {
-    traverse([&](const BvhNode& n) { return contains(n, p); }, visit);
+    const ub_float3 q = ub_make_float3(p.x, p.y, p.z);
+    traverse([&](const BvhNode& n) { return ub_bvh_contains(n, q) != 0; }, visit);
 }
 
 template <class Visit>
 void Bvh::querySegment(const Vec3& o, const Vec3& d, float len, Visit&& visit) const {
-    const Vec3 invD(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
-    traverse([&](const BvhNode& n) { return meets(n, o, invD, len); }, visit);
+    const ub_float3 oo = ub_make_float3(o.x, o.y, o.z);
+    const ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+    traverse([&](const BvhNode& n) { return ub_bvh_meets(n, oo, invD, len) != 0; }, visit);
 }
 
 }  // namespace ub

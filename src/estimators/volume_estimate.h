@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "kernels/shared/ub_bvh.h"
 #include "kernels/shared/ub_upbp_records.h"
 #include "render/upbp_techniques.h"
 
@@ -88,10 +89,7 @@ void forEachQuery(size_t n, size_t grain, std::vector<Rgb>* out, size_t* pairs,
 class HashGrid;
 class Bvh;
 class BeamMedium;
-struct BeamPart {
-    uint32_t beam;
-    float t0, t1;  ///< parameter range of the part on its beam
-};
+using BeamPart = ub_beam_part;  ///< a diced part of a photon beam (kernels/shared/ub_bvh.h)
 void estimatePP3D(const VolumeEstimateInput& in, const HashGrid& grid, std::vector<Rgb>* out,
                   size_t* pairs);
 void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres, std::vector<Rgb>* out,

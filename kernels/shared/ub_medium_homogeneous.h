@@ -1,0 +1,37 @@
+/* A homogeneous medium along a beam, in closed form: the ub_segment_eval of
+ * [0, t] (transmittance, sigma_s at the end, free-flight densities of stopping at
+ * either end and of passing, spectral MIS over RGB: pdfs are channel averages; Novak
+ * et al. 2018, Sec. 5.1). The host twins (src/estimators/beam_medium.cpp) and the
+ * kernels evaluate homogeneous media with this function. */
+#ifndef UB_MEDIUM_HOMOGENEOUS_H
+#define UB_MEDIUM_HOMOGENEOUS_H
+
+#include "ub_upbp_records.h"
+
+/* What the kernels know of a medium. 32 bytes. */
+typedef struct {
+    float sigmaT[3];
+    float sigmaS[3];
+    float g;
+    ub_uint homogeneous; /* 0: a grid (the kernels leave such media to the host) */
+} ub_medium_info;
+
+UB_INLINE ub_segment_eval ub_homogeneous_segment(ub_medium_info m, float t) {
+    ub_segment_eval e;
+    float stop = 0.0f, pass = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+        float T = ub_exp(-m.sigmaT[a] * t);
+        e.transmittance[a] = T;
+        e.sigmaS[a] = m.sigmaS[a];
+        stop += m.sigmaT[a] * T;
+        pass += T;
+    }
+    e.stopFwdL = stop * (1.0f / 3.0f);
+    e.stopRevStartL = e.stopFwdL; /* the same extinction at both ends */
+    e.passProb = pass * (1.0f / 3.0f);
+    e.contProb = ub_medium_cont_prob(m.sigmaS[0], m.sigmaS[1], m.sigmaS[2], m.sigmaT[0],
+                                     m.sigmaT[1], m.sigmaT[2]);
+    return e;
+}
+
+#endif /* UB_MEDIUM_HOMOGENEOUS_H */
