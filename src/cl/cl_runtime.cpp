@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "cl/embedded_kernels.h"
+#include "estimators/bvh.h"
 #include "estimators/hash_grid.h"
 
 namespace ub {
@@ -125,10 +126,10 @@ std::vector<ClDeviceDescription> listClDevices(std::string* error) {
     return out;
 }
 
-std::string clProgramSource(const std::string& file) {
+std::string clProgramSource(const std::vector<std::string>& files) {
     std::set<std::string> done;
     std::string out;
-    expandIncludes(file, done, out);
+    for (const std::string& f : files) expandIncludes(f, done, out);
     return out;
 }
 
@@ -166,7 +167,7 @@ ClRuntime::ClRuntime(int platform, int device) {
     check(err, "clCreateContext");
     queue_ = clCreateCommandQueue(context_, dev, 0, &err);
     check(err, "clCreateCommandQueue");
-    const std::string src = clProgramSource("pp3d.cl");
+    const std::string src = clProgramSource({"pp3d.cl", "beams.cl"});
     const char* text = src.c_str();
     const size_t len = src.size();
     program_ = clCreateProgramWithSource(context_, 1, &text, &len, &err);
@@ -177,11 +178,17 @@ ClRuntime::ClRuntime(int platform, int device) {
         clGetProgramBuildInfo(program_, dev, CL_PROGRAM_BUILD_LOG, 0, nullptr, &n);
         std::string log(n, '\0');
         clGetProgramBuildInfo(program_, dev, CL_PROGRAM_BUILD_LOG, n, &log[0], nullptr);
-        throw ClError("OpenCL: building kernels/pp3d.cl for " + desc_.device + " with '" + options +
-                      "' failed:\n" + log);
+        throw ClError("OpenCL: building kernels/pp3d.cl and kernels/beams.cl for " + desc_.device +
+                      " with '" + options + "' failed:\n" + log);
     }
     pp3d_ = clCreateKernel(program_, "ub_pp3d_estimate", &err);
     check(err, "clCreateKernel(ub_pp3d_estimate)");
+    pb2d_ = clCreateKernel(program_, "ub_pb2d_estimate", &err);
+    check(err, "clCreateKernel(ub_pb2d_estimate)");
+    bp2d_ = clCreateKernel(program_, "ub_bp2d_estimate", &err);
+    check(err, "clCreateKernel(ub_bp2d_estimate)");
+    bb1d_ = clCreateKernel(program_, "ub_bb1d_estimate", &err);
+    check(err, "clCreateKernel(ub_bb1d_estimate)");
     checkLayout();
 }
 
@@ -229,7 +236,8 @@ void ClRuntime::checkLayout() {
 }
 
 ClRuntime::~ClRuntime() {
-    if (pp3d_) clReleaseKernel(pp3d_);
+    for (cl_kernel k : {pp3d_, pb2d_, bp2d_, bb1d_})
+        if (k) clReleaseKernel(k);
     if (program_) clReleaseProgram(program_);
     if (queue_) clReleaseCommandQueue(queue_);
     if (context_) clReleaseContext(context_);
@@ -288,6 +296,108 @@ void ClRuntime::estimatePP3D(const std::vector<ub_photon_point>& photons,
           "clEnqueueReadBuffer(results)");
     for (size_t i = 0; i < queries.size(); ++i)
         (*out)[i] = Rgb(host[3 * i], host[3 * i + 1], host[3 * i + 2]);
+}
+
+void ClRuntime::run(cl_kernel kernel, const char* name, const std::vector<Arg>& args, size_t count,
+                    std::vector<Rgb>* out) {
+    out->assign(count, Rgb(0.0f));
+    if (count == 0) return;
+    struct Buffers {
+        std::vector<cl_mem> mems;
+        ~Buffers() {
+            for (cl_mem m : mems) clReleaseMemObject(m);
+        }
+    } b;
+    cl_int err = CL_SUCCESS;
+    cl_uint index = 0;
+    for (const Arg& a : args) {
+        if (a.buffer) {
+            cl_mem m = upload(context_, a.data, a.bytes);
+            b.mems.push_back(m);
+            check(clSetKernelArg(kernel, index++, sizeof(cl_mem), &m), "clSetKernelArg");
+        } else {
+            check(clSetKernelArg(kernel, index++, a.bytes, a.data), "clSetKernelArg");
+        }
+    }
+    cl_mem res =
+        clCreateBuffer(context_, CL_MEM_WRITE_ONLY, count * 3 * sizeof(float), nullptr, &err);
+    check(err, "clCreateBuffer(results)");
+    b.mems.push_back(res);
+    check(clSetKernelArg(kernel, index++, sizeof(cl_mem), &res), "clSetKernelArg");
+    const size_t local = 64;
+    const size_t global = (count + local - 1) / local * local;
+    check(clEnqueueNDRangeKernel(queue_, kernel, 1, nullptr, &global, &local, 0, nullptr, nullptr),
+          name);
+    std::vector<float> host(count * 3);
+    check(clEnqueueReadBuffer(queue_, res, CL_TRUE, 0, host.size() * sizeof(float), host.data(), 0,
+                              nullptr, nullptr),
+          "clEnqueueReadBuffer(results)");
+    for (size_t i = 0; i < count; ++i)
+        (*out)[i] = Rgb(host[3 * i], host[3 * i + 1], host[3 * i + 2]);
+}
+
+namespace {
+template <class T>
+ClRuntime::Arg bufferArg(const std::vector<T>& v) {
+    return {v.data(), v.size() * sizeof(T), true};
+}
+template <class T>
+ClRuntime::Arg scalarArg(const T& v) {
+    return {&v, sizeof(T), false};
+}
+}  // namespace
+
+void ClRuntime::estimatePB2D(const std::vector<ub_photon_point>& photons, const Bvh& spheres,
+                             const std::vector<ub_beam>& queries,
+                             const std::vector<ub_medium_info>& media, const ub_mis_constants& mis,
+                             float radius, float normalization, uint32_t minLength,
+                             uint32_t maxLength, std::vector<Rgb>* out) {
+    if (photons.empty() || spheres.empty()) {
+        out->assign(queries.size(), Rgb(0.0f));
+        return;
+    }
+    const cl_uint count = cl_uint(queries.size());
+    run(pb2d_, "clEnqueueNDRangeKernel(ub_pb2d_estimate)",
+        {bufferArg(photons), bufferArg(spheres.nodes()), bufferArg(spheres.prims()),
+         bufferArg(queries), scalarArg(count), bufferArg(media), scalarArg(mis), scalarArg(radius),
+         scalarArg(normalization), scalarArg(minLength), scalarArg(maxLength)},
+        queries.size(), out);
+}
+
+void ClRuntime::estimateBP2D(const std::vector<ub_beam>& beams,
+                             const std::vector<ub_beam_part>& parts, const Bvh& bvh,
+                             const std::vector<ub_query_point>& queries,
+                             const std::vector<ub_medium_info>& media, const ub_mis_constants& mis,
+                             float radius, float normalization, uint32_t minLength,
+                             uint32_t maxLength, std::vector<Rgb>* out) {
+    if (beams.empty() || bvh.empty()) {
+        out->assign(queries.size(), Rgb(0.0f));
+        return;
+    }
+    const cl_uint count = cl_uint(queries.size());
+    run(bp2d_, "clEnqueueNDRangeKernel(ub_bp2d_estimate)",
+        {bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()), bufferArg(bvh.prims()),
+         bufferArg(queries), scalarArg(count), bufferArg(media), scalarArg(mis), scalarArg(radius),
+         scalarArg(normalization), scalarArg(minLength), scalarArg(maxLength)},
+        queries.size(), out);
+}
+
+void ClRuntime::estimateBB1D(const std::vector<ub_beam>& beams,
+                             const std::vector<ub_beam_part>& parts, const Bvh& bvh,
+                             const std::vector<ub_beam>& queries,
+                             const std::vector<ub_medium_info>& media, const ub_mis_constants& mis,
+                             float radius, float normalization, uint32_t minLength,
+                             uint32_t maxLength, std::vector<Rgb>* out) {
+    if (beams.empty() || bvh.empty()) {
+        out->assign(queries.size(), Rgb(0.0f));
+        return;
+    }
+    const cl_uint count = cl_uint(queries.size());
+    run(bb1d_, "clEnqueueNDRangeKernel(ub_bb1d_estimate)",
+        {bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()), bufferArg(bvh.prims()),
+         bufferArg(queries), scalarArg(count), bufferArg(media), scalarArg(mis), scalarArg(radius),
+         scalarArg(normalization), scalarArg(minLength), scalarArg(maxLength)},
+        queries.size(), out);
 }
 
 }  // namespace ub

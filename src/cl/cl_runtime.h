@@ -2,10 +2,11 @@
 // the embedded kernel sources (kernels/*.cl with kernels/shared/*.h, the same headers
 // the host twins compile; cmake/EmbedKernels.cmake), buffers and kernel launches.
 //
-// Status: the pp3d estimator runs as a kernel (kernels/pp3d.cl); pb2d, bp2d and bb1d
-// run on the host (their beam medium tabulation and BVH traversal are not in
-// kernels/shared yet). Results come back one per query and are added to pixels on the
-// host in query order, so no float atomics are needed and images are deterministic.
+// Status: pp3d runs as a kernel (kernels/pp3d.cl) in every medium; pb2d, bp2d and bb1d
+// (kernels/beams.cl) in scenes whose media are all homogeneous, else on the host (the
+// regular tracking through NanoVDB grids along beams is not in kernels/shared yet).
+// Results come back one per query and are added to pixels on the host in query order, so
+// no float atomics are needed and images are deterministic.
 #pragma once
 
 #define CL_TARGET_OPENCL_VERSION 120
@@ -18,11 +19,14 @@
 #include <vector>
 
 #include "core/vec.h"
+#include "kernels/shared/ub_bvh.h"
+#include "kernels/shared/ub_medium_homogeneous.h"
 #include "kernels/shared/ub_upbp_records.h"
 
 namespace ub {
 
 class HashGrid;
+class Bvh;
 
 /// An OpenCL problem (no platform, bad device index, build failure, out of resources):
 /// the message says what and, for build failures, includes the build log and options.
@@ -41,9 +45,10 @@ struct ClDeviceDescription {
 /// Every device of every platform (empty, with *error set, if there is no platform).
 std::vector<ClDeviceDescription> listClDevices(std::string* error);
 
-/// The embedded source of kernels/`file` with every #include "x.h" replaced by the
-/// embedded kernels/shared/x.h, each header once. Throws ClError for an unknown file.
-std::string clProgramSource(const std::string& file);
+/// The embedded sources of kernels/`files`, one after the other, with every #include "x.h"
+/// replaced by the embedded kernels/shared/x.h, each header once. Throws ClError for an
+/// unknown file.
+std::string clProgramSource(const std::vector<std::string>& files);
 
 class ClRuntime {
   public:
@@ -64,6 +69,23 @@ class ClRuntime {
                       float normalization, uint32_t minLength, uint32_t maxLength,
                       std::vector<Rgb>* out);
 
+    /// The beam estimators in homogeneous media (kernels/beams.cl), as their host twins
+    /// compute them; media[i] describes medium i (ub_medium_info).
+    void estimatePB2D(const std::vector<ub_photon_point>& photons, const Bvh& spheres,
+                      const std::vector<ub_beam>& queries, const std::vector<ub_medium_info>& media,
+                      const ub_mis_constants& mis, float radius, float normalization,
+                      uint32_t minLength, uint32_t maxLength, std::vector<Rgb>* out);
+    void estimateBP2D(const std::vector<ub_beam>& beams, const std::vector<ub_beam_part>& parts,
+                      const Bvh& bvh, const std::vector<ub_query_point>& queries,
+                      const std::vector<ub_medium_info>& media, const ub_mis_constants& mis,
+                      float radius, float normalization, uint32_t minLength, uint32_t maxLength,
+                      std::vector<Rgb>* out);
+    void estimateBB1D(const std::vector<ub_beam>& beams, const std::vector<ub_beam_part>& parts,
+                      const Bvh& bvh, const std::vector<ub_beam>& queries,
+                      const std::vector<ub_medium_info>& media, const ub_mis_constants& mis,
+                      float radius, float normalization, uint32_t minLength, uint32_t maxLength,
+                      std::vector<Rgb>* out);
+
   private:
     /// Runs the layout probe (kernels/pp3d.cl) and compares with the host; throws ClError.
     void checkLayout();
@@ -72,7 +94,20 @@ class ClRuntime {
     cl_context context_ = nullptr;
     cl_command_queue queue_ = nullptr;
     cl_program program_ = nullptr;
-    cl_kernel pp3d_ = nullptr;
+    cl_kernel pp3d_ = nullptr, pb2d_ = nullptr, bp2d_ = nullptr, bb1d_ = nullptr;
+    /// Uploads `buffers` (host pointer, bytes), sets them and `scalars` as the kernel's
+    /// arguments in order (buffers first where `order` says so), runs it over `count`
+    /// work-items and reads 3 floats per item into out.
+  public:
+    struct Arg {
+        const void* data;
+        size_t bytes;
+        bool buffer;
+    };
+
+  private:
+    void run(cl_kernel kernel, const char* name, const std::vector<Arg>& args, size_t count,
+             std::vector<Rgb>* out);
 };
 
 }  // namespace ub

@@ -111,19 +111,46 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
             estimatePP3D(in, grid, &perPoint[UB_TECH_PP3D], &st.pairs[UB_TECH_PP3D]);
         }
     }
+    // The beam estimators' kernels evaluate homogeneous media only (kernels/beams.cl).
+    std::vector<ub_medium_info> media;
+    bool allHomogeneous = true;
+    for (const Medium& m : in.scene->media) {
+        media.push_back(mediumInfo(m));
+        allHomogeneous &= m.type == MediumType::kHomogeneous;
+    }
+    ClRuntime* beamCl = allHomogeneous ? in.cl : nullptr;
+    const uint32_t minL = uint32_t(in.minLength), maxL = uint32_t(in.maxLength);
     if (t.bp2d) {
         perPoint[UB_TECH_BP2D].assign(nPoints, Rgb(0.0f));
-        estimateBP2D(in, beamBvh, parts, photonMedia, &perPoint[UB_TECH_BP2D],
-                     &st.pairs[UB_TECH_BP2D]);
+        const float r = in.radius[UB_TECH_BP2D];
+        if (beamCl)
+            beamCl->estimateBP2D(beams, parts, beamBvh, *in.queryPoints, media, in.mis, r,
+                                 1.0f / (in.beamPathCount * kPi * r * r), minL, maxL,
+                                 &perPoint[UB_TECH_BP2D]);
+        else
+            estimateBP2D(in, beamBvh, parts, photonMedia, &perPoint[UB_TECH_BP2D],
+                         &st.pairs[UB_TECH_BP2D]);
     }
     if (t.pb2d) {
         perBeam[UB_TECH_PB2D].assign(nBeams, Rgb(0.0f));
-        estimatePB2D(in, spheres, &perBeam[UB_TECH_PB2D], &st.pairs[UB_TECH_PB2D]);
+        const float r = in.radius[UB_TECH_PB2D];
+        if (beamCl)
+            beamCl->estimatePB2D(photons, spheres, *in.queryBeams, media, in.mis, r,
+                                 1.0f / (in.lightPathCount * kPi * r * r), minL, maxL,
+                                 &perBeam[UB_TECH_PB2D]);
+        else
+            estimatePB2D(in, spheres, &perBeam[UB_TECH_PB2D], &st.pairs[UB_TECH_PB2D]);
     }
     if (t.bb1d) {
         perBeam[UB_TECH_BB1D].assign(nBeams, Rgb(0.0f));
-        estimateBB1D(in, beamBvh, parts, photonMedia, &perBeam[UB_TECH_BB1D],
-                     &st.pairs[UB_TECH_BB1D]);
+        const float r = in.radius[UB_TECH_BB1D];
+        if (beamCl)
+            beamCl->estimateBB1D(beams, parts, beamBvh, *in.queryBeams, media, in.mis, r,
+                                 1.0f / (in.beamPathCount * 2.0f * r), minL, maxL,
+                                 &perBeam[UB_TECH_BB1D]);
+        else
+            estimateBB1D(in, beamBvh, parts, photonMedia, &perBeam[UB_TECH_BB1D],
+                         &st.pairs[UB_TECH_BB1D]);
     }
     st.estimateSeconds = secondsSince(t0);
 

@@ -176,18 +176,22 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
     if (algorithm_ == Algorithm::Upbp) {
         // The estimate pass: OpenCL kernels for what has one (pp3d), the host for the rest.
         backendNote_ = "estimate pass on the host";
-        if (options.backend != "host" && upbp_.pp3d) {
+        if (options.backend != "host" && upbp_.anyVolume()) {
             try {
                 cl_ = std::make_unique<ClRuntime>(options.clPlatform, options.clDevice);
-                backendNote_ = "estimate pass: pp3d on OpenCL device '" + cl_->device().device +
-                               "' (" + cl_->device().platform + "), pb2d/bp2d/bb1d on the host";
+                bool homogeneous = true;
+                for (const Medium& m : scene.media)
+                    homogeneous &= m.type == MediumType::kHomogeneous;
+                backendNote_ = "estimate pass on OpenCL device '" + cl_->device().device + "' (" +
+                               cl_->device().platform + ")" +
+                               (homogeneous ? ""
+                                            : ": pp3d; pb2d, bp2d, bb1d on the host (grid "
+                                              "media have no beam kernel yet)");
             } catch (const ClError& e) {
                 if (options.backend == "opencl") throw InputError("", e.what());
                 backendNote_ =
                     std::string("estimate pass on the host (backend auto: ") + e.what() + ")";
             }
-        } else if (options.backend != "host") {
-            backendNote_ = "estimate pass on the host (no technique with a kernel: pp3d has one)";
         }
     }
     baseRadius_ = options.radius * (options.radiusIsRelative ? scene.sceneSphere.radius : 1.0f);
