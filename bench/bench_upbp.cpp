@@ -10,7 +10,8 @@
 // `runs` timed iterations (each a fresh, independent one). Also prints the photon, beam and
 // query counts of the last iteration and the image mean (a sanity check). Not run by ctest.
 //
-// Usage: bench_upbp [--runs N] [--sets s1,s2,...] [--resolution WxH] [SCENE ...]
+// Usage: bench_upbp [--runs N] [--sets s1,s2,...] [--backends host,opencl] [--resolution WxH]
+//                   [SCENE ...]
 //   default scenes: cornell-fog, cornell-smoke, forward-scattering (scenes/) and the SmallUPBP
 //   candle, mirrorballs, bunny (scenes/smallupbp/)
 #include <sys/resource.h>
@@ -44,7 +45,8 @@ std::vector<std::string> splitList(const std::string& list) {
     return out;
 }
 
-int runOne(const std::string& path, const std::string& set, int runs, int width, int height) {
+int runOne(const std::string& path, const std::string& set, int runs, int width, int height,
+           const std::string& backend) {
     std::vector<Diagnostic> warnings;
     std::unique_ptr<Scene> scene = loadScene(path, &warnings);
     scene->camera = scene->camera.resized(width, height, scene->settings.keepHorizontalFov);
@@ -60,6 +62,7 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
     opt.shortPhotonBeams = true;
     opt.shortQueryBeams = false;
     opt.beamPaths = 4000;
+    opt.backend = backend;
     std::unique_ptr<Integrator> integrator = makeIntegrator(*scene, opt);
     Image img;
     integrator->renderIteration(0, img);
@@ -72,8 +75,8 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
     }
     std::sort(times.begin(), times.end());
     const Rgb mean = img.mean();
-    std::printf("%-14s %-16s %9.3f s/it  mean %.4g %.4g %.4g\n",
-                std::filesystem::path(path).stem().string().c_str(), set.c_str(),
+    std::printf("%-14s %-16s %-6s %9.3f s/it  mean %.4g %.4g %.4g\n",
+                std::filesystem::path(path).stem().string().c_str(), set.c_str(), backend.c_str(),
                 times[times.size() / 2], mean.x, mean.y, mean.z);
     const std::string summary = integrator->iterationSummary();
     if (!summary.empty()) std::printf("    %s\n", summary.c_str());
@@ -85,6 +88,7 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
 
 int main(int argc, char** argv) {
     int runs = 3, width = 256, height = 256;
+    std::vector<std::string> backends = {"host"};
     std::vector<std::string> scenes,
         sets = {"upbp:bpt", "upbp:pp3d", "upbp:pb2d", "upbp:bp2d", "upbp:bb1d", "upbp"};
     for (int i = 1; i < argc; ++i) {
@@ -93,6 +97,8 @@ int main(int argc, char** argv) {
             runs = std::max(1, std::atoi(argv[++i]));
         } else if (a == "--sets" && i + 1 < argc) {
             sets = splitList(argv[++i]);
+        } else if (a == "--backends" && i + 1 < argc) {
+            backends = splitList(argv[++i]);
         } else if (a == "--resolution" && i + 1 < argc) {
             if (std::sscanf(argv[++i], "%dx%d", &width, &height) != 2 || width < 1 || height < 1) {
                 std::fprintf(stderr, "bench_upbp: --resolution expects WxH\n");
@@ -112,27 +118,28 @@ int main(int argc, char** argv) {
     std::printf("bench_upbp: %dx%d, median of %d iterations, peak resident memory per run\n", width,
                 height, runs);
     for (const std::string& scene : scenes)
-        for (const std::string& set : sets) {
-            std::fflush(stdout);
-            const pid_t pid = fork();
-            if (pid < 0) {
-                std::perror("fork");
-                return 1;
-            }
-            if (pid == 0) {
-                try {
-                    std::_Exit(runOne(scene, set, runs, width, height));
-                } catch (const std::exception& e) {
-                    std::fprintf(stderr, "bench_upbp: %s %s: %s\n", scene.c_str(), set.c_str(),
-                                 e.what());
-                    std::_Exit(1);
+        for (const std::string& set : sets)
+            for (const std::string& backend : backends) {
+                std::fflush(stdout);
+                const pid_t pid = fork();
+                if (pid < 0) {
+                    std::perror("fork");
+                    return 1;
                 }
+                if (pid == 0) {
+                    try {
+                        std::_Exit(runOne(scene, set, runs, width, height, backend));
+                    } catch (const std::exception& e) {
+                        std::fprintf(stderr, "bench_upbp: %s %s: %s\n", scene.c_str(), set.c_str(),
+                                     e.what());
+                        std::_Exit(1);
+                    }
+                }
+                int status = 0;
+                rusage ru{};
+                wait4(pid, &status, 0, &ru);
+                std::printf("    peak memory %.0f MB%s\n", double(ru.ru_maxrss) / 1024.0,
+                            WIFEXITED(status) && WEXITSTATUS(status) == 0 ? "" : " (failed)");
             }
-            int status = 0;
-            rusage ru{};
-            wait4(pid, &status, 0, &ru);
-            std::printf("    peak memory %.0f MB%s\n", double(ru.ru_maxrss) / 1024.0,
-                        WIFEXITED(status) && WEXITSTATUS(status) == 0 ? "" : " (failed)");
-        }
     return 0;
 }
