@@ -50,3 +50,7 @@ __kernel void ub_layout_probe(__global uint* out) {
     out[6] = (uint)((__private char*)&q.pixel - (__private char*)&q);
     out[7] = (uint)((__private char*)&b.fwdPassBefore - (__private char*)&b);
 }
+
+#ifdef UB_FORCE_BUILD_ERROR
+#error "build failure forced by -DUB_FORCE_BUILD_ERROR (tests/opencl_estimate_test.cpp)"
+#endif

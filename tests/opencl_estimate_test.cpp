@@ -6,8 +6,10 @@
 // layout probe passes, and the error paths give their messages. A missing OpenCL platform
 // fails these tests with the reason, never skips them.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -40,6 +42,7 @@ RenderOptions pp3dOptions(const std::string& backend) {
     opt.radiusIsRelative = false;
     opt.radiusPP3D = 0.25f;  // a few photons in every query ball at 1024 light subpaths
     opt.backend = backend;
+    opt.clCache = "-";  // hermetic: no program cache in the user's folder
     return opt;
 }
 
@@ -137,7 +140,51 @@ TEST(OpenClEstimate, WholeRenderAgreesBetweenBackends) {
     }
 }
 
+// The program cache: the first runtime builds and caches, the second loads the entry; a
+// corrupt entry is rebuilt and replaced, never fatal.
+TEST(OpenClEstimate, ProgramCacheHitAndCorruptEntry) {
+    const std::string dir =
+        (std::filesystem::temp_directory_path() / ("unibeam-clcache-" + std::to_string(::getpid())))
+            .string();
+    std::filesystem::remove_all(dir);
+    {
+        ClRuntime a(-1, -1, dir);
+        EXPECT_NE(a.programNote().find("cached as"), std::string::npos) << a.programNote();
+    }
+    {
+        ClRuntime b(-1, -1, dir);
+        EXPECT_NE(b.programNote().find("from cache"), std::string::npos) << b.programNote();
+    }
+    int entries = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir)) {
+        ++entries;
+        std::ofstream(e.path(), std::ios::binary | std::ios::trunc) << "not a program binary";
+    }
+    EXPECT_EQ(entries, 1);
+    {
+        ClRuntime c(-1, -1, dir);
+        EXPECT_NE(c.programNote().find("corrupt program cache entry"), std::string::npos)
+            << c.programNote();
+        EXPECT_NE(c.programNote().find("cached as"), std::string::npos) << c.programNote();
+    }
+    {
+        ClRuntime d(-1, -1, dir);  // the replaced entry loads
+        EXPECT_NE(d.programNote().find("from cache"), std::string::npos) << d.programNote();
+    }
+    std::filesystem::remove_all(dir);
+}
+
 TEST(OpenClEstimate, ErrorPaths) {
+    // A forced build failure: the message has the build log and the options.
+    try {
+        ClRuntime cl(-1, -1, "-", "-DUB_FORCE_BUILD_ERROR");
+        ADD_FAILURE() << "forced build failure not reported";
+    } catch (const ClError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("failed"), std::string::npos) << m;
+        EXPECT_NE(m.find("-DUB_FORCE_BUILD_ERROR"), std::string::npos) << m;
+        EXPECT_NE(m.find("build failure forced"), std::string::npos) << m;  // the log
+    }
     // A device index that does not exist.
     try {
         ClRuntime cl(7, 3);

@@ -42,6 +42,7 @@ struct RenderArgs {
     std::optional<int> beamPaths;
     std::string backend = "auto";                ///< --backend host|opencl|auto
     std::string clDevice;                        ///< --cl-device PLATFORM:DEVICE
+    std::string clCache;                         ///< --cl-cache DIR
     std::map<std::string, std::string> defines;  ///< -D name=value (Mitsuba XML parameters)
     std::string variancePath;                    ///< --variance: per-iteration variance EXR
 };

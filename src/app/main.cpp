@@ -249,6 +249,11 @@ int run(int argc, char** argv) {
                      "upbp: OpenCL device PLATFORM:DEVICE as 'unibeam devices' lists them "
                      "(default: the first)")
         ->type_name("P:D");
+    render
+        ->add_option("--cl-cache", ra.clCache,
+                     "upbp: folder of the OpenCL program cache (default "
+                     "$XDG_CACHE_HOME/unibeam/opencl or ~/.cache/unibeam/opencl; '-': none)")
+        ->type_name("DIR");
     std::vector<std::string> renderDefines, infoDefines;
     render
         ->add_option("-D,--define", renderDefines,

@@ -132,6 +132,7 @@ int runRender(const RenderArgs& args) {
     if (!args.queryBeams.empty()) options.shortQueryBeams = args.queryBeams == "short";
     if (args.beamPaths) options.beamPaths = *args.beamPaths;
     options.backend = args.backend;
+    options.clCache = args.clCache;
     if (!args.clDevice.empty()) {
         int p = -1, d = -1;
         char tail = 0;

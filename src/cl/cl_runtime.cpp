@@ -1,8 +1,14 @@
 // OpenCL runtime (see cl_runtime.h).
 #include "cl/cl_runtime.h"
 
+#include <unistd.h>
+
 #include <cstddef>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -42,16 +48,99 @@ void check(cl_int err, const char* what) {
     throw ClError(msg);
 }
 
-const char* findEmbedded(const std::string& name) {
+/// The text of kernel file `name`: embedded, or read from $UNIBEAM_KERNEL_DIR (and its
+/// shared/ folder) when that developer option is set, so kernels can be edited without a
+/// rebuild. False if there is no such file.
+bool kernelText(const std::string& name, std::string* text) {
+    if (const char* dir = std::getenv("UNIBEAM_KERNEL_DIR")) {
+        for (const std::string& path :
+             {std::string(dir) + "/" + name, std::string(dir) + "/shared/" + name}) {
+            std::ifstream in(path, std::ios::binary);
+            if (in) {
+                std::ostringstream ss;
+                ss << in.rdbuf();
+                *text = ss.str();
+                return true;
+            }
+        }
+        return false;
+    }
     for (size_t i = 0; i < kEmbeddedKernelFileCount; ++i)
-        if (name == kEmbeddedKernelFiles[i].name) return kEmbeddedKernelFiles[i].text;
-    return nullptr;
+        if (name == kEmbeddedKernelFiles[i].name) {
+            *text = kEmbeddedKernelFiles[i].text;
+            return true;
+        }
+    return false;
+}
+
+/// FNV-1a, 64 bits: a stable key for cache file names (std::hash is not stable).
+uint64_t fnv1a(const std::string& s, uint64_t h = 1469598103934665603ull) {
+    for (unsigned char c : s) {
+        h ^= c;
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+std::string defaultCacheDir() {
+    if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x)
+        return std::string(x) + "/unibeam/opencl";
+    if (const char* home = std::getenv("HOME"); home && *home)
+        return std::string(home) + "/.cache/unibeam/opencl";
+    return "";
+}
+
+/// Cache file layout: magic, the key, the binary's size, the binary, an FNV-1a checksum of
+/// the binary. Anything else is "corrupt".
+constexpr char kCacheMagic[8] = {'U', 'B', 'C', 'L', 'B', 'I', 'N', '1'};
+
+bool readCache(const std::string& path, uint64_t key, std::vector<unsigned char>* binary) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return false;
+    char magic[8];
+    uint64_t k = 0, size = 0, sum = 0;
+    if (!in.read(magic, 8) || std::memcmp(magic, kCacheMagic, 8) != 0) return false;
+    if (!in.read(reinterpret_cast<char*>(&k), 8) || k != key) return false;
+    if (!in.read(reinterpret_cast<char*>(&size), 8) || size == 0 || size > (1ull << 30))
+        return false;
+    binary->resize(size_t(size));
+    if (!in.read(reinterpret_cast<char*>(binary->data()), std::streamsize(size))) return false;
+    if (!in.read(reinterpret_cast<char*>(&sum), 8)) return false;
+    return sum == fnv1a(std::string(binary->begin(), binary->end()));
+}
+
+/// Writes atomically (temporary file, then rename); false on any failure.
+bool writeCache(const std::string& path, uint64_t key, const std::vector<unsigned char>& binary) {
+    const std::string tmp = path + ".tmp" + std::to_string(uint64_t(::getpid()));
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        if (!out) return false;
+        const uint64_t size = binary.size();
+        const uint64_t sum = fnv1a(std::string(binary.begin(), binary.end()));
+        out.write(kCacheMagic, 8);
+        out.write(reinterpret_cast<const char*>(&key), 8);
+        out.write(reinterpret_cast<const char*>(&size), 8);
+        out.write(reinterpret_cast<const char*>(binary.data()), std::streamsize(size));
+        out.write(reinterpret_cast<const char*>(&sum), 8);
+        if (!out.flush()) {
+            std::remove(tmp.c_str());
+            return false;
+        }
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+        std::remove(tmp.c_str());
+        return false;
+    }
+    return true;
 }
 
 void expandIncludes(const std::string& name, std::set<std::string>& done, std::string& out) {
     if (!done.insert(name).second) return;
-    const char* text = findEmbedded(name);
-    if (!text) throw ClError("OpenCL: no embedded kernel source '" + name + "'");
+    std::string text;
+    if (!kernelText(name, &text))
+        throw ClError(std::string("OpenCL: no kernel source '") + name + "'" +
+                      (std::getenv("UNIBEAM_KERNEL_DIR") ? " in $UNIBEAM_KERNEL_DIR"
+                                                         : " among the embedded ones"));
     std::istringstream in(text);
     std::string line;
     while (std::getline(in, line)) {
@@ -133,7 +222,8 @@ std::string clProgramSource(const std::vector<std::string>& files) {
     return out;
 }
 
-ClRuntime::ClRuntime(int platform, int device) {
+ClRuntime::ClRuntime(int platform, int device, const std::string& cacheDir,
+                     const std::string& extraOptions) {
     std::string why;
     std::vector<ClDeviceDescription> all = listClDevices(&why);
     if (all.empty()) throw ClError("OpenCL: " + why);
@@ -168,18 +258,67 @@ ClRuntime::ClRuntime(int platform, int device) {
     queue_ = clCreateCommandQueue(context_, dev, 0, &err);
     check(err, "clCreateCommandQueue");
     const std::string src = clProgramSource({"pp3d.cl", "beams.cl"});
-    const char* text = src.c_str();
-    const size_t len = src.size();
-    program_ = clCreateProgramWithSource(context_, 1, &text, &len, &err);
-    check(err, "clCreateProgramWithSource");
-    const char* options = "-cl-std=CL1.2";
-    if (clBuildProgram(program_, 1, &dev, options, nullptr, nullptr) != CL_SUCCESS) {
-        size_t n = 0;
-        clGetProgramBuildInfo(program_, dev, CL_PROGRAM_BUILD_LOG, 0, nullptr, &n);
-        std::string log(n, '\0');
-        clGetProgramBuildInfo(program_, dev, CL_PROGRAM_BUILD_LOG, n, &log[0], nullptr);
-        throw ClError("OpenCL: building kernels/pp3d.cl and kernels/beams.cl for " + desc_.device +
-                      " with '" + options + "' failed:\n" + log);
+    const std::string options =
+        std::string("-cl-std=CL1.2") + (extraOptions.empty() ? "" : " " + extraOptions);
+    // Program cache: key = source, options, device, driver.
+    const std::string dir =
+        cacheDir.empty() ? defaultCacheDir() : (cacheDir == "-" ? "" : cacheDir);
+    const uint64_t key =
+        fnv1a(desc_.driver, fnv1a(desc_.device + "|" + desc_.platform, fnv1a(options, fnv1a(src))));
+    std::string cachePath;
+    if (!dir.empty()) {
+        std::error_code ec;
+        std::filesystem::create_directories(dir, ec);
+        char name[40];
+        std::snprintf(name, sizeof(name), "%016llx.bin", static_cast<unsigned long long>(key));
+        if (!ec)
+            cachePath = dir + "/" + name;
+        else
+            programNote_ = "program cache unusable (" + dir + ": " + ec.message() + ")";
+    }
+    std::vector<unsigned char> binary;
+    if (!cachePath.empty() && readCache(cachePath, key, &binary)) {
+        const unsigned char* bin = binary.data();
+        const size_t binLen = binary.size();
+        cl_int status = CL_SUCCESS;
+        program_ = clCreateProgramWithBinary(context_, 1, &dev, &binLen, &bin, &status, &err);
+        if (err == CL_SUCCESS && status == CL_SUCCESS &&
+            clBuildProgram(program_, 1, &dev, options.c_str(), nullptr, nullptr) == CL_SUCCESS) {
+            programNote_ = "program from cache " + cachePath;
+        } else {
+            if (program_) clReleaseProgram(program_);
+            program_ = nullptr;  // a stale or corrupt entry: rebuilt and replaced below
+        }
+    } else if (!cachePath.empty() && std::filesystem::exists(cachePath)) {
+        programNote_ = "corrupt program cache entry " + cachePath + " rebuilt";
+    }
+    if (!program_) {
+        const char* text = src.c_str();
+        const size_t len = src.size();
+        program_ = clCreateProgramWithSource(context_, 1, &text, &len, &err);
+        check(err, "clCreateProgramWithSource");
+        if (clBuildProgram(program_, 1, &dev, options.c_str(), nullptr, nullptr) != CL_SUCCESS) {
+            size_t n = 0;
+            clGetProgramBuildInfo(program_, dev, CL_PROGRAM_BUILD_LOG, 0, nullptr, &n);
+            std::string log(n, '\0');
+            clGetProgramBuildInfo(program_, dev, CL_PROGRAM_BUILD_LOG, n, &log[0], nullptr);
+            throw ClError("OpenCL: building kernels/pp3d.cl and kernels/beams.cl for " +
+                          desc_.device + " with options '" + options + "' failed:\n" + log);
+        }
+        if (!cachePath.empty()) {
+            size_t binSize = 0;
+            clGetProgramInfo(program_, CL_PROGRAM_BINARY_SIZES, sizeof(binSize), &binSize, nullptr);
+            std::vector<unsigned char> out(binSize);
+            unsigned char* ptr = out.data();
+            const bool got =
+                binSize > 0 && clGetProgramInfo(program_, CL_PROGRAM_BINARIES, sizeof(ptr), &ptr,
+                                                nullptr) == CL_SUCCESS;
+            const bool saved = got && writeCache(cachePath, key, out);
+            programNote_ = (programNote_.empty() ? std::string("built") : programNote_) +
+                           (saved ? ", cached as " + cachePath : ", not cached");
+        } else if (programNote_.empty()) {
+            programNote_ = "built (no program cache)";
+        }
     }
     pp3d_ = clCreateKernel(program_, "ub_pp3d_estimate", &err);
     check(err, "clCreateKernel(ub_pp3d_estimate)");

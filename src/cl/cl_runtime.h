@@ -1,6 +1,7 @@
 // OpenCL runtime of UPBP's estimate pass: device discovery, the program built from
 // the embedded kernel sources (kernels/*.cl with kernels/shared/*.h, the same headers
-// the host twins compile; cmake/EmbedKernels.cmake), buffers and kernel launches.
+// the host twins compile; cmake/EmbedKernels.cmake; $UNIBEAM_KERNEL_DIR makes it read them
+// from a folder instead), the on-disk program cache, buffers and kernel launches.
 //
 // Status: pp3d runs as a kernel (kernels/pp3d.cl) in every medium; pb2d, bp2d and bb1d
 // (kernels/beams.cl) in scenes whose media are all homogeneous, else on the host (the
@@ -53,13 +54,22 @@ std::string clProgramSource(const std::vector<std::string>& files);
 class ClRuntime {
   public:
     /// Opens device `device` of platform `platform` (both -1: the first device found) and
-    /// builds the estimate kernels. Throws ClError.
-    ClRuntime(int platform, int device);
+    /// builds the estimate kernels, or loads them from the program cache in cacheDir (empty:
+    /// $XDG_CACHE_HOME/unibeam/opencl, else ~/.cache/unibeam/opencl; "-": no cache). Cache
+    /// entries are keyed by the source, the build options, the device and the driver
+    /// version; a corrupt or stale entry is rebuilt and replaced, never fatal. extraOptions
+    /// are appended to the build options (tests force a build failure with them).
+    /// Throws ClError.
+    ClRuntime(int platform, int device, const std::string& cacheDir = "",
+              const std::string& extraOptions = "");
     ~ClRuntime();
     ClRuntime(const ClRuntime&) = delete;
     ClRuntime& operator=(const ClRuntime&) = delete;
 
     const ClDeviceDescription& device() const { return desc_; }
+    /// How the program was obtained: "built", "built, cached as FILE", "from cache FILE", or
+    /// why the cache was not used.
+    const std::string& programNote() const { return programNote_; }
 
     /// pp3d (kernels/pp3d.cl) over the given records and grid: (*out)[i] is query i's
     /// estimate, as estimatePP3D on the host computes it.
@@ -91,6 +101,7 @@ class ClRuntime {
     void checkLayout();
 
     ClDeviceDescription desc_;
+    std::string programNote_;
     cl_context context_ = nullptr;
     cl_command_queue queue_ = nullptr;
     cl_program program_ = nullptr;

@@ -44,6 +44,7 @@ struct RenderOptions {
     /// no device works), "auto" (OpenCL when a device works, else the host, saying why).
     std::string backend = "host";
     int clPlatform = -1, clDevice = -1;  ///< OpenCL device (-1, -1: the first one)
+    std::string clCache;  ///< OpenCL program cache folder ("": the user's cache, "-": none)
 };
 
 class Integrator {

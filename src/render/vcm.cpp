@@ -178,7 +178,8 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
         backendNote_ = "estimate pass on the host";
         if (options.backend != "host" && upbp_.anyVolume()) {
             try {
-                cl_ = std::make_unique<ClRuntime>(options.clPlatform, options.clDevice);
+                cl_ = std::make_unique<ClRuntime>(options.clPlatform, options.clDevice,
+                                                  options.clCache);
                 bool homogeneous = true;
                 for (const Medium& m : scene.media)
                     homogeneous &= m.type == MediumType::kHomogeneous;
@@ -186,7 +187,8 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
                                cl_->device().platform + ")" +
                                (homogeneous ? ""
                                             : ": pp3d; pb2d, bp2d, bb1d on the host (grid "
-                                              "media have no beam kernel yet)");
+                                              "media have no beam kernel yet)") +
+                               "; " + cl_->programNote();
             } catch (const ClError& e) {
                 if (options.backend == "opencl") throw InputError("", e.what());
                 backendNote_ =
