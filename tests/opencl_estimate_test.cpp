@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "estimators/hash_grid.h"
 #include "estimators/volume_estimate.h"
+#include "kernels/shared/ub_pp3d.h"
 #include "render/integrator.h"
 #include "render/vcm.h"
 #include "scene/io/json_loader.h"
@@ -89,8 +90,8 @@ TEST(OpenClEstimate, Pp3dKernelEqualsHostTwinPerQuery) {
     ASSERT_GT(pairs, 1000u);
     ClRuntime cl(-1, -1);
     std::vector<float> g = {scene->media[0].g};
-    cl.estimatePP3D(photons, queries, grid, in.mis, g,
-                    1.0f / (1024.0f * (4.0f / 3.0f) * kPi * r * r * r), 0, 5, &device);
+    cl.estimatePP3D(photons, queries, grid, in.mis, g, ub_pp3d_normalization(1024.0f, r), 0, 5,
+                    &device);
     ASSERT_EQ(device.size(), host.size());
     size_t nonzero = 0;
     for (size_t i = 0; i < host.size(); ++i)

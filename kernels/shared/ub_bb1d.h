@@ -19,6 +19,12 @@
 #include "ub_phase.h"
 #include "ub_upbp_records.h"
 
+/* 1 / (N_B 2 r): the box kernel K1 over the N_B beam-emitting light subpaths (the 1 / sin
+ * of UPBP Table 1 is applied per pair). */
+UB_INLINE float ub_bb1d_normalization(float beamPaths, float radius) {
+    return 1.0f / (beamPaths * 2.0f * radius);
+}
+
 /* Contribution of photon beam pb at t_l to query beam qb at t_c (ub_beam_beam_dist2),
  * sl / sc their media over [0, t_l] / [0, t_c]. normalization = 1 / (N_B 2 r). */
 UB_INLINE ub_float3 ub_bb1d_contribution(ub_mis_constants c, ub_beam pb, ub_beam qb,

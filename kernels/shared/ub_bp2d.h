@@ -19,6 +19,11 @@
 #include "ub_phase.h"
 #include "ub_upbp_records.h"
 
+/* 1 / (N_B pi r^2): the box kernel K2 over the N_B beam-emitting light subpaths. */
+UB_INLINE float ub_bp2d_normalization(float beamPaths, float radius) {
+    return 1.0f / (beamPaths * UB_PI * radius * radius);
+}
+
 /* Contribution of photon beam pb at parameter t to query point q, the beam's medium over
  * [0, t] in s. normalization = 1 / (N_B pi r^2). */
 UB_INLINE ub_float3 ub_bp2d_contribution(ub_mis_constants c, ub_beam pb, ub_query_point q,

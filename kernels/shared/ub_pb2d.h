@@ -21,6 +21,11 @@
 #include "ub_phase.h"
 #include "ub_upbp_records.h"
 
+/* 1 / (N_L pi r^2): the box kernel K2 over N_L light subpaths (UPBP Table 1). */
+UB_INLINE float ub_pb2d_normalization(float lightPaths, float radius) {
+    return 1.0f / (lightPaths * UB_PI * radius * radius);
+}
+
 /* Contribution of photon ph to query beam qb at parameter t (from
  * ub_point_beam_dist2), with the medium of qb evaluated over [0, t] in s.
  * normalization = 1 / (N_L pi r^2). */

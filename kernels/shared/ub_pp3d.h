@@ -22,6 +22,11 @@
 #include "ub_phase.h"
 #include "ub_upbp_records.h"
 
+/* 1 / (N_L (4/3) pi r^3): the box kernel K3 over N_L light subpaths (UPBP Table 1). */
+UB_INLINE float ub_pp3d_normalization(float lightPaths, float radius) {
+    return 1.0f / (lightPaths * (4.0f / 3.0f) * UB_PI * radius * radius * radius);
+}
+
 /* Contribution of photon ph to query q (0 if out of range or in another medium).
  * g: the medium's HG asymmetry; normalization = 1 / (N_L (4/3) pi r^3). */
 UB_INLINE ub_float3 ub_pp3d_contribution(ub_mis_constants c, ub_photon_point ph, ub_query_point q,

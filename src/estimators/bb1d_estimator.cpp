@@ -23,7 +23,7 @@ void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
     const std::vector<ub_beam>& queries = *in.queryBeams;
     if (beams.empty() || queries.empty()) return;
     const float r = in.radius[UB_TECH_BB1D];
-    const float normalization = 1.0f / (in.beamPathCount * 2.0f * r);  // K1 / N_B
+    const float normalization = ub_bb1d_normalization(in.beamPathCount, r);
     forEachQuery(queries.size(), 16, out, pairs, [&](size_t i, size_t* found) {
         const ub_beam& qb = queries[i];
         const float g = in.scene->media[qb.mediumId].g;

@@ -21,7 +21,7 @@ void estimateBP2D(const VolumeEstimateInput& in, const Bvh& beamParts,
     const std::vector<ub_query_point>& queries = *in.queryPoints;
     if (beams.empty() || queries.empty()) return;
     const float r = in.radius[UB_TECH_BP2D];
-    const float normalization = 1.0f / (in.beamPathCount * kPi * r * r);  // K2 / N_B
+    const float normalization = ub_bp2d_normalization(in.beamPathCount, r);
     forEachQuery(queries.size(), 64, out, pairs, [&](size_t i, size_t* found) {
         const ub_query_point& q = queries[i];
         const float g = in.scene->media[q.mediumId].g;

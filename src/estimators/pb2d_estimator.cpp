@@ -22,7 +22,7 @@ void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres, std::
     const std::vector<ub_beam>& queries = *in.queryBeams;
     if (photons.empty() || queries.empty()) return;
     const float r = in.radius[UB_TECH_PB2D];
-    const float normalization = 1.0f / (in.lightPathCount * kPi * r * r);  // K2 / N_L
+    const float normalization = ub_pb2d_normalization(in.lightPathCount, r);
     forEachQuery(queries.size(), 16, out, pairs, [&](size_t i, size_t* found) {
         const ub_beam& qb = queries[i];
         const float g = in.scene->media[qb.mediumId].g;

@@ -20,7 +20,7 @@ void estimatePP3D(const VolumeEstimateInput& in, const HashGrid& grid, std::vect
     if (photons.empty() || queries.empty()) return;
     const float r = in.radius[UB_TECH_PP3D];
     // UPBP Table 1: K3 = 1 / ((4/3) pi r^3), over N_L light subpaths.
-    const float normalization = 1.0f / (in.lightPathCount * (4.0f / 3.0f) * kPi * r * r * r);
+    const float normalization = ub_pp3d_normalization(in.lightPathCount, r);
     forEachQuery(queries.size(), 64, out, pairs, [&](size_t i, size_t* found) {
         const ub_query_point& q = queries[i];
         const float g = in.scene->media[q.mediumId].g;

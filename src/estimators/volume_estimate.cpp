@@ -12,6 +12,10 @@
 #include "estimators/beam_medium.h"
 #include "estimators/bvh.h"
 #include "estimators/hash_grid.h"
+#include "kernels/shared/ub_bb1d.h"
+#include "kernels/shared/ub_bp2d.h"
+#include "kernels/shared/ub_pb2d.h"
+#include "kernels/shared/ub_pp3d.h"
 #include "scene/medium.h"
 #include "scene/scene.h"
 
@@ -104,9 +108,9 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
             for (const Medium& m : in.scene->media) mediumG.push_back(m.g);
             const float r = in.radius[UB_TECH_PP3D];
             in.cl->estimatePP3D(photons, *in.queryPoints, grid, in.mis, mediumG,
-                                1.0f / (in.lightPathCount * (4.0f / 3.0f) * kPi * r * r * r),
-                                uint32_t(in.minLength), uint32_t(in.maxLength),
-                                &perPoint[UB_TECH_PP3D]);
+                                ub_pp3d_normalization(in.lightPathCount, r), uint32_t(in.minLength),
+                                uint32_t(in.maxLength), &perPoint[UB_TECH_PP3D]);
+            st.pairs[UB_TECH_PP3D] = VolumeEstimateStats::kNotCounted;
         } else {
             estimatePP3D(in, grid, &perPoint[UB_TECH_PP3D], &st.pairs[UB_TECH_PP3D]);
         }
@@ -123,34 +127,40 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     if (t.bp2d) {
         perPoint[UB_TECH_BP2D].assign(nPoints, Rgb(0.0f));
         const float r = in.radius[UB_TECH_BP2D];
-        if (beamCl)
+        if (beamCl) {
             beamCl->estimateBP2D(beams, parts, beamBvh, *in.queryPoints, media, in.mis, r,
-                                 1.0f / (in.beamPathCount * kPi * r * r), minL, maxL,
+                                 ub_bp2d_normalization(in.beamPathCount, r), minL, maxL,
                                  &perPoint[UB_TECH_BP2D]);
-        else
+            st.pairs[UB_TECH_BP2D] = VolumeEstimateStats::kNotCounted;
+        } else {
             estimateBP2D(in, beamBvh, parts, photonMedia, &perPoint[UB_TECH_BP2D],
                          &st.pairs[UB_TECH_BP2D]);
+        }
     }
     if (t.pb2d) {
         perBeam[UB_TECH_PB2D].assign(nBeams, Rgb(0.0f));
         const float r = in.radius[UB_TECH_PB2D];
-        if (beamCl)
+        if (beamCl) {
             beamCl->estimatePB2D(photons, spheres, *in.queryBeams, media, in.mis, r,
-                                 1.0f / (in.lightPathCount * kPi * r * r), minL, maxL,
+                                 ub_pb2d_normalization(in.lightPathCount, r), minL, maxL,
                                  &perBeam[UB_TECH_PB2D]);
-        else
+            st.pairs[UB_TECH_PB2D] = VolumeEstimateStats::kNotCounted;
+        } else {
             estimatePB2D(in, spheres, &perBeam[UB_TECH_PB2D], &st.pairs[UB_TECH_PB2D]);
+        }
     }
     if (t.bb1d) {
         perBeam[UB_TECH_BB1D].assign(nBeams, Rgb(0.0f));
         const float r = in.radius[UB_TECH_BB1D];
-        if (beamCl)
+        if (beamCl) {
             beamCl->estimateBB1D(beams, parts, beamBvh, *in.queryBeams, media, in.mis, r,
-                                 1.0f / (in.beamPathCount * 2.0f * r), minL, maxL,
+                                 ub_bb1d_normalization(in.beamPathCount, r), minL, maxL,
                                  &perBeam[UB_TECH_BB1D]);
-        else
+            st.pairs[UB_TECH_BB1D] = VolumeEstimateStats::kNotCounted;
+        } else {
             estimateBB1D(in, beamBvh, parts, photonMedia, &perBeam[UB_TECH_BB1D],
                          &st.pairs[UB_TECH_BB1D]);
+        }
     }
     st.estimateSeconds = secondsSince(t0);
 

@@ -57,7 +57,10 @@ struct VolumeEstimateInput {
 
 /// Per-iteration counts and times of the estimate pass.
 struct VolumeEstimateStats {
-    size_t pairs[4] = {0, 0, 0, 0};  ///< photon-query pairs within the kernel, per technique
+    /// Photon-query pairs within the kernel, per technique; kNotCounted where a technique ran
+    /// as an OpenCL kernel (the kernels do not count).
+    size_t pairs[4] = {0, 0, 0, 0};
+    static constexpr size_t kNotCounted = ~size_t(0);
     double buildSeconds = 0, estimateSeconds = 0;
     size_t lookupBytes = 0;
 };

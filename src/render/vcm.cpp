@@ -478,15 +478,22 @@ bool VertexCM::sampleScattering(Rng& rng, const VertexScatter& scatter, const Pa
 
 std::string VertexCM::iterationSummary() const {
     if (algorithm_ != Algorithm::Upbp) return "";
+    std::string pairs;
+    const char* names[4] = {"pp3d", "pb2d", "bp2d", "bb1d"};
+    for (int t = 0; t < 4; ++t) {
+        pairs += std::string(t ? ", " : "") + names[t] + " ";
+        pairs += lastPairs_[t] == VolumeEstimateStats::kNotCounted
+                     ? std::string("(OpenCL, not counted)")
+                     : std::to_string(lastPairs_[t]);
+    }
     char buf[512];
     std::snprintf(buf, sizeof(buf),
                   "upbp (%s), last iteration: %zu light vertices, %zu photon points, %zu photon "
                   "beam pieces (%d beam paths), %zu query points, %zu query beam pieces; kernel "
-                  "pairs pp3d %zu, pb2d %zu, bp2d %zu, bb1d %zu; lookups %.3f s, estimates %.3f s",
+                  "pairs %s; lookups %.3f s, estimates %.3f s",
                   upbp_.describe().c_str(), lightVertices_.size(), photonPoints_.size(),
                   photonBeams_.size(), beamPaths_, queryPoints_.size(), queryBeams_.size(),
-                  lastPairs_[0], lastPairs_[1], lastPairs_[2], lastPairs_[3], lastBuildSeconds_,
-                  lastEstimateSeconds_);
+                  pairs.c_str(), lastBuildSeconds_, lastEstimateSeconds_);
     return buf;
 }
 
