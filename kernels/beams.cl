@@ -11,6 +11,29 @@
 
 #define UB_BVH_STACK 64
 
+/* Depth-first walk of the BVH in the host twin's order (src/estimators/bvh.h: the right
+ * child is pushed first, so the left one is visited first): for every leaf whose path
+ * passes ACCEPT (an expression of the node `n`), runs the block after it with `k` the index
+ * into prims of each of its primitives (`continue` in it skips a primitive; variadic, so
+ * that commas in the block are no macro argument separators). */
+#define UB_BVH_WALK(nodes, ACCEPT, ...)                                    \
+    {                                                                      \
+        uint ubStack[UB_BVH_STACK];                                        \
+        int ubTop = 0;                                                     \
+        ubStack[ubTop++] = 0u;                                             \
+        while (ubTop > 0) {                                                \
+            uint ubSelf = ubStack[--ubTop];                                \
+            ub_bvh_node n = nodes[ubSelf];                                 \
+            if (!(ACCEPT)) continue;                                       \
+            if (n.count == 0u) {                                           \
+                ubStack[ubTop++] = n.first;                                \
+                ubStack[ubTop++] = ubSelf + 1u;                            \
+                continue;                                                  \
+            }                                                              \
+            for (uint k = n.first; k < n.first + n.count; ++k) __VA_ARGS__ \
+        }                                                                  \
+    }
+
 /* pb2d: query beams x photon points (BVH over the photons' kernel spheres). */
 __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
                                __global const ub_bvh_node* nodes, __global const uint* prims,
@@ -25,33 +48,20 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
     ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    uint stack[UB_BVH_STACK];
-    int top = 0;
-    stack[top++] = 0u;
-    while (top > 0) {
-        uint self = stack[--top];
-        ub_bvh_node n = nodes[self];
-        if (!ub_bvh_meets(n, o, invD, qb.length)) continue;
-        if (n.count == 0u) {
-            stack[top++] = n.first;
-            stack[top++] = self + 1u;
-            continue;
-        }
-        for (uint k = n.first; k < n.first + n.count; ++k) {
-            ub_photon_point ph = photons[prims[k]];
-            if (ph.mediumId != qb.mediumId) continue;
-            uint length = ph.pathLength + qb.pathLength;
-            if (length > maxLength || length < minLength) continue;
-            float t = 0.0f;
-            float d2 = ub_point_beam_dist2(ub_f3_from(ph.pos), o, d, qb.length, &t);
-            if (d2 < 0.0f || d2 > radius * radius) continue;
-            ub_segment_eval s = ub_homogeneous_segment(m, t);
-            ub_float3 c = ub_pb2d_contribution(mis, ph, qb, s, t, m.g, normalization);
-            sx += c.x;
-            sy += c.y;
-            sz += c.z;
-        }
-    }
+    UB_BVH_WALK(nodes, ub_bvh_meets(n, o, invD, qb.length), {
+        ub_photon_point ph = photons[prims[k]];
+        if (ph.mediumId != qb.mediumId) continue;
+        uint length = ph.pathLength + qb.pathLength;
+        if (length > maxLength || length < minLength) continue;
+        float t = 0.0f;
+        float d2 = ub_point_beam_dist2(ub_f3_from(ph.pos), o, d, qb.length, &t);
+        if (d2 < 0.0f || d2 > radius * radius) continue;
+        ub_segment_eval s = ub_homogeneous_segment(m, t);
+        ub_float3 c = ub_pb2d_contribution(mis, ph, qb, s, t, m.g, normalization);
+        sx += c.x;
+        sy += c.y;
+        sz += c.z;
+    })
     out[3 * i + 0] = sx;
     out[3 * i + 1] = sy;
     out[3 * i + 2] = sz;
@@ -70,36 +80,22 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
     ub_medium_info m = media[q.mediumId];
     ub_float3 p = ub_f3_from(q.pos);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    uint stack[UB_BVH_STACK];
-    int top = 0;
-    stack[top++] = 0u;
-    while (top > 0) {
-        uint self = stack[--top];
-        ub_bvh_node n = nodes[self];
-        if (!ub_bvh_contains(n, p)) continue;
-        if (n.count == 0u) {
-            stack[top++] = n.first;
-            stack[top++] = self + 1u;
-            continue;
-        }
-        for (uint k = n.first; k < n.first + n.count; ++k) {
-            ub_beam_part part = parts[prims[k]];
-            ub_beam pb = beams[part.beam];
-            if (pb.mediumId != q.mediumId) continue;
-            uint length = pb.pathLength + q.pathLength;
-            if (length > maxLength || length < minLength) continue;
-            float t = 0.0f;
-            float d2 =
-                ub_point_beam_dist2(p, ub_f3_from(pb.origin), ub_f3_from(pb.dir), pb.length, &t);
-            if (d2 < 0.0f || d2 > radius * radius) continue;
-            if (!ub_beam_part_holds(part, t, pb.length)) continue;
-            ub_segment_eval s = ub_homogeneous_segment(m, t);
-            ub_float3 c = ub_bp2d_contribution(mis, pb, q, s, t, m.g, normalization);
-            sx += c.x;
-            sy += c.y;
-            sz += c.z;
-        }
-    }
+    UB_BVH_WALK(nodes, ub_bvh_contains(n, p), {
+        ub_beam_part part = parts[prims[k]];
+        ub_beam pb = beams[part.beam];
+        if (pb.mediumId != q.mediumId) continue;
+        uint length = pb.pathLength + q.pathLength;
+        if (length > maxLength || length < minLength) continue;
+        float t = 0.0f;
+        float d2 = ub_point_beam_dist2(p, ub_f3_from(pb.origin), ub_f3_from(pb.dir), pb.length, &t);
+        if (d2 < 0.0f || d2 > radius * radius) continue;
+        if (!ub_beam_part_holds(part, t, pb.length)) continue;
+        ub_segment_eval s = ub_homogeneous_segment(m, t);
+        ub_float3 c = ub_bp2d_contribution(mis, pb, q, s, t, m.g, normalization);
+        sx += c.x;
+        sy += c.y;
+        sz += c.z;
+    })
     out[3 * i + 0] = sx;
     out[3 * i + 1] = sy;
     out[3 * i + 2] = sz;
@@ -119,39 +115,26 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
     ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
     ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    uint stack[UB_BVH_STACK];
-    int top = 0;
-    stack[top++] = 0u;
-    while (top > 0) {
-        uint self = stack[--top];
-        ub_bvh_node n = nodes[self];
-        if (!ub_bvh_meets(n, o, invD, qb.length)) continue;
-        if (n.count == 0u) {
-            stack[top++] = n.first;
-            stack[top++] = self + 1u;
-            continue;
-        }
-        for (uint k = n.first; k < n.first + n.count; ++k) {
-            ub_beam_part part = parts[prims[k]];
-            ub_beam pb = beams[part.beam];
-            if (pb.mediumId != qb.mediumId) continue;
-            uint length = pb.pathLength + qb.pathLength;
-            if (length > maxLength || length < minLength) continue;
-            float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
-            float d2 = ub_beam_beam_dist2(o, d, ub_f3_from(pb.origin), ub_f3_from(pb.dir), &tc, &tl,
-                                          &sinTheta);
-            if (d2 < 0.0f || d2 > radius * radius) continue;
-            if (tc < 0.0f || tc > qb.length || tl < 0.0f || tl > pb.length) continue;
-            if (!ub_beam_part_holds(part, tl, pb.length)) continue;
-            ub_segment_eval sl = ub_homogeneous_segment(m, tl);
-            ub_segment_eval sc = ub_homogeneous_segment(m, tc);
-            ub_float3 c =
-                ub_bb1d_contribution(mis, pb, qb, sl, sc, tl, tc, sinTheta, m.g, normalization);
-            sx += c.x;
-            sy += c.y;
-            sz += c.z;
-        }
-    }
+    UB_BVH_WALK(nodes, ub_bvh_meets(n, o, invD, qb.length), {
+        ub_beam_part part = parts[prims[k]];
+        ub_beam pb = beams[part.beam];
+        if (pb.mediumId != qb.mediumId) continue;
+        uint length = pb.pathLength + qb.pathLength;
+        if (length > maxLength || length < minLength) continue;
+        float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
+        float d2 = ub_beam_beam_dist2(o, d, ub_f3_from(pb.origin), ub_f3_from(pb.dir), &tc, &tl,
+                                      &sinTheta);
+        if (d2 < 0.0f || d2 > radius * radius) continue;
+        if (tc < 0.0f || tc > qb.length || tl < 0.0f || tl > pb.length) continue;
+        if (!ub_beam_part_holds(part, tl, pb.length)) continue;
+        ub_segment_eval sl = ub_homogeneous_segment(m, tl);
+        ub_segment_eval sc = ub_homogeneous_segment(m, tc);
+        ub_float3 c =
+            ub_bb1d_contribution(mis, pb, qb, sl, sc, tl, tc, sinTheta, m.g, normalization);
+        sx += c.x;
+        sy += c.y;
+        sz += c.z;
+    })
     out[3 * i + 0] = sx;
     out[3 * i + 1] = sy;
     out[3 * i + 2] = sz;
