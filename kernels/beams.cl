@@ -50,12 +50,8 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     UB_BVH_WALK(nodes, ub_bvh_meets(n, o, invD, qb.length), {
         ub_photon_point ph = photons[prims[k]];
-        if (ph.mediumId != qb.mediumId) continue;
-        uint length = ph.pathLength + qb.pathLength;
-        if (length > maxLength || length < minLength) continue;
         float t = 0.0f;
-        float d2 = ub_point_beam_dist2(ub_f3_from(ph.pos), o, d, qb.length, &t);
-        if (d2 < 0.0f || d2 > radius * radius) continue;
+        if (!ub_pb2d_pair(ph, qb, radius * radius, minLength, maxLength, &t)) continue;
         ub_segment_eval s = ub_homogeneous_segment(m, t);
         ub_float3 c = ub_pb2d_contribution(mis, ph, qb, s, t, m.g, normalization);
         sx += c.x;
@@ -83,13 +79,8 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
     UB_BVH_WALK(nodes, ub_bvh_contains(n, p), {
         ub_beam_part part = parts[prims[k]];
         ub_beam pb = beams[part.beam];
-        if (pb.mediumId != q.mediumId) continue;
-        uint length = pb.pathLength + q.pathLength;
-        if (length > maxLength || length < minLength) continue;
         float t = 0.0f;
-        float d2 = ub_point_beam_dist2(p, ub_f3_from(pb.origin), ub_f3_from(pb.dir), pb.length, &t);
-        if (d2 < 0.0f || d2 > radius * radius) continue;
-        if (!ub_beam_part_holds(part, t, pb.length)) continue;
+        if (!ub_bp2d_pair(q, pb, part, radius * radius, minLength, maxLength, &t)) continue;
         ub_segment_eval s = ub_homogeneous_segment(m, t);
         ub_float3 c = ub_bp2d_contribution(mis, pb, q, s, t, m.g, normalization);
         sx += c.x;
@@ -118,15 +109,9 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
     UB_BVH_WALK(nodes, ub_bvh_meets(n, o, invD, qb.length), {
         ub_beam_part part = parts[prims[k]];
         ub_beam pb = beams[part.beam];
-        if (pb.mediumId != qb.mediumId) continue;
-        uint length = pb.pathLength + qb.pathLength;
-        if (length > maxLength || length < minLength) continue;
         float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
-        float d2 = ub_beam_beam_dist2(o, d, ub_f3_from(pb.origin), ub_f3_from(pb.dir), &tc, &tl,
-                                      &sinTheta);
-        if (d2 < 0.0f || d2 > radius * radius) continue;
-        if (tc < 0.0f || tc > qb.length || tl < 0.0f || tl > pb.length) continue;
-        if (!ub_beam_part_holds(part, tl, pb.length)) continue;
+        if (!ub_bb1d_pair(qb, pb, part, radius * radius, minLength, maxLength, &tc, &tl, &sinTheta))
+            continue;
         ub_segment_eval sl = ub_homogeneous_segment(m, tl);
         ub_segment_eval sc = ub_homogeneous_segment(m, tc);
         ub_float3 c =

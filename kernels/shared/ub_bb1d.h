@@ -16,6 +16,7 @@
 #define UB_BB1D_H
 
 #include "ub_beam_geometry.h"
+#include "ub_bvh.h"
 #include "ub_phase.h"
 #include "ub_upbp_records.h"
 
@@ -23,6 +24,22 @@
  * of UPBP Table 1 is applied per pair). */
 UB_INLINE float ub_bb1d_normalization(float beamPaths, float radius) {
     return 1.0f / (beamPaths * 2.0f * radius);
+}
+
+/* Whether query beam qb and the part `part` of photon beam pb make a bb1d pair (same
+ * medium, path length in range, lines within radius, closest approach on both beams and in
+ * this part); writes the parameters and sin(theta). */
+UB_INLINE int ub_bb1d_pair(ub_beam qb, ub_beam pb, ub_beam_part part, float radiusSqr,
+                           ub_uint minLength, ub_uint maxLength, UB_PRIVATE float* tc,
+                           UB_PRIVATE float* tl, UB_PRIVATE float* sinTheta) {
+    if (pb.mediumId != qb.mediumId) return 0;
+    ub_uint length = pb.pathLength + qb.pathLength;
+    if (length > maxLength || length < minLength) return 0;
+    float d2 = ub_beam_beam_dist2(ub_f3_from(qb.origin), ub_f3_from(qb.dir), ub_f3_from(pb.origin),
+                                  ub_f3_from(pb.dir), tc, tl, sinTheta);
+    if (d2 < 0.0f || d2 > radiusSqr) return 0;
+    if (*tc < 0.0f || *tc > qb.length || *tl < 0.0f || *tl > pb.length) return 0;
+    return ub_beam_part_holds(part, *tl, pb.length);
 }
 
 /* Contribution of photon beam pb at t_l to query beam qb at t_c (ub_beam_beam_dist2),

@@ -26,6 +26,18 @@ UB_INLINE float ub_pb2d_normalization(float lightPaths, float radius) {
     return 1.0f / (lightPaths * UB_PI * radius * radius);
 }
 
+/* Whether photon ph and query beam qb make a pb2d pair: same medium, path length in
+ * [minLength, maxLength], the photon within radius of the beam; writes its beam parameter. */
+UB_INLINE int ub_pb2d_pair(ub_photon_point ph, ub_beam qb, float radiusSqr, ub_uint minLength,
+                           ub_uint maxLength, UB_PRIVATE float* t) {
+    if (ph.mediumId != qb.mediumId) return 0;
+    ub_uint length = ph.pathLength + qb.pathLength;
+    if (length > maxLength || length < minLength) return 0;
+    float d2 = ub_point_beam_dist2(ub_f3_from(ph.pos), ub_f3_from(qb.origin), ub_f3_from(qb.dir),
+                                   qb.length, t);
+    return d2 >= 0.0f && d2 <= radiusSqr;
+}
+
 /* Contribution of photon ph to query beam qb at parameter t (from
  * ub_point_beam_dist2), with the medium of qb evaluated over [0, t] in s.
  * normalization = 1 / (N_L pi r^2). */

@@ -31,27 +31,22 @@ void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
         BeamMedium queryMedium;  // tabulated when the first pair is found
         queryMedium.reset(*in.scene, qb);
         Rgb sum(0.0f);
-        beamParts.querySegment(
-            Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length, [&](uint32_t k) {
-                const BeamPart& part = parts[k];
-                const ub_beam& pb = beams[part.beam];
-                if (pb.mediumId != qb.mediumId) return;
-                const ub_uint length = pb.pathLength + qb.pathLength;
-                if (length > ub_uint(in.maxLength) || length < ub_uint(in.minLength)) return;
-                float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
-                const float d2 = ub_beam_beam_dist2(o, d, ub_f3_from(pb.origin), ub_f3_from(pb.dir),
-                                                    &tc, &tl, &sinTheta);
-                if (d2 < 0.0f || d2 > r * r) return;
-                if (tc < 0.0f || tc > qb.length || tl < 0.0f || tl > pb.length) return;
-                if (!ub_beam_part_holds(part, tl, pb.length)) return;
-                if (!queryMedium.built()) queryMedium.build();
-                const ub_segment_eval sl = photonMedia[part.beam].eval(tl);
-                const ub_segment_eval sc = queryMedium.eval(tc);
-                const ub_float3 c = ub_bb1d_contribution(in.mis, pb, qb, sl, sc, tl, tc, sinTheta,
-                                                         g, normalization);
-                sum += Rgb(c.x, c.y, c.z);
-                ++*found;
-            });
+        beamParts.querySegment(Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length,
+                               [&](uint32_t k) {
+                                   const BeamPart& part = parts[k];
+                                   const ub_beam& pb = beams[part.beam];
+                                   float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
+                                   if (!ub_bb1d_pair(qb, pb, part, r * r, ub_uint(in.minLength),
+                                                     ub_uint(in.maxLength), &tc, &tl, &sinTheta))
+                                       return;
+                                   if (!queryMedium.built()) queryMedium.build();
+                                   const ub_segment_eval sl = photonMedia[part.beam].eval(tl);
+                                   const ub_segment_eval sc = queryMedium.eval(tc);
+                                   const ub_float3 c = ub_bb1d_contribution(
+                                       in.mis, pb, qb, sl, sc, tl, tc, sinTheta, g, normalization);
+                                   sum += Rgb(c.x, c.y, c.z);
+                                   ++*found;
+                               });
         return sum;
     });
 }

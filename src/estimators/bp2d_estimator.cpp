@@ -30,15 +30,9 @@ void estimateBP2D(const VolumeEstimateInput& in, const Bvh& beamParts,
         beamParts.queryPoint(Vec3(p.x, p.y, p.z), [&](uint32_t k) {
             const BeamPart& part = parts[k];
             const ub_beam& pb = beams[part.beam];
-            if (pb.mediumId != q.mediumId) return;
-            const ub_uint length = pb.pathLength + q.pathLength;
-            if (length > ub_uint(in.maxLength) || length < ub_uint(in.minLength)) return;
             float t = 0.0f;
-            const float d2 =
-                ub_point_beam_dist2(p, ub_f3_from(pb.origin), ub_f3_from(pb.dir), pb.length, &t);
-            if (d2 < 0.0f || d2 > r * r) return;
-            // The part holding the projection counts the beam (once per beam).
-            if (!ub_beam_part_holds(part, t, pb.length)) return;
+            if (!ub_bp2d_pair(q, pb, part, r * r, ub_uint(in.minLength), ub_uint(in.maxLength), &t))
+                return;
             const ub_segment_eval s = photonMedia[part.beam].eval(t);
             const ub_float3 c = ub_bp2d_contribution(in.mis, pb, q, s, t, g, normalization);
             sum += Rgb(c.x, c.y, c.z);

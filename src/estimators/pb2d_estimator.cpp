@@ -33,12 +33,9 @@ void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres, std::
         photonSpheres.querySegment(
             Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length, [&](uint32_t j) {
                 const ub_photon_point& ph = photons[j];
-                if (ph.mediumId != qb.mediumId) return;
-                const ub_uint length = ph.pathLength + qb.pathLength;
-                if (length > ub_uint(in.maxLength) || length < ub_uint(in.minLength)) return;
                 float t = 0.0f;
-                const float d2 = ub_point_beam_dist2(ub_f3_from(ph.pos), o, d, qb.length, &t);
-                if (d2 < 0.0f || d2 > r * r) return;
+                if (!ub_pb2d_pair(ph, qb, r * r, ub_uint(in.minLength), ub_uint(in.maxLength), &t))
+                    return;
                 if (!queryMedium.built()) queryMedium.build();
                 const ub_segment_eval s = queryMedium.eval(t);
                 const ub_float3 c = ub_pb2d_contribution(in.mis, ph, qb, s, t, g, normalization);
