@@ -58,9 +58,7 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
         sy += c.y;
         sz += c.z;
     })
-    out[3 * i + 0] = sx;
-    out[3 * i + 1] = sy;
-    out[3 * i + 2] = sz;
+    ub_store_f3(out, i, sx, sy, sz);
 }
 
 /* bp2d: query points x photon beams (BVH over the diced beam parts). */
@@ -87,9 +85,7 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
         sy += c.y;
         sz += c.z;
     })
-    out[3 * i + 0] = sx;
-    out[3 * i + 1] = sy;
-    out[3 * i + 2] = sz;
+    ub_store_f3(out, i, sx, sy, sz);
 }
 
 /* bb1d: query beams x photon beams (BVH over the diced beam parts). */
@@ -120,7 +116,5 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
         sy += c.y;
         sz += c.z;
     })
-    out[3 * i + 0] = sx;
-    out[3 * i + 1] = sy;
-    out[3 * i + 2] = sz;
+    ub_store_f3(out, i, sx, sy, sz);
 }

@@ -3,18 +3,21 @@
  * src/estimators/pp3d_estimator.cpp runs the same per-pair function over the same buffers
  * in the same order). out: 3 floats per query. */
 #include "ub_hash_grid.h"
+#include "ub_medium_homogeneous.h"
 #include "ub_pp3d.h"
 
+/* Arguments: the lookup (photons, grid), then the tail every estimate kernel shares (queries,
+ * their count, media, MIS constants, radius, normalisation, path lengths, results). */
 __kernel void ub_pp3d_estimate(__global const ub_photon_point* photons,
-                               __global const ub_query_point* queries, uint queryCount,
                                __global const uint* cellEnds, __global const uint* indices,
-                               ub_hash_grid grid, ub_mis_constants mis,
-                               __global const float* mediumG, float normalization, uint minLength,
-                               uint maxLength, __global float* out) {
+                               ub_hash_grid grid, __global const ub_query_point* queries,
+                               uint queryCount, __global const ub_medium_info* media,
+                               ub_mis_constants mis, float radius, float normalization,
+                               uint minLength, uint maxLength, __global float* out) {
     uint i = get_global_id(0);
     if (i >= queryCount) return;
     ub_query_point q = queries[i];
-    float g = mediumG[q.mediumId];
+    float g = media[q.mediumId].g;
     ub_uint buckets[8];
     int nb = ub_hash_buckets(grid, ub_f3_from(q.pos), buckets);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
@@ -23,16 +26,14 @@ __kernel void ub_pp3d_estimate(__global const ub_photon_point* photons,
         uint begin = b == 0 ? 0u : cellEnds[b - 1], end = cellEnds[b];
         for (uint j = begin; j < end; ++j) {
             ub_photon_point ph = photons[indices[j]];
-            ub_float3 c = ub_pp3d_contribution(mis, ph, q, g, grid.radiusSqr, normalization,
+            ub_float3 c = ub_pp3d_contribution(mis, ph, q, g, radius * radius, normalization,
                                                minLength, maxLength);
             sx += c.x;
             sy += c.y;
             sz += c.z;
         }
     }
-    out[3 * i + 0] = sx;
-    out[3 * i + 1] = sy;
-    out[3 * i + 2] = sz;
+    ub_store_f3(out, i, sx, sy, sz);
 }
 
 /* Layout probe: the device's sizes and offsets of the shared records, compared with the

@@ -15,6 +15,7 @@
 
 #include "cl/cl_runtime.h"
 #include "core/error.h"
+#include "estimators/beam_medium.h"
 #include "estimators/hash_grid.h"
 #include "estimators/volume_estimate.h"
 #include "kernels/shared/ub_pp3d.h"
@@ -89,9 +90,15 @@ TEST(OpenClEstimate, Pp3dKernelEqualsHostTwinPerQuery) {
     estimatePP3D(in, grid, &host, &pairs);
     ASSERT_GT(pairs, 1000u);
     ClRuntime cl(-1, -1);
-    std::vector<float> g = {scene->media[0].g};
-    cl.estimatePP3D(photons, queries, grid, in.mis, g, ub_pp3d_normalization(1024.0f, r), 0, 5,
-                    &device);
+    std::vector<ub_medium_info> media = {mediumInfo(scene->media[0])};
+    ClRuntime::EstimateArgs args;
+    args.media = &media;
+    args.mis = in.mis;
+    args.radius = r;
+    args.normalization = ub_pp3d_normalization(1024.0f, r);
+    args.minLength = 0;
+    args.maxLength = 5;
+    cl.estimatePP3D(photons, grid, queries, args, &device);
     ASSERT_EQ(device.size(), host.size());
     size_t nonzero = 0;
     for (size_t i = 0; i < host.size(); ++i)

@@ -15,6 +15,13 @@ typedef struct {
     float x, y, z;
 } ub_float3;
 
+/* Writes v to out[3i .. 3i+2] (the per-query results of the estimate kernels). */
+UB_INLINE void ub_store_f3(UB_GLOBAL float* out, unsigned int i, float x, float y, float z) {
+    out[3 * i + 0] = x;
+    out[3 * i + 1] = y;
+    out[3 * i + 2] = z;
+}
+
 UB_INLINE ub_float3 ub_make_float3(float x, float y, float z) {
     ub_float3 r;
     r.x = x;

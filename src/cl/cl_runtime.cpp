@@ -382,65 +382,28 @@ ClRuntime::~ClRuntime() {
     if (context_) clReleaseContext(context_);
 }
 
-void ClRuntime::estimatePP3D(const std::vector<ub_photon_point>& photons,
-                             const std::vector<ub_query_point>& queries, const HashGrid& grid,
-                             const ub_mis_constants& mis, const std::vector<float>& mediumG,
-                             float normalization, uint32_t minLength, uint32_t maxLength,
-                             std::vector<Rgb>* out) {
-    out->assign(queries.size(), Rgb(0.0f));
-    if (queries.empty() || photons.empty()) return;
-    struct Buffers {
-        std::vector<cl_mem> mems;
-        ~Buffers() {
-            for (cl_mem m : mems) clReleaseMemObject(m);
-        }
-    } b;
-    cl_mem ph = upload(context_, photons.data(), photons.size() * sizeof(ub_photon_point));
-    b.mems.push_back(ph);
-    cl_mem qs = upload(context_, queries.data(), queries.size() * sizeof(ub_query_point));
-    b.mems.push_back(qs);
-    cl_mem ends = upload(context_, grid.cellEnds().data(), grid.cellEnds().size() * 4);
-    b.mems.push_back(ends);
-    cl_mem idx = upload(context_, grid.indices().data(), grid.indices().size() * 4);
-    b.mems.push_back(idx);
-    cl_mem gs = upload(context_, mediumG.data(), mediumG.size() * 4);
-    b.mems.push_back(gs);
-    cl_int err = CL_SUCCESS;
-    cl_mem res = clCreateBuffer(context_, CL_MEM_WRITE_ONLY, queries.size() * 3 * sizeof(float),
-                                nullptr, &err);
-    check(err, "clCreateBuffer(results)");
-    b.mems.push_back(res);
-    const cl_uint count = cl_uint(queries.size());
-    const ub_hash_grid params = grid.params();
-    int a = 0;
-    check(clSetKernelArg(pp3d_, a++, sizeof(cl_mem), &ph), "clSetKernelArg");
-    check(clSetKernelArg(pp3d_, a++, sizeof(cl_mem), &qs), "clSetKernelArg");
-    check(clSetKernelArg(pp3d_, a++, sizeof(cl_uint), &count), "clSetKernelArg");
-    check(clSetKernelArg(pp3d_, a++, sizeof(cl_mem), &ends), "clSetKernelArg");
-    check(clSetKernelArg(pp3d_, a++, sizeof(cl_mem), &idx), "clSetKernelArg");
-    check(clSetKernelArg(pp3d_, a++, sizeof(ub_hash_grid), &params), "clSetKernelArg");
-    check(clSetKernelArg(pp3d_, a++, sizeof(ub_mis_constants), &mis), "clSetKernelArg");
-    check(clSetKernelArg(pp3d_, a++, sizeof(cl_mem), &gs), "clSetKernelArg");
-    check(clSetKernelArg(pp3d_, a++, sizeof(float), &normalization), "clSetKernelArg");
-    check(clSetKernelArg(pp3d_, a++, sizeof(cl_uint), &minLength), "clSetKernelArg");
-    check(clSetKernelArg(pp3d_, a++, sizeof(cl_uint), &maxLength), "clSetKernelArg");
-    check(clSetKernelArg(pp3d_, a++, sizeof(cl_mem), &res), "clSetKernelArg");
-    const size_t local = 64;
-    const size_t global = (queries.size() + local - 1) / local * local;
-    check(clEnqueueNDRangeKernel(queue_, pp3d_, 1, nullptr, &global, &local, 0, nullptr, nullptr),
-          "clEnqueueNDRangeKernel(ub_pp3d_estimate)");
-    std::vector<float> host(queries.size() * 3);
-    check(clEnqueueReadBuffer(queue_, res, CL_TRUE, 0, host.size() * sizeof(float), host.data(), 0,
-                              nullptr, nullptr),
-          "clEnqueueReadBuffer(results)");
-    for (size_t i = 0; i < queries.size(); ++i)
-        (*out)[i] = Rgb(host[3 * i], host[3 * i + 1], host[3 * i + 2]);
+namespace {
+template <class T>
+ClRuntime::Arg bufferArg(const std::vector<T>& v) {
+    return {v.data(), v.size() * sizeof(T), true};
 }
+template <class T>
+ClRuntime::Arg scalarArg(const T& v) {
+    return {&v, sizeof(T), false};
+}
+}  // namespace
 
-void ClRuntime::run(cl_kernel kernel, const char* name, const std::vector<Arg>& args, size_t count,
-                    std::vector<Rgb>* out) {
+void ClRuntime::runEstimate(cl_kernel kernel, const char* name, const std::vector<Arg>& lookup,
+                            const Arg& queries, size_t count, const EstimateArgs& a,
+                            std::vector<Rgb>* out) {
     out->assign(count, Rgb(0.0f));
     if (count == 0) return;
+    const cl_uint n = cl_uint(count);
+    std::vector<Arg> args = lookup;
+    for (const Arg& x :
+         {queries, scalarArg(n), bufferArg(*a.media), scalarArg(a.mis), scalarArg(a.radius),
+          scalarArg(a.normalization), scalarArg(a.minLength), scalarArg(a.maxLength)})
+        args.push_back(x);
     struct Buffers {
         std::vector<cl_mem> mems;
         ~Buffers() {
@@ -449,13 +412,13 @@ void ClRuntime::run(cl_kernel kernel, const char* name, const std::vector<Arg>& 
     } b;
     cl_int err = CL_SUCCESS;
     cl_uint index = 0;
-    for (const Arg& a : args) {
-        if (a.buffer) {
-            cl_mem m = upload(context_, a.data, a.bytes);
+    for (const Arg& x : args) {
+        if (x.buffer) {
+            cl_mem m = upload(context_, x.data, x.bytes);
             b.mems.push_back(m);
             check(clSetKernelArg(kernel, index++, sizeof(cl_mem), &m), "clSetKernelArg");
         } else {
-            check(clSetKernelArg(kernel, index++, a.bytes, a.data), "clSetKernelArg");
+            check(clSetKernelArg(kernel, index++, x.bytes, x.data), "clSetKernelArg");
         }
     }
     cl_mem res =
@@ -475,68 +438,45 @@ void ClRuntime::run(cl_kernel kernel, const char* name, const std::vector<Arg>& 
         (*out)[i] = Rgb(host[3 * i], host[3 * i + 1], host[3 * i + 2]);
 }
 
-namespace {
-template <class T>
-ClRuntime::Arg bufferArg(const std::vector<T>& v) {
-    return {v.data(), v.size() * sizeof(T), true};
+void ClRuntime::estimatePP3D(const std::vector<ub_photon_point>& photons, const HashGrid& grid,
+                             const std::vector<ub_query_point>& queries, const EstimateArgs& a,
+                             std::vector<Rgb>* out) {
+    if (photons.empty()) return out->assign(queries.size(), Rgb(0.0f));
+    runEstimate(pp3d_, "clEnqueueNDRangeKernel(ub_pp3d_estimate)",
+                {bufferArg(photons), bufferArg(grid.cellEnds()), bufferArg(grid.indices()),
+                 scalarArg(grid.params())},
+                bufferArg(queries), queries.size(), a, out);
 }
-template <class T>
-ClRuntime::Arg scalarArg(const T& v) {
-    return {&v, sizeof(T), false};
-}
-}  // namespace
 
 void ClRuntime::estimatePB2D(const std::vector<ub_photon_point>& photons, const Bvh& spheres,
-                             const std::vector<ub_beam>& queries,
-                             const std::vector<ub_medium_info>& media, const ub_mis_constants& mis,
-                             float radius, float normalization, uint32_t minLength,
-                             uint32_t maxLength, std::vector<Rgb>* out) {
-    if (photons.empty() || spheres.empty()) {
-        out->assign(queries.size(), Rgb(0.0f));
-        return;
-    }
-    const cl_uint count = cl_uint(queries.size());
-    run(pb2d_, "clEnqueueNDRangeKernel(ub_pb2d_estimate)",
-        {bufferArg(photons), bufferArg(spheres.nodes()), bufferArg(spheres.prims()),
-         bufferArg(queries), scalarArg(count), bufferArg(media), scalarArg(mis), scalarArg(radius),
-         scalarArg(normalization), scalarArg(minLength), scalarArg(maxLength)},
-        queries.size(), out);
+                             const std::vector<ub_beam>& queries, const EstimateArgs& a,
+                             std::vector<Rgb>* out) {
+    if (photons.empty() || spheres.empty()) return out->assign(queries.size(), Rgb(0.0f));
+    runEstimate(pb2d_, "clEnqueueNDRangeKernel(ub_pb2d_estimate)",
+                {bufferArg(photons), bufferArg(spheres.nodes()), bufferArg(spheres.prims())},
+                bufferArg(queries), queries.size(), a, out);
 }
 
 void ClRuntime::estimateBP2D(const std::vector<ub_beam>& beams,
                              const std::vector<ub_beam_part>& parts, const Bvh& bvh,
-                             const std::vector<ub_query_point>& queries,
-                             const std::vector<ub_medium_info>& media, const ub_mis_constants& mis,
-                             float radius, float normalization, uint32_t minLength,
-                             uint32_t maxLength, std::vector<Rgb>* out) {
-    if (beams.empty() || bvh.empty()) {
-        out->assign(queries.size(), Rgb(0.0f));
-        return;
-    }
-    const cl_uint count = cl_uint(queries.size());
-    run(bp2d_, "clEnqueueNDRangeKernel(ub_bp2d_estimate)",
-        {bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()), bufferArg(bvh.prims()),
-         bufferArg(queries), scalarArg(count), bufferArg(media), scalarArg(mis), scalarArg(radius),
-         scalarArg(normalization), scalarArg(minLength), scalarArg(maxLength)},
-        queries.size(), out);
+                             const std::vector<ub_query_point>& queries, const EstimateArgs& a,
+                             std::vector<Rgb>* out) {
+    if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
+    runEstimate(
+        bp2d_, "clEnqueueNDRangeKernel(ub_bp2d_estimate)",
+        {bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()), bufferArg(bvh.prims())},
+        bufferArg(queries), queries.size(), a, out);
 }
 
 void ClRuntime::estimateBB1D(const std::vector<ub_beam>& beams,
                              const std::vector<ub_beam_part>& parts, const Bvh& bvh,
-                             const std::vector<ub_beam>& queries,
-                             const std::vector<ub_medium_info>& media, const ub_mis_constants& mis,
-                             float radius, float normalization, uint32_t minLength,
-                             uint32_t maxLength, std::vector<Rgb>* out) {
-    if (beams.empty() || bvh.empty()) {
-        out->assign(queries.size(), Rgb(0.0f));
-        return;
-    }
-    const cl_uint count = cl_uint(queries.size());
-    run(bb1d_, "clEnqueueNDRangeKernel(ub_bb1d_estimate)",
-        {bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()), bufferArg(bvh.prims()),
-         bufferArg(queries), scalarArg(count), bufferArg(media), scalarArg(mis), scalarArg(radius),
-         scalarArg(normalization), scalarArg(minLength), scalarArg(maxLength)},
-        queries.size(), out);
+                             const std::vector<ub_beam>& queries, const EstimateArgs& a,
+                             std::vector<Rgb>* out) {
+    if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
+    runEstimate(
+        bb1d_, "clEnqueueNDRangeKernel(ub_bb1d_estimate)",
+        {bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()), bufferArg(bvh.prims())},
+        bufferArg(queries), queries.size(), a, out);
 }
 
 }  // namespace ub

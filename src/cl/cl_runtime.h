@@ -71,30 +71,34 @@ class ClRuntime {
     /// why the cache was not used.
     const std::string& programNote() const { return programNote_; }
 
-    /// pp3d (kernels/pp3d.cl) over the given records and grid: (*out)[i] is query i's
-    /// estimate, as estimatePP3D on the host computes it.
-    void estimatePP3D(const std::vector<ub_photon_point>& photons,
-                      const std::vector<ub_query_point>& queries, const HashGrid& grid,
-                      const ub_mis_constants& mis, const std::vector<float>& mediumG,
-                      float normalization, uint32_t minLength, uint32_t maxLength,
+    /// The estimators as kernels (kernels/pp3d.cl, kernels/beams.cl; pb2d, bp2d and bb1d for
+    /// homogeneous media only): (*out)[i] is query i's estimate, as the host twin computes it
+    /// from the same records and lookups. media[m] describes medium m (ub_medium_info).
+    struct EstimateArgs {
+        const std::vector<ub_medium_info>* media = nullptr;
+        ub_mis_constants mis{};
+        float radius = 0, normalization = 0;
+        uint32_t minLength = 0, maxLength = 0;
+    };
+    void estimatePP3D(const std::vector<ub_photon_point>& photons, const HashGrid& grid,
+                      const std::vector<ub_query_point>& queries, const EstimateArgs& a,
                       std::vector<Rgb>* out);
-
-    /// The beam estimators in homogeneous media (kernels/beams.cl), as their host twins
-    /// compute them; media[i] describes medium i (ub_medium_info).
     void estimatePB2D(const std::vector<ub_photon_point>& photons, const Bvh& spheres,
-                      const std::vector<ub_beam>& queries, const std::vector<ub_medium_info>& media,
-                      const ub_mis_constants& mis, float radius, float normalization,
-                      uint32_t minLength, uint32_t maxLength, std::vector<Rgb>* out);
+                      const std::vector<ub_beam>& queries, const EstimateArgs& a,
+                      std::vector<Rgb>* out);
     void estimateBP2D(const std::vector<ub_beam>& beams, const std::vector<ub_beam_part>& parts,
                       const Bvh& bvh, const std::vector<ub_query_point>& queries,
-                      const std::vector<ub_medium_info>& media, const ub_mis_constants& mis,
-                      float radius, float normalization, uint32_t minLength, uint32_t maxLength,
-                      std::vector<Rgb>* out);
+                      const EstimateArgs& a, std::vector<Rgb>* out);
     void estimateBB1D(const std::vector<ub_beam>& beams, const std::vector<ub_beam_part>& parts,
-                      const Bvh& bvh, const std::vector<ub_beam>& queries,
-                      const std::vector<ub_medium_info>& media, const ub_mis_constants& mis,
-                      float radius, float normalization, uint32_t minLength, uint32_t maxLength,
+                      const Bvh& bvh, const std::vector<ub_beam>& queries, const EstimateArgs& a,
                       std::vector<Rgb>* out);
+
+    /// A kernel argument: host data uploaded as a buffer, or a scalar/struct by value.
+    struct Arg {
+        const void* data;
+        size_t bytes;
+        bool buffer;
+    };
 
   private:
     /// Runs the layout probe (kernels/pp3d.cl) and compares with the host; throws ClError.
@@ -106,19 +110,12 @@ class ClRuntime {
     cl_command_queue queue_ = nullptr;
     cl_program program_ = nullptr;
     cl_kernel pp3d_ = nullptr, pb2d_ = nullptr, bp2d_ = nullptr, bb1d_ = nullptr;
-    /// Uploads `buffers` (host pointer, bytes), sets them and `scalars` as the kernel's
-    /// arguments in order (buffers first where `order` says so), runs it over `count`
-    /// work-items and reads 3 floats per item into out.
-  public:
-    struct Arg {
-        const void* data;
-        size_t bytes;
-        bool buffer;
-    };
-
-  private:
-    void run(cl_kernel kernel, const char* name, const std::vector<Arg>& args, size_t count,
-             std::vector<Rgb>* out);
+    /// Runs estimate kernel `kernel` over `count` queries: its arguments are `lookup`, then
+    /// the queries (a buffer), their count and the EstimateArgs tail, then the results, read
+    /// back as 3 floats per query.
+    void runEstimate(cl_kernel kernel, const char* name, const std::vector<Arg>& lookup,
+                     const Arg& queries, size_t count, const EstimateArgs& a,
+                     std::vector<Rgb>* out);
 };
 
 }  // namespace ub

@@ -101,20 +101,6 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
 
     t0 = std::chrono::steady_clock::now();
     std::vector<Rgb> perPoint[4], perBeam[4];
-    if (t.pp3d) {
-        perPoint[UB_TECH_PP3D].assign(nPoints, Rgb(0.0f));
-        if (in.cl) {
-            std::vector<float> mediumG;
-            for (const Medium& m : in.scene->media) mediumG.push_back(m.g);
-            const float r = in.radius[UB_TECH_PP3D];
-            in.cl->estimatePP3D(photons, *in.queryPoints, grid, in.mis, mediumG,
-                                ub_pp3d_normalization(in.lightPathCount, r), uint32_t(in.minLength),
-                                uint32_t(in.maxLength), &perPoint[UB_TECH_PP3D]);
-            st.pairs[UB_TECH_PP3D] = VolumeEstimateStats::kNotCounted;
-        } else {
-            estimatePP3D(in, grid, &perPoint[UB_TECH_PP3D], &st.pairs[UB_TECH_PP3D]);
-        }
-    }
     // The beam estimators' kernels evaluate homogeneous media only (kernels/beams.cl).
     std::vector<ub_medium_info> media;
     bool allHomogeneous = true;
@@ -123,13 +109,35 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         allHomogeneous &= m.type == MediumType::kHomogeneous;
     }
     ClRuntime* beamCl = allHomogeneous ? in.cl : nullptr;
-    const uint32_t minL = uint32_t(in.minLength), maxL = uint32_t(in.maxLength);
+    auto clArgs = [&](int tech, float normalization) {
+        ClRuntime::EstimateArgs a;
+        a.media = &media;
+        a.mis = in.mis;
+        a.radius = in.radius[tech];
+        a.normalization = normalization;
+        a.minLength = uint32_t(in.minLength);
+        a.maxLength = uint32_t(in.maxLength);
+        return a;
+    };
+    if (t.pp3d) {
+        perPoint[UB_TECH_PP3D].assign(nPoints, Rgb(0.0f));
+        if (in.cl) {
+            in.cl->estimatePP3D(
+                photons, grid, *in.queryPoints,
+                clArgs(UB_TECH_PP3D,
+                       ub_pp3d_normalization(in.lightPathCount, in.radius[UB_TECH_PP3D])),
+                &perPoint[UB_TECH_PP3D]);
+            st.pairs[UB_TECH_PP3D] = VolumeEstimateStats::kNotCounted;
+        } else {
+            estimatePP3D(in, grid, &perPoint[UB_TECH_PP3D], &st.pairs[UB_TECH_PP3D]);
+        }
+    }
     if (t.bp2d) {
         perPoint[UB_TECH_BP2D].assign(nPoints, Rgb(0.0f));
         const float r = in.radius[UB_TECH_BP2D];
         if (beamCl) {
-            beamCl->estimateBP2D(beams, parts, beamBvh, *in.queryPoints, media, in.mis, r,
-                                 ub_bp2d_normalization(in.beamPathCount, r), minL, maxL,
+            beamCl->estimateBP2D(beams, parts, beamBvh, *in.queryPoints,
+                                 clArgs(UB_TECH_BP2D, ub_bp2d_normalization(in.beamPathCount, r)),
                                  &perPoint[UB_TECH_BP2D]);
             st.pairs[UB_TECH_BP2D] = VolumeEstimateStats::kNotCounted;
         } else {
@@ -141,8 +149,8 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         perBeam[UB_TECH_PB2D].assign(nBeams, Rgb(0.0f));
         const float r = in.radius[UB_TECH_PB2D];
         if (beamCl) {
-            beamCl->estimatePB2D(photons, spheres, *in.queryBeams, media, in.mis, r,
-                                 ub_pb2d_normalization(in.lightPathCount, r), minL, maxL,
+            beamCl->estimatePB2D(photons, spheres, *in.queryBeams,
+                                 clArgs(UB_TECH_PB2D, ub_pb2d_normalization(in.lightPathCount, r)),
                                  &perBeam[UB_TECH_PB2D]);
             st.pairs[UB_TECH_PB2D] = VolumeEstimateStats::kNotCounted;
         } else {
@@ -153,8 +161,8 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         perBeam[UB_TECH_BB1D].assign(nBeams, Rgb(0.0f));
         const float r = in.radius[UB_TECH_BB1D];
         if (beamCl) {
-            beamCl->estimateBB1D(beams, parts, beamBvh, *in.queryBeams, media, in.mis, r,
-                                 ub_bb1d_normalization(in.beamPathCount, r), minL, maxL,
+            beamCl->estimateBB1D(beams, parts, beamBvh, *in.queryBeams,
+                                 clArgs(UB_TECH_BB1D, ub_bb1d_normalization(in.beamPathCount, r)),
                                  &perBeam[UB_TECH_BB1D]);
             st.pairs[UB_TECH_BB1D] = VolumeEstimateStats::kNotCounted;
         } else {
