@@ -33,6 +33,13 @@ class HashGrid {
         const Vec3* first = items.empty() ? nullptr : &(items[0].*member);
         build(first, items.size(), sizeof(T), radius);
     }
+    /// The same for records of kernels/shared, whose positions are float[3] fields.
+    template <class T, class B>
+    void build(const std::vector<T>& items, float (B::*member)[3], float radius) {
+        const Vec3* first =
+            items.empty() ? nullptr : reinterpret_cast<const Vec3*>(&(items[0].*member)[0]);
+        build(first, items.size(), sizeof(T), radius);
+    }
 
     /// Calls visit(index) for every point i with |positions[i] - q| <= radius, each once.
     /// `positions` must be the data the grid was built from.
@@ -43,6 +50,12 @@ class HashGrid {
                Visit&& visit) const {
         if (items.empty()) return;
         query(q, &(items[0].*member), sizeof(T), visit);
+    }
+    template <class T, class B, class Visit>
+    void query(const Vec3& q, const std::vector<T>& items, float (B::*member)[3],
+               Visit&& visit) const {
+        if (items.empty()) return;
+        query(q, reinterpret_cast<const Vec3*>(&(items[0].*member)[0]), sizeof(T), visit);
     }
 
     float radius() const { return radius_; }

@@ -26,18 +26,18 @@ Rgb VertexCM::mergeVertices(const SubPath& state, const Hit& hit, const Bsdf& bs
         if (length > maxLength || length < minLength) return;
         float cameraDirPdfW = 0.0f, cameraRevPdfW = 0.0f;
         // The camera BSDF evaluated towards the light vertex's incoming direction.
-        Rgb f = bsdf.evaluate(lv.dirFix, nullptr, &cameraDirPdfW, &cameraRevPdfW);
+        Rgb f = bsdf.evaluate(lv.dirFix3(), nullptr, &cameraDirPdfW, &cameraRevPdfW);
         if (isBlack(f)) return;
         float weight = 1.0f;  // PPM: no MIS
         if (!ppm_) {
             cameraDirPdfW *= cameraCont;
             // The reverse direction would be sampled by the light subpath: its roulette.
-            cameraRevPdfW *= lv.continuationProb;
+            cameraRevPdfW *= lv.contProb;
             ub_mis_partials lightMis = {lv.dVCM, lv.dVC, lv.dVM, 0.0f};
             // Weight of [TR (38), (39)].
             weight = ub_mis_weight_merge(mis_, lightMis, state.mis, cameraDirPdfW, cameraRevPdfW);
         }
-        sum += f * lv.throughput * weight;
+        sum += f * lv.throughput3() * weight;
     });
     return sum * vmNormalization_;
 }

@@ -19,7 +19,7 @@ namespace ub {
 
 Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const PathVertex& v,
                               const VertexScatter& scatter) const {
-    Vec3 dir = lv.position - v.pos;
+    Vec3 dir = lv.pos3() - v.pos;
     const float distSqr = lengthSqr(dir);
     if (!(distSqr > 0.0f)) return Rgb(0.0f);
     const float distance = std::sqrt(distSqr);
@@ -35,16 +35,15 @@ Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const
     // The light vertex's scattering function: its BSDF, or its medium's phase function.
     VertexScatter lightScatter;
     if (lv.inMedium())
-        lightScatter.setupMedium(scene_.media[size_t(lv.mediumId())].g, lv.dirFix,
-                                 lv.continuationProb);
-    else if (!lightScatter.setupSurface(scene_, int(lv.materialId), lv.uv, lv.dirFix, lv.geoNormal,
-                                        lv.shadingNormal, /*fromLight=*/true))
+        lightScatter.setupMedium(scene_.media[size_t(lv.mediumId())].g, lv.dirFix3(), lv.contProb);
+    else if (!lightScatter.setupSurface(scene_, int(lv.materialId), lv.uv2(), lv.dirFix3(),
+                                        lv.geoNormal3(), lv.shadingNormal3(), /*fromLight=*/true))
         return Rgb(0.0f);
     float cosLight = 0.0f, lightDirPdfW = 0.0f, lightRevPdfW = 0.0f;
     Rgb fLight = lightScatter.evaluate(-dir, &cosLight, &lightDirPdfW, &lightRevPdfW);
     if (isBlack(fLight)) return Rgb(0.0f);
-    lightDirPdfW *= lv.continuationProb;
-    lightRevPdfW *= lv.continuationProb;
+    lightDirPdfW *= lv.contProb;
+    lightRevPdfW *= lv.contProb;
 
     // Visibility; with media the transmittance of the connecting chain (walked from the
     // camera vertex through imaginary boundaries) and its free-flight pdfs in both
@@ -55,7 +54,7 @@ Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const
         MediumStack stack;
         if (!stackTowards(v, state, dir, &stack)) return Rgb(0.0f);
         const MediumShadow sh =
-            scene_.shadowTransmittance(v.pos, v.geoNormal(), stack, lv.position, lv.geoNormal);
+            scene_.shadowTransmittance(v.pos, v.geoNormal(), stack, lv.pos3(), lv.geoNormal3());
         if (sh.blocked || isBlack(sh.transmittance)) return Rgb(0.0f);
         transmittance = sh.transmittance;
         distPdfToLight = lv.inMedium() ? sh.pdfScatterFwdL : sh.probPass;
@@ -71,7 +70,7 @@ Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const
     // Merging factors of both ends; R_out of each is the other kind of beam along the
     // connecting chain (ub_mis_volume.h).
     const ub_mis_factor lightFactor =
-        ub_mis_vertex_factor(mis_, lv.inMedium(), 0, 1, lv.rInL, length(cross(lv.dirFix, dir)));
+        ub_mis_vertex_factor(mis_, lv.inMedium(), 0, 1, lv.rInL, length(cross(lv.dirFix3(), dir)));
     const ub_mis_factor cameraFactor = ub_mis_vertex_factor(
         mis_, v.inMedium, 0, 0, ratioIn(state, v), length(cross(state.ray.dir, dir)));
     const float lightMerge =
@@ -84,7 +83,7 @@ Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const
                               cameraRevPdfW, lightMerge, cameraMerge);
     const Rgb contrib = fCamera * fLight * transmittance * (weight * geometry);
     if (isBlack(contrib)) return Rgb(0.0f);
-    if (!useMedia_ && scene_.occluded(v.pos, v.hit.geoNormal, lv.position, lv.geoNormal))
+    if (!useMedia_ && scene_.occluded(v.pos, v.hit.geoNormal, lv.pos3(), lv.geoNormal3()))
         return Rgb(0.0f);
     return contrib;
 }

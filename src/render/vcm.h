@@ -31,7 +31,7 @@
 // boundaries (Scene::traceMedia) and sample free-flight distances along them
 // (render/medium_walk.h), so they also scatter at medium vertices with the HG
 // phase function (render/vertex_scatter.h). Medium vertices are stored as light
-// vertices (LightVertex::kLightVertexInMedium), connected to the camera, to camera
+// vertices (UB_LIGHT_VERTEX_IN_MEDIUM), connected to the camera, to camera
 // vertices and to lights like surface vertices, with the transmittance of the
 // connecting chain (Scene::shadowTransmittance, through imaginary boundaries).
 // Every MIS pdf includes the free-flight pdfs of its segment in its direction

@@ -107,7 +107,8 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
                 const int length = int(lv.pathLength) + 1 + state.pathLength;
                 if (length < minLength) continue;
                 if (length > maxLength) break;  // vertices are stored in path order
-                color += state.throughput * lv.throughput * connectVertices(lv, state, v, scatter);
+                color +=
+                    state.throughput * lv.throughput3() * connectVertices(lv, state, v, scatter);
             }
         }
         if (!atLimit && !scatter.isDelta() && useVM_ && !v.inMedium) {

@@ -84,23 +84,24 @@ void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuf
             // Store the vertex unless the BSDF is purely specular (no connection or merging).
             if (!scatter.isDelta() && (useVC_ || useVM_)) {
                 LightVertex lv{};
-                lv.position = v.pos;
+                storeF3(lv.position, v.pos);
                 lv.pathLength = uint32_t(state.pathLength);
-                lv.throughput = state.throughput;
-                lv.dirFix = -state.ray.dir;
-                lv.continuationProb = scatter.continuationProb();
+                storeF3(lv.throughput, state.throughput);
+                storeF3(lv.dirFix, -state.ray.dir);
+                lv.contProb = scatter.continuationProb();
                 lv.dVCM = state.mis.dVCM;
                 lv.dVC = state.mis.dVC;
                 lv.dVM = state.mis.dVM;
                 lv.rInL = rIn;
                 if (v.inMedium) {
-                    lv.flags = LightVertex::kLightVertexInMedium;
+                    lv.flags = UB_LIGHT_VERTEX_IN_MEDIUM;
                     lv.materialId = uint32_t(v.mediumId);
                 } else {
                     lv.materialId = uint32_t(v.hit.materialId);
-                    lv.geoNormal = v.hit.geoNormal;
-                    lv.shadingNormal = v.hit.shadingNormal;
-                    lv.uv = v.hit.uv;
+                    storeF3(lv.geoNormal, v.hit.geoNormal);
+                    storeF3(lv.shadingNormal, v.hit.shadingNormal);
+                    lv.uv[0] = v.hit.uv.x;
+                    lv.uv[1] = v.hit.uv.y;
                 }
                 // UPBP: surface vertices are connected and merged on surfaces; medium
                 // vertices are connected, and merged through the photon points below.
