@@ -31,6 +31,7 @@
 #include "render/upbp_techniques.h"
 #include "render/vcm.h"
 #include "scene/io/json_loader.h"
+#include "scene/io/scene_loader.h"
 #include "scene/medium.h"
 #include "scene/vdb_grid.h"
 #include "tests/support/render_stats.h"
@@ -51,26 +52,40 @@ std::unique_ptr<Scene> loadJsonFile(const std::string& dir, const std::string& f
     return loadJsonSceneFromString(j.dump(), file, dir);
 }
 
-/// Renders `algorithm` and vpt (the reference) and runs the block and image-mean z-tests.
-void expectAgreesWithVpt(const Scene& scene, const RenderOptions& base, int vptIterations,
-                         int iterations, const std::string& what) {
+/// Renders `reference` (vpt by default) with base's settings and seed 101.
+BlockStats renderReference(const Scene& scene, const RenderOptions& base, int iterations,
+                           const std::string& reference = "vpt") {
     RenderOptions opt = base;
-    opt.algorithm = "vpt";
+    opt.algorithm = reference;
     opt.seed = 101;
-    auto vpt = makeIntegrator(scene, opt);
-    BlockStats ref = renderBlockStats(*vpt, vptIterations, 8);
-    opt = base;
+    auto integrator = makeIntegrator(scene, opt);
+    return renderBlockStats(*integrator, iterations, 8);
+}
+
+/// Renders `algorithm` (seed 102) and runs the block and image-mean z-tests against ref.
+void expectAgrees(const Scene& scene, const RenderOptions& base, const BlockStats& ref,
+                  int iterations, const std::string& what, const std::string& reference) {
+    RenderOptions opt = base;
     opt.seed = 102;
     auto integrator = makeIntegrator(scene, opt);
     BlockStats s = renderBlockStats(*integrator, iterations, 8);
     Agreement g = compare(s, ref);
-    std::printf("[ upbp     ] %s vs vpt on %s: %s\n", base.algorithm.c_str(), what.c_str(),
-                g.report.c_str());
+    std::printf("[ upbp     ] %s vs %s on %s: %s\n", base.algorithm.c_str(), reference.c_str(),
+                what.c_str(), g.report.c_str());
     EXPECT_GT(g.minBlockP, sidakLevel(1e-3, g.tests))
         << base.algorithm << " on " << what << ": " << g.report;
     for (int ch = 0; ch < 3; ++ch)
         EXPECT_LT(std::fabs(g.meanZ[ch]), 3.9)
             << base.algorithm << " on " << what << " channel " << ch << ": " << g.report;
+}
+
+/// Renders `algorithm` and `reference` (vpt by default) and runs the block and image-mean
+/// z-tests.
+void expectAgreesWithVpt(const Scene& scene, const RenderOptions& base, int vptIterations,
+                         int iterations, const std::string& what,
+                         const std::string& reference = "vpt") {
+    expectAgrees(scene, base, renderReference(scene, base, vptIterations, reference), iterations,
+                 what, reference);
 }
 
 }  // namespace
@@ -245,6 +260,83 @@ TEST(Upbp, AgreesWithVptOnBundledMediaScenes) {
     }
 }
 
+// The same on SmallUPBP's three scenes (scenes/smallupbp), as SmallUPBP's files describe
+// them, at 32x32:
+//  * the candle (dense wax, path length 4) and mirrorballs (thin global fog, glass and
+//    mirror balls, a lamp behind glass): against vbpt (upbp:bpt, which reaches the light
+//    behind the lamp glass by light tracing), the candle against vpt too;
+//  * the bunny, lit only through the lamp glass and seen through its own glass: its
+//    specular-diffuse-specular paths (light, glass, a floor or medium vertex, the bunny's
+//    glass, camera) are found by vbpt only when a camera path hits the light by chance,
+//    so vbpt's image is dominated by a few fireflies (two pixels held 54% of a 4,000-
+//    iteration vbpt render) and cannot serve as a reference. There the subsets are checked
+//    against each other: every set holds surf (the surface SDS paths) and one or more
+//    volumetric merges (the medium SDS paths), and upbp:bpt+surf+pp3d is the reference.
+// Larger volumetric radii are checked where their bias stays below the tests' resolution:
+// 4x the defaults on mirrorballs and the bunny; on the candle 4x the earlier defaults
+// failed (z = -8.8: the wax is thin, next to the flame, and the kernel reaches out of it,
+// bias O(r)), 2x passes. (4x surf radius on mirrorballs blurs its caustics visibly: block
+// p 1e-8; surf keeps its default.) On the bunny every set sits 1-3 standard errors above
+// the pp3d reference (pp3d's boundary bias is the largest of the four), within the bound.
+struct SmallUpbpCase {
+    const char* file;
+    int maxLength, refIterations, iterations;
+    const char* reference;
+    float radiusScale;
+};
+
+void expectAgreesOnSmallUpbpScene(const SmallUpbpCase& c) {
+    const std::string dir = std::string(UNIBEAM_SOURCE_DIR) + "/scenes/smallupbp";
+    std::vector<Diagnostic> warnings;
+    auto scene = loadScene(dir + "/" + c.file, &warnings);
+    scene->camera = scene->camera.resized(32, 32);
+    const bool sds = std::string(c.reference) != "vbpt";
+    std::vector<std::string> sets = {"upbp", "upbp:bpt+pb2d+bb1d", "upbp:bpt+surf+pp3d",
+                                     "upbp:bpt+bp2d+bb1d"};
+    if (sds)
+        sets = {"upbp", "upbp:bpt+surf+pb2d+bb1d", "upbp:bpt+surf+bp2d+bb1d",
+                "upbp:bpt+surf+pp3d+bb1d"};
+    for (const char* x : kSingle) {
+        if (!sds)
+            sets.push_back(std::string("upbp:bpt+") + x);
+        else if (std::string(x) != "surf" && std::string(x) != "pp3d")
+            sets.push_back(std::string("upbp:bpt+surf+") + x);
+    }
+    RenderOptions opt;
+    opt.maxPathLength = c.maxLength;
+    const BlockStats ref = renderReference(*scene, opt, c.refIterations, c.reference);
+    for (const std::string& set : sets) {
+        opt.algorithm = set;
+        expectAgrees(*scene, opt, ref, c.iterations, c.file, c.reference);
+    }
+    opt = RenderOptions();
+    opt.algorithm = "upbp";
+    opt.maxPathLength = c.maxLength;
+    opt.radiusPP3D *= c.radiusScale;
+    opt.radiusPB2D *= c.radiusScale;
+    opt.radiusBP2D *= c.radiusScale;
+    opt.radiusBB1D *= c.radiusScale;
+    char what[128];
+    std::snprintf(what, sizeof(what), "%s (%gx radii)", c.file, double(c.radiusScale));
+    expectAgrees(*scene, opt, ref, c.iterations, what, c.reference);
+    if (c.maxLength == 4) {
+        opt = RenderOptions();
+        opt.algorithm = "upbp";
+        opt.maxPathLength = c.maxLength;
+        expectAgreesWithVpt(*scene, opt, 4 * c.refIterations, c.iterations, c.file);
+    }
+}
+
+TEST(Upbp, AgreesOnSmallUpbpCandle) {
+    expectAgreesOnSmallUpbpScene({"candle/candle.obj", 4, 1024, 256, "vbpt", 2.0f});
+}
+TEST(Upbp, AgreesOnSmallUpbpMirrorballs) {
+    expectAgreesOnSmallUpbpScene({"mirrorballs/mirrorballs.obj", 12, 256, 64, "vbpt", 4.0f});
+}
+TEST(Upbp, AgreesOnSmallUpbpBunny) {
+    expectAgreesOnSmallUpbpScene({"bunny/bunny.obj", 12, 128, 64, "upbp:bpt+surf+pp3d", 4.0f});
+}
+
 // Same seed, same image, whatever the number of threads: records are made per chunk and
 // per row and concatenated in order, estimates are summed per pixel in query order.
 TEST(Upbp, SameSeedSameImageForAnyThreadCount) {
@@ -300,6 +392,9 @@ TEST(Upbp, TechniqueLayersSumToTheImage) {
         RenderOptions opt;
         opt.algorithm = set;
         opt.seed = 12;
+        // Radii large enough that every layer gets something in one 24x24 iteration.
+        opt.radiusPP3D = 0.04f;
+        opt.radiusPB2D = opt.radiusBP2D = opt.radiusBB1D = 0.02f;
         auto integrator = makeIntegrator(*scene, opt);
         Image img;
         integrator->renderIteration(0, img);

@@ -33,7 +33,7 @@ struct RenderOptions {
     /// radii (if radiusIsRelative, fractions of the radius of the media: half the diagonal of
     /// the bounding box of the medium boundaries, or the scene radius with a global medium) and
     /// reduction exponents, r_i = r_1 i^((alpha - 1) / k) for a k-dimensional kernel.
-    float radiusPP3D = 0.01f, radiusPB2D = 0.005f, radiusBP2D = 0.005f, radiusBB1D = 0.005f;
+    float radiusPP3D = 0.005f, radiusPB2D = 0.0025f, radiusBP2D = 0.005f, radiusBB1D = 0.005f;
     float alphaPP3D = 0.75f, alphaPB2D = 0.75f, alphaBP2D = 0.75f, alphaBB1D = 0.75f;
     bool shortPhotonBeams = true;  ///< photon beams end at the sampled distance (else: surface)
     bool shortQueryBeams = false;  ///< query beams end at the sampled distance (else: surface)
