@@ -282,6 +282,53 @@ TEST(Cli, VersionAndHelp) {
 
 // SIGINT during a long (time-limited) render: the iteration in progress finishes, the
 // image so far is written with its metadata, and the exit status is 0.
+// unibeam compare IMAGE REF: metrics, threshold (exit 0/1), --diff PNG, bad input (exit 2).
+TEST(Cli, CompareReportsErrorsThresholdAndDiff) {
+    const fs::path dir = tempDir();
+    const std::string a = (dir / "a.exr").string(), b = (dir / "b.exr").string();
+    for (const auto& [file, seed] : {std::pair{a, "1"}, std::pair{b, "2"}}) {
+        RunResult r = runUnibeam({"render", kScene, "-a", "pt", "--resolution", "32x24", "-i", "4",
+                                  "--seed", seed, "-o", file},
+                                 dir);
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+    }
+    RunResult same = runUnibeam({"compare", a, a, "--threshold", "0"}, dir);
+    EXPECT_EQ(same.exitCode, 0) << same.out << same.err;
+    EXPECT_NE(same.out.find("overall RMSE 0  relMSE 0  MAE 0"), std::string::npos) << same.out;
+    RunResult diff = runUnibeam({"compare", a, b, "--diff", (dir / "d.png").string()}, dir);
+    EXPECT_EQ(diff.exitCode, 0) << diff.err;
+    for (const char* s : {"R       RMSE", "G       RMSE", "B       RMSE", "overall RMSE"})
+        EXPECT_NE(diff.out.find(s), std::string::npos) << diff.out;
+    int w = 0, h = 0;
+    ASSERT_TRUE(pngSize(dir / "d.png", &w, &h));
+    EXPECT_EQ(w, 32);
+    EXPECT_GT(h, 24);
+    RunResult fail = runUnibeam({"compare", a, b, "--threshold", "1e-9", "--metric", "mae"}, dir);
+    EXPECT_EQ(fail.exitCode, 1) << fail.out << fail.err;
+    EXPECT_NE(fail.out.find("mae"), std::string::npos);
+    EXPECT_NE(fail.out.find("FAIL"), std::string::npos);
+    // Bad input: exit 2 with the file named.
+    RunResult missing = runUnibeam({"compare", a, (dir / "none.exr").string()}, dir);
+    EXPECT_EQ(missing.exitCode, 2);
+    EXPECT_NE(missing.err.find("none.exr"), std::string::npos) << missing.err;
+    std::ofstream(dir / "junk.exr") << "not an exr";
+    RunResult junk = runUnibeam({"compare", a, (dir / "junk.exr").string()}, dir);
+    EXPECT_EQ(junk.exitCode, 2);
+    EXPECT_NE(junk.err.find("junk.exr"), std::string::npos) << junk.err;
+    RunResult small = runUnibeam({"render", kScene, "-a", "pt", "--resolution", "8x8", "-i", "1",
+                                  "-o", (dir / "s.exr").string()},
+                                 dir);
+    ASSERT_EQ(small.exitCode, 0);
+    RunResult size = runUnibeam({"compare", a, (dir / "s.exr").string()}, dir);
+    EXPECT_EQ(size.exitCode, 2);
+    EXPECT_NE(size.err.find("32x24"), std::string::npos) << size.err;
+    RunResult noSpp = runUnibeam({"compare", a, b, "--ztest", b}, dir);
+    EXPECT_EQ(noSpp.exitCode, 2);
+    EXPECT_NE(noSpp.err.find("--spp"), std::string::npos) << noSpp.err;
+    RunResult metric = runUnibeam({"compare", a, b, "--metric", "psnr"}, dir);
+    EXPECT_EQ(metric.exitCode, 2);
+}
+
 TEST(Cli, SigintWritesImageAndExitsZero) {
     ASSERT_TRUE(fs::exists(kScene)) << kScene;
     fs::path dir = tempDir();

@@ -48,9 +48,14 @@ struct RenderArgs {
 };
 
 struct CompareArgs {
-    std::string reference, referenceVariance, image, imageVariance;
-    double samples = 0;           ///< --spp: iterations averaged into IMAGE
-    double referenceSamples = 0;  ///< --ref-spp (0: exact reference)
+    std::string image, reference;                  ///< IMAGE REF
+    double threshold = -1;                         ///< --threshold (< 0: report only)
+    std::string metric = "relmse";                 ///< --metric the threshold applies to
+    std::string diffPng;                           ///< --diff OUT.png
+    float diffMax = 0;                             ///< --diff-max (0: 99th percentile)
+    std::string referenceVariance, imageVariance;  ///< --ztest VAR.exr, --image-var
+    double samples = 0;                            ///< --spp: iterations averaged into IMAGE
+    double referenceSamples = 0;                   ///< --ref-spp (0: exact reference)
     double alpha = 0.01;
     int varianceRadius = 0;  ///< --variance-radius: pool the image variance (needs --image-var)
 };
@@ -62,8 +67,9 @@ int runRender(const RenderArgs& args);
 int runInfo(const std::string& scenePath, const std::map<std::string, std::string>& defines = {});
 /// `unibeam devices`: the OpenCL platforms and devices; exit 2 if there is none.
 int runDevices();
-/// `unibeam compare --ztest`: 0 pass, 1 fail, 2 bad input (UsageError / InputError).
-int runCompareZTest(const CompareArgs& args);
+/// `unibeam compare`: 0 pass, 1 fail (threshold or z-test), 2 bad input (UsageError /
+/// InputError).
+int runCompare(const CompareArgs& args);
 /// Parses the values of -D flags ("name=value"); throws UsageError on a malformed one.
 std::map<std::string, std::string> parseDefines(const std::vector<std::string>& values);
 

@@ -1,11 +1,13 @@
-// `unibeam compare --ztest`: per-pixel z-test of a rendered image against a
-// reference mean and variance (core/ztest.h), and the -D flag parser.
+// `unibeam compare`: error metrics of a rendered image against a reference
+// (core/image_metrics.h), an optional false-colour error PNG and per-pixel z-test
+// (core/ztest.h), and the -D flag parser.
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
 
 #include "app/commands.h"
 #include "core/image.h"
+#include "core/image_metrics.h"
 #include "core/ztest.h"
 
 namespace ub::app {
@@ -28,27 +30,54 @@ std::map<std::string, std::string> parseDefines(const std::vector<std::string>& 
     return out;
 }
 
-int runCompareZTest(const CompareArgs& args) {
+int runCompare(const CompareArgs& args) {
     for (const std::string* f :
-         {&args.reference, &args.referenceVariance, &args.image, &args.imageVariance}) {
+         {&args.image, &args.reference, &args.referenceVariance, &args.imageVariance}) {
         if (!f->empty() && !std::filesystem::is_regular_file(*f))
             throw UsageError("compare: file '" + *f + "' does not exist");
     }
-    Image ref = readExr(args.reference);
-    Image refVar = readExr(args.referenceVariance);
-    Image img = readExr(args.image);
-    Image imgVar;
-    if (!args.imageVariance.empty()) imgVar = readExr(args.imageVariance);
-    ZTestOptions o;
-    o.alpha = args.alpha;
-    o.samples = args.samples;
-    o.referenceSamples = args.referenceSamples;
-    o.varianceRadius = args.varianceRadius;
-    if (o.varianceRadius > 0 && args.imageVariance.empty())
-        throw UsageError("compare: --variance-radius needs --image-var");
-    ZTestResult r = zTest(img, args.imageVariance.empty() ? nullptr : &imgVar, ref, refVar, o);
-    std::printf("%s\n", describeZTest(r, o).c_str());
-    return r.passed ? 0 : 1;
+    if (args.referenceVariance.empty() &&
+        (args.samples > 0 || !args.imageVariance.empty() || args.referenceSamples > 0))
+        throw UsageError("compare: --spp, --image-var and --ref-spp belong to --ztest VAR.exr");
+    if (!args.referenceVariance.empty() && !(args.samples > 0))
+        throw UsageError("compare: --ztest needs --spp N (iterations averaged into IMAGE)");
+    const Image img = readExr(args.image);
+    const Image ref = readExr(args.reference);
+    if (img.width != ref.width || img.height != ref.height)
+        throw UsageError("compare: '" + args.image + "' is " + std::to_string(img.width) + "x" +
+                         std::to_string(img.height) + " but the reference '" + args.reference +
+                         "' is " + std::to_string(ref.width) + "x" + std::to_string(ref.height));
+    const ImageError e = imageError(img, ref);
+    std::printf("%s\n", describeImageError(e).c_str());
+    bool passed = true;
+    if (args.threshold >= 0) {
+        const double v = e.overall(args.metric);
+        passed = v <= args.threshold;
+        std::printf("%s %.6g %s threshold %.6g: %s\n", args.metric.c_str(), v, passed ? "<=" : ">",
+                    args.threshold, passed ? "pass" : "FAIL");
+    }
+    if (!args.diffPng.empty()) {
+        float used = 0;
+        writePng(args.diffPng, falseColourError(img, ref, args.diffMax, &used));
+        std::printf("wrote %s (relative error |a - r| / (r + 0.01), scale 0 .. %.3g)\n",
+                    args.diffPng.c_str(), double(used));
+    }
+    if (!args.referenceVariance.empty()) {
+        const Image refVar = readExr(args.referenceVariance);
+        Image imgVar;
+        if (!args.imageVariance.empty()) imgVar = readExr(args.imageVariance);
+        ZTestOptions o;
+        o.alpha = args.alpha;
+        o.samples = args.samples;
+        o.referenceSamples = args.referenceSamples;
+        o.varianceRadius = args.varianceRadius;
+        if (o.varianceRadius > 0 && args.imageVariance.empty())
+            throw UsageError("compare: --variance-radius needs --image-var");
+        ZTestResult r = zTest(img, args.imageVariance.empty() ? nullptr : &imgVar, ref, refVar, o);
+        std::printf("%s\n", describeZTest(r, o).c_str());
+        passed = passed && r.passed;
+    }
+    return passed ? 0 : 1;
 }
 
 }  // namespace ub::app

@@ -1,7 +1,7 @@
 // `unibeam`: the command-line program (CLI11). Commands:
 //   unibeam render SCENE [options]   render a scene progressively, write EXR / PNG
 //   unibeam info SCENE               print what a scene contains
-//   unibeam compare --ztest REF REF_VAR IMAGE   per-pixel z-test against a reference
+//   unibeam compare IMAGE REF [--threshold T] [--diff OUT.png] [--ztest REF_VAR --spp N]
 //   unibeam --version | --help, and --help on every command.
 // Exit status: 0 success, 1 unexpected failure, 2 bad input (flags, scene, paths).
 // docs/cli.md documents every option.
@@ -281,42 +281,65 @@ int run(int argc, char** argv) {
 
     // ---- compare ----
     ub::app::CompareArgs ca;
-    std::vector<std::string> ztestFiles;
     CLI::App* compare = app.add_subcommand(
-        "compare", "Compare a rendered image with a reference (exit 0 pass, 1 fail, 2 bad input)");
-    compare
-        ->add_option("--ztest", ztestFiles,
-                     "Per-pixel z-test: reference mean, reference per-sample variance, image "
-                     "(all OpenEXR)")
-        ->expected(3)
+        "compare",
+        "Compare a rendered image with a reference: RMSE, relative MSE and mean absolute error "
+        "per channel and overall (exit 0 pass, 1 fail, 2 bad input)");
+    compare->add_option("IMAGE", ca.image, "Rendered image (OpenEXR)")
         ->required()
-        ->type_name("REF REF_VAR IMAGE");
+        ->type_name("IMAGE.exr");
+    compare->add_option("REF", ca.reference, "Reference image (OpenEXR, same size)")
+        ->required()
+        ->type_name("REF.exr");
+    compare
+        ->add_option("--threshold", ca.threshold,
+                     "Fail (exit 1) when the overall --metric exceeds T; default: report only")
+        ->check(CLI::NonNegativeNumber)
+        ->type_name("T");
+    compare
+        ->add_option("--metric", ca.metric,
+                     "Metric that --threshold applies to: relmse (default), rmse or mae")
+        ->check(CLI::IsMember({"relmse", "rmse", "mae"}))
+        ->type_name("M");
+    compare
+        ->add_option("--diff", ca.diffPng,
+                     "Write a false-colour PNG of the per-pixel relative error with a colour bar")
+        ->type_name("OUT.png");
+    compare
+        ->add_option("--diff-max", ca.diffMax,
+                     "Top of the --diff colour scale (default: the 99th percentile)")
+        ->check(positiveReal())
+        ->type_name("E");
+    compare
+        ->add_option("--ztest", ca.referenceVariance,
+                     "Also run a per-pixel z-test with this per-sample variance of the reference "
+                     "(e.g. Mitsuba's *_ref_rgb_var.exr); needs --spp")
+        ->type_name("VAR.exr");
     compare
         ->add_option("--image-var", ca.imageVariance,
-                     "Per-sample variance of the image (unibeam render --variance); default: "
-                     "the reference variance stands for it")
+                     "z-test: per-sample variance of the image (unibeam render --variance); "
+                     "default: the reference variance stands for it")
         ->type_name("VAR.exr");
-    compare->add_option("--spp", ca.samples, "Iterations averaged into IMAGE (required)")
-        ->required()
+    compare->add_option("--spp", ca.samples, "z-test: iterations averaged into IMAGE")
         ->check(positiveReal())
         ->type_name("N");
     compare
         ->add_option("--ref-spp", ca.referenceSamples,
-                     "Samples per pixel of the reference (adds its own error); default: the "
-                     "reference is treated as exact")
+                     "z-test: samples per pixel of the reference (adds its own error); default: "
+                     "the reference is treated as exact")
         ->check(positiveReal())
         ->type_name("M");
     compare
         ->add_option("--alpha", ca.alpha,
-                     "Family-wise significance level, Sidak-corrected over all pixel-channels "
-                     "(default 0.01)")
+                     "z-test: family-wise significance level, Sidak-corrected over all "
+                     "pixel-channels (default 0.01)")
         ->check(positiveReal(0.999))
         ->type_name("A");
     compare
         ->add_option("--variance-radius", ca.varianceRadius,
-                     "Image variance of a pixel: the larger of its own and the mean over its "
-                     "(2R+1)^2 neighbourhood (needs --image-var; guards against heavy-tailed "
-                     "estimators; default 0: its own)")
+                     "z-test: image variance of a pixel is the larger of its own and the mean "
+                     "over its (2R+1)^2 neighbourhood (needs --image-var; guards against "
+                     "heavy-tailed estimators; default 0: its own)")
         ->check(CLI::Range(0, 8))
         ->type_name("R");
 
@@ -366,12 +389,7 @@ int run(int argc, char** argv) {
         }
         if (*info) return ub::app::runInfo(infoScene, ub::app::parseDefines(infoDefines));
         if (*devices) return ub::app::runDevices();
-        if (*compare) {
-            ca.reference = ztestFiles.at(0);
-            ca.referenceVariance = ztestFiles.at(1);
-            ca.image = ztestFiles.at(2);
-            return ub::app::runCompareZTest(ca);
-        }
+        if (*compare) return ub::app::runCompare(ca);
     } catch (const ub::app::UsageError& e) {
         std::fprintf(stderr, "unibeam: error: %s\n", e.what());
         return kExitBadInput;
