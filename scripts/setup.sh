@@ -12,6 +12,7 @@ PACKAGES=(
   ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd clinfo
   nlohmann-json3-dev libcli11-dev libtinyobjloader-dev libassimp-dev libpugixml-dev
   libgtest-dev libgmock-dev libbenchmark-dev clang-format
+  python3-matplotlib chromium
 )
 
 missing=()

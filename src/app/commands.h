@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "render/integrator.h"
+
 namespace ub::app {
 
 struct UsageError : std::runtime_error {
@@ -64,6 +66,22 @@ struct CompareArgs {
 constexpr int kDefaultIterations = 16;
 
 int runRender(const RenderArgs& args);
+/// The RenderOptions that args ask for on scene (scene settings where args are silent);
+/// throws UsageError on a malformed --cl-device.
+RenderOptions makeRenderOptions(const RenderArgs& args, const Scene& scene);
+/// Parses "WxH" (positive integers up to 16384); throws UsageError naming --resolution.
+void parseResolution(const std::string& s, int* w, int* h);
+
+struct StudyArgs {
+    std::string scene, outDir, reference;
+    std::vector<std::string> techniques;
+    double timeSeconds = 0;       ///< --time: per technique
+    int iterations = 0;           ///< --iterations: per technique
+    double referenceSeconds = 0;  ///< --reference-time (0: 4x the per-technique budget)
+    RenderArgs render;            ///< resolution, seed, max length, backend, threads, -D
+};
+/// `unibeam study`: 0 done, 2 bad input.
+int runStudy(const StudyArgs& args);
 int runInfo(const std::string& scenePath, const std::map<std::string, std::string>& defines = {});
 /// `unibeam devices`: the OpenCL platforms and devices; exit 2 if there is none.
 int runDevices();

@@ -13,6 +13,7 @@
 #include <exception>
 #include <iostream>
 #include <new>
+#include <sstream>
 #include <string>
 
 #include "app/commands.h"
@@ -343,12 +344,58 @@ int run(int argc, char** argv) {
         ->check(CLI::Range(0, 8))
         ->type_name("R");
 
+    // ---- study ----
+    ub::app::StudyArgs sa;
+    std::string studyTechniques;
+    uint64_t studySeed = 0;
+    int studyMaxLength = 0;
+    CLI::App* study = app.add_subcommand(
+        "study",
+        "Equal-time (or equal-iteration) comparison of techniques against a reference: "
+        "convergence.csv, summary.csv, convergence.png and index.html in --out DIR");
+    study->add_option("SCENE", sa.scene, "Scene file (.json, .xml, .obj)")->required();
+    study
+        ->add_option("--techniques", studyTechniques,
+                     "Comma-separated techniques, any -a value (e.g. upbp,upbp:bpt+bb1d,vpt)")
+        ->required()
+        ->type_name("T1,T2,...");
+    auto* studyTime = study->add_option("--time", sa.timeSeconds, "Seconds per technique")
+                          ->check(positiveReal())
+                          ->type_name("S");
+    study->add_option("--iterations", sa.iterations, "Iterations per technique")
+        ->check(CLI::PositiveNumber)
+        ->excludes(studyTime)
+        ->type_name("N");
+    study
+        ->add_option("--reference", sa.reference,
+                     "Reference image (OpenEXR, the study's resolution); default: rendered "
+                     "first with upbp for 4x the per-technique budget")
+        ->type_name("REF.exr");
+    study
+        ->add_option("--reference-time", sa.referenceSeconds,
+                     "Seconds for the reference render when no --reference is given")
+        ->check(positiveReal())
+        ->type_name("S");
+    study->add_option("--resolution", sa.render.resolution, "Image size WIDTHxHEIGHT")
+        ->type_name("WxH");
+    study->add_option("--out", sa.outDir, "Output folder (created)")->required()->type_name("DIR");
+    auto* studySeedOpt =
+        study->add_option("--seed", studySeed, "Random seed (default: scene)")->type_name("N");
+    auto* studyLengthOpt =
+        study->add_option("--max-length", studyMaxLength, "Maximum path length (default: scene)")
+            ->check(CLI::PositiveNumber)
+            ->type_name("N");
+    study->add_option("--backend", sa.render.backend, "upbp estimate pass: opencl, host, auto")
+        ->check(CLI::IsMember({"opencl", "host", "auto"}));
+    study->add_option("--threads", sa.render.threads, "Worker threads (default: all cores)")
+        ->check(CLI::PositiveNumber);
+
     if (argc >= 2 && argv[1][0] != '-' && std::string(argv[1]) != "render" &&
         std::string(argv[1]) != "info" && std::string(argv[1]) != "compare" &&
-        std::string(argv[1]) != "devices") {
+        std::string(argv[1]) != "devices" && std::string(argv[1]) != "study") {
         std::fprintf(
             stderr,
-            "unibeam: error: unknown command '%s' (valid: render, info, compare, devices)\n"
+            "unibeam: error: unknown command '%s' (valid: render, info, compare, devices, study)\n"
             "Run 'unibeam --help' for usage.\n",
             argv[1]);
         return kExitBadInput;
@@ -390,6 +437,14 @@ int run(int argc, char** argv) {
         if (*info) return ub::app::runInfo(infoScene, ub::app::parseDefines(infoDefines));
         if (*devices) return ub::app::runDevices();
         if (*compare) return ub::app::runCompare(ca);
+        if (*study) {
+            std::stringstream list(studyTechniques);
+            for (std::string t; std::getline(list, t, ',');)
+                if (!t.empty()) sa.techniques.push_back(t);
+            if (studySeedOpt->count() > 0) sa.render.seed = studySeed;
+            if (studyLengthOpt->count() > 0) sa.render.maxLength = studyMaxLength;
+            return ub::app::runStudy(sa);
+        }
     } catch (const ub::app::UsageError& e) {
         std::fprintf(stderr, "unibeam: error: %s\n", e.what());
         return kExitBadInput;

@@ -50,7 +50,8 @@ void checkOutputPath(const std::string& path, const std::string& ext, const std:
         throw UsageError(flag + ": cannot write '" + path + "': file is not writable");
 }
 
-/// Parses "WxH" (positive integers up to 16384).
+}  // namespace
+
 void parseResolution(const std::string& s, int* w, int* h) {
     auto bad = [&] {
         return UsageError(
@@ -70,6 +71,8 @@ void parseResolution(const std::string& s, int* w, int* h) {
     *h = parse(s.substr(x + 1));
 }
 
+namespace {
+
 std::string join(const std::vector<std::string>& v) {
     std::string s;
     for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
@@ -77,6 +80,42 @@ std::string join(const std::vector<std::string>& v) {
 }
 
 }  // namespace
+
+RenderOptions makeRenderOptions(const RenderArgs& args, const Scene& scene) {
+    RenderOptions options;
+    options.algorithm = args.algorithm;
+    options.maxPathLength = args.maxLength ? *args.maxLength : scene.settings.maxPathLength;
+    options.minPathLength = scene.settings.minPathLength;
+    options.seed = args.seed ? *args.seed : scene.settings.seed;
+    options.heuristic = args.mis == "balance" ? MisHeuristic::Balance : MisHeuristic::Power;
+    if (args.radius) options.radius = *args.radius;
+    if (args.alpha) options.alpha = *args.alpha;
+    float* radii[4] = {&options.radiusPP3D, &options.radiusPB2D, &options.radiusBP2D,
+                       &options.radiusBB1D};
+    float* alphas[4] = {&options.alphaPP3D, &options.alphaPB2D, &options.alphaBP2D,
+                        &options.alphaBB1D};
+    for (int t = 0; t < 4; ++t) {
+        if (args.volumeRadius[t]) *radii[t] = *args.volumeRadius[t];
+        if (args.volumeAlpha[t]) *alphas[t] = *args.volumeAlpha[t];
+    }
+    if (!args.photonBeams.empty()) options.shortPhotonBeams = args.photonBeams == "short";
+    if (!args.queryBeams.empty()) options.shortQueryBeams = args.queryBeams == "short";
+    if (args.beamPaths) options.beamPaths = *args.beamPaths;
+    options.backend = args.backend;
+    options.clCache = args.clCache;
+    if (!args.clDevice.empty()) {
+        int p = -1, d = -1;
+        char tail = 0;
+        if (std::sscanf(args.clDevice.c_str(), "%d:%d%c", &p, &d, &tail) != 2 || p < 0 || d < 0)
+            throw UsageError(
+                "--cl-device: expected PLATFORM:DEVICE (two indices >= 0, as "
+                "'unibeam devices' lists them), got '" +
+                args.clDevice + "'");
+        options.clPlatform = p;
+        options.clDevice = d;
+    }
+    return options;
+}
 
 int runRender(const RenderArgs& args) {
     // ---- validate everything that does not need the scene ----
@@ -112,38 +151,7 @@ int runRender(const RenderArgs& args) {
     std::unique_ptr<Scene> scene = loadSceneFile(args.scene, args.defines);
     if (width > 0)
         scene->camera = scene->camera.resized(width, height, scene->settings.keepHorizontalFov);
-    RenderOptions options;
-    options.algorithm = args.algorithm;
-    options.maxPathLength = args.maxLength ? *args.maxLength : scene->settings.maxPathLength;
-    options.minPathLength = scene->settings.minPathLength;
-    options.seed = args.seed ? *args.seed : scene->settings.seed;
-    options.heuristic = args.mis == "balance" ? MisHeuristic::Balance : MisHeuristic::Power;
-    if (args.radius) options.radius = *args.radius;
-    if (args.alpha) options.alpha = *args.alpha;
-    float* radii[4] = {&options.radiusPP3D, &options.radiusPB2D, &options.radiusBP2D,
-                       &options.radiusBB1D};
-    float* alphas[4] = {&options.alphaPP3D, &options.alphaPB2D, &options.alphaBP2D,
-                        &options.alphaBB1D};
-    for (int t = 0; t < 4; ++t) {
-        if (args.volumeRadius[t]) *radii[t] = *args.volumeRadius[t];
-        if (args.volumeAlpha[t]) *alphas[t] = *args.volumeAlpha[t];
-    }
-    if (!args.photonBeams.empty()) options.shortPhotonBeams = args.photonBeams == "short";
-    if (!args.queryBeams.empty()) options.shortQueryBeams = args.queryBeams == "short";
-    if (args.beamPaths) options.beamPaths = *args.beamPaths;
-    options.backend = args.backend;
-    options.clCache = args.clCache;
-    if (!args.clDevice.empty()) {
-        int p = -1, d = -1;
-        char tail = 0;
-        if (std::sscanf(args.clDevice.c_str(), "%d:%d%c", &p, &d, &tail) != 2 || p < 0 || d < 0)
-            throw UsageError(
-                "--cl-device: expected PLATFORM:DEVICE (two indices >= 0, as "
-                "'unibeam devices' lists them), got '" +
-                args.clDevice + "'");
-        options.clPlatform = p;
-        options.clDevice = d;
-    }
+    RenderOptions options = makeRenderOptions(args, *scene);
     std::unique_ptr<Integrator> integrator = makeIntegrator(*scene, options);
     if (!integrator->setupNote().empty())
         std::fprintf(stderr, "unibeam: %s\n", integrator->setupNote().c_str());
