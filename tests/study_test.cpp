@@ -115,6 +115,26 @@ TEST(Study, WritesCsvPlotAndAReportThatRendersInChromium) {
     fs::remove_all(dir);
 }
 
+// Every study scene of scenes/README.md gives the CSV, the plot and the report (tiny
+// budget: this checks that the study runs there, not what it finds).
+TEST(Study, RunsOnEveryStudyScene) {
+    const fs::path dir = tempDir("scenes");
+    for (const char* s : {"study-thin-fog.json", "study-dense-medium.json", "cornell-fog.json",
+                          "glass-medium-caustics.json", "cornell-smoke.json"}) {
+        const fs::path out = dir / s;
+        const std::string cmd = "'" + kBinary + "' study '" + std::string(UNIBEAM_SOURCE_DIR) +
+                                "/scenes/" + s +
+                                "' --techniques upbp:bpt+pp3d,upbp:bpt+bb1d --iterations 3 "
+                                "--resolution 16x16 --backend host --out '" +
+                                out.string() + "' >'" + (dir / "log.txt").string() + "' 2>&1";
+        ASSERT_EQ(runShell(cmd), 0) << s << ": " << readFile(dir / "log.txt");
+        for (const char* f : {"convergence.csv", "summary.csv", "convergence.png", "index.html",
+                              "upbp_bpt_pp3d.png", "upbp_bpt_bb1d.error.png"})
+            EXPECT_TRUE(fs::is_regular_file(out / f)) << s << ": " << f;
+    }
+    fs::remove_all(dir);
+}
+
 TEST(Study, BadOptionsExitTwo) {
     const fs::path dir = tempDir("bad");
     const std::string scene = std::string(UNIBEAM_SOURCE_DIR) + "/scenes/cornell-fog.json";

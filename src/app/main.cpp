@@ -202,11 +202,12 @@ int run(int argc, char** argv) {
         std::snprintf(def, sizeof(def), "%g", double(kDefaultRadius[t]));
         volumeRadiusOpt[t] =
             render
-                ->add_option(std::string("--radius-") + kTech[t], volumeRadius[t],
-                             std::string("upbp: initial ") + kTech[t] +
-                                 " radius as a fraction of the scene bounding sphere radius (> "
-                                 "0; default " +
-                                 def + ")")
+                ->add_option(
+                    std::string("--radius-") + kTech[t], volumeRadius[t],
+                    std::string("upbp: initial ") + kTech[t] +
+                        " radius as a fraction of the media's radius (docs/algorithms.md; > "
+                        "0; default " +
+                        def + ")")
                 ->check(positiveReal())
                 ->type_name("R");
         volumeAlphaOpt[t] = render
@@ -389,6 +390,19 @@ int run(int argc, char** argv) {
         ->check(CLI::IsMember({"opencl", "host", "auto"}));
     study->add_option("--threads", sa.render.threads, "Worker threads (default: all cores)")
         ->check(CLI::PositiveNumber);
+    float studyRadius[4] = {0, 0, 0, 0}, studySurfRadius = 0;
+    CLI::Option* studyRadiusOpt[4];
+    for (int t = 0; t < 4; ++t)
+        studyRadiusOpt[t] =
+            study
+                ->add_option(std::string("--radius-") + kTech[t], studyRadius[t],
+                             std::string("upbp: initial ") + kTech[t] + " radius, as for render")
+                ->check(positiveReal())
+                ->type_name("R");
+    auto* studySurfRadiusOpt =
+        study->add_option("--radius", studySurfRadius, "Surface merging radius, as for render")
+            ->check(positiveReal())
+            ->type_name("R");
 
     if (argc >= 2 && argv[1][0] != '-' && std::string(argv[1]) != "render" &&
         std::string(argv[1]) != "info" && std::string(argv[1]) != "compare" &&
@@ -443,6 +457,9 @@ int run(int argc, char** argv) {
                 if (!t.empty()) sa.techniques.push_back(t);
             if (studySeedOpt->count() > 0) sa.render.seed = studySeed;
             if (studyLengthOpt->count() > 0) sa.render.maxLength = studyMaxLength;
+            for (int t = 0; t < 4; ++t)
+                if (studyRadiusOpt[t]->count() > 0) sa.render.volumeRadius[t] = studyRadius[t];
+            if (studySurfRadiusOpt->count() > 0) sa.render.radius = studySurfRadius;
             return ub::app::runStudy(sa);
         }
     } catch (const ub::app::UsageError& e) {
