@@ -114,6 +114,12 @@ TEST(Cli, RenderWritesExrAndPngWithMetadata) {
     ASSERT_TRUE(pngSize(png, &w, &h));
     EXPECT_EQ(w, 32);
     EXPECT_EQ(h, 24);
+    // The contribution guard's counts (render/contribution_guard.h), zeros included.
+    EXPECT_EQ(meta["unibeam.rejected.pt"], "0");
+    EXPECT_EQ(meta["unibeam.rejected.film"], "0");
+    EXPECT_NE(r.err.find("unibeam: rejected contributions (NaN, Inf or negative): pt 0, film 0\n"),
+              std::string::npos)
+        << r.err;
     // Non-terminal stderr: plain progress lines, no carriage returns.
     EXPECT_NE(r.err.find("unibeam: iteration 2/2"), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find('\r'), std::string::npos);
@@ -130,6 +136,26 @@ TEST(Cli, RenderWritesExrAndPngWithMetadata) {
         ASSERT_TRUE(img1.pixels[i].x == img.pixels[i].x && img1.pixels[i].y == img.pixels[i].y &&
                     img1.pixels[i].z == img.pixels[i].z)
             << "pixel " << i;
+    fs::remove_all(dir);
+}
+
+// upbp: one rejection count per technique layer (and the film) on stderr and in the EXR.
+TEST(Cli, UpbpReportsRejectionsPerTechnique) {
+    const std::string scene = std::string(UNIBEAM_SOURCE_DIR) + "/scenes/cornell-fog.json";
+    fs::path dir = tempDir();
+    fs::path exr = dir / "upbp.exr";
+    RunResult r = runUnibeam(
+        {"render", scene, "-a", "upbp", "--resolution", "12x12", "-i", "1", "-o", exr.string()},
+        dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    ImageMetadata meta;
+    readExr(exr.string(), &meta);
+    std::string expected = "unibeam: rejected contributions (NaN, Inf or negative): ";
+    for (const char* t : {"bpt", "surf", "pp3d", "pb2d", "bp2d", "bb1d", "film"}) {
+        EXPECT_EQ(meta[std::string("unibeam.rejected.") + t], "0") << t;
+        expected += std::string(t) + " 0" + (std::string(t) == "film" ? "\n" : ", ");
+    }
+    EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
     fs::remove_all(dir);
 }
 

@@ -456,6 +456,7 @@ class CountingIntegrator : public Integrator {
         for (auto& p : out.pixels) p = Rgb(float(iteration));
         if (stopAfterFirst) stopAfterFirst->store(true);
     }
+    RejectionCounts rejectedContributions() const override { return {{"counting", 0}}; }
 };
 
 TEST(Progressive, StopsAtIterationCountAndAverages) {

@@ -194,6 +194,7 @@ int runRender(const RenderArgs& args) {
         for (const auto& l : result.layers) names += (names.empty() ? "" : ",") + l.first;
         meta["layers"] = names;
     }
+    for (const auto& [key, value] : rejectionAttributes(result.rejected)) meta[key] = value;
     if (!exrPath.empty()) {
         writeExr(exrPath, result.image, meta, result.layers);
         std::fprintf(stderr, "unibeam: wrote %s\n", exrPath.c_str());
@@ -234,6 +235,9 @@ int runRender(const RenderArgs& args) {
         }
         std::fprintf(stderr, "unibeam: technique shares of the image: %s\n", shares.c_str());
     }
+    // Always printed, zeros included (docs/cli.md, "Rejected contributions").
+    std::fprintf(stderr, "unibeam: rejected contributions (NaN, Inf or negative): %s\n",
+                 formatRejections(result.rejected).c_str());
     const std::string summary = integrator->iterationSummary();
     if (!summary.empty()) std::fprintf(stderr, "unibeam: %s\n", summary.c_str());
     std::fprintf(stderr, "unibeam: %d iterations in %s (%.3f s/iteration)\n", result.iterations,

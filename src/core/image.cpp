@@ -185,6 +185,27 @@ Image readPng(const std::string& path, bool linearize) {
     height = int(h64);
     bitDepth = png_get_bit_depth(png, info);
     const int colorType = png_get_color_type(png, info);
+    // The pixels are deflate-compressed, which shrinks data at most 1032:1: a header whose
+    // pixels cannot fit in the rest of the file is rejected before the image is allocated
+    // (found by fuzz_png_image: a few hundred bytes made readPng allocate gigabytes).
+    {
+        std::error_code ec;
+        const uintmax_t fileBytes = std::filesystem::file_size(path, ec);
+        const int channels = png_get_channels(png, info);
+        const uint64_t rawBytes =
+            (uint64_t(w64) * uint64_t(channels) * uint64_t(bitDepth) + 7) / 8 * uint64_t(h64) +
+            uint64_t(h64);  // one filter byte per row
+        if (!ec && rawBytes > uint64_t(fileBytes) * 1032 + 4096) {
+            png_destroy_read_struct(&png, &info, nullptr);
+            std::fclose(fp);
+            throw InputError(
+                path, "corrupt PNG image: " + std::to_string(w64) + " x " + std::to_string(h64) +
+                          " pixels need " + std::to_string(rawBytes) +
+                          " bytes of image data, more than the " + std::to_string(fileBytes) +
+                          " bytes of the file can hold (expected the image data "
+                          "of every pixel the header announces)");
+        }
+    }
     // Normalise to 8/16-bit RGB without alpha.
     if (colorType == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
     if (colorType == PNG_COLOR_TYPE_GRAY && bitDepth < 8) png_set_expand_gray_1_2_4_to_8(png);

@@ -48,6 +48,7 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
                     VolumeEstimateStats* stats) {
     VolumeEstimateStats local;
     VolumeEstimateStats& st = stats ? *stats : local;
+    for (uint64_t& n : st.rejected) n = 0;
     st = VolumeEstimateStats();
     const UpbpTechniques& t = in.techniques;
     const std::vector<ub_photon_point>& photons = *in.photonPoints;
@@ -172,9 +173,10 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     }
     st.estimateSeconds = secondsSince(t0);
 
-    // Accumulate in query order (deterministic).
+    // Accumulate in query order (deterministic), each estimate through its technique's guard.
     const int width = image->width;
-    auto add = [&](uint32_t pixel, int tech, const Rgb& v) {
+    auto add = [&](uint32_t pixel, int tech, Rgb v) {
+        if (!in.guards[tech].filter(pixel, &v, &st.rejected[tech])) return;
         const int x = int(pixel % uint32_t(width)), y = int(pixel / uint32_t(width));
         image->at(x, y) += v;
         if (layers) (*layers)[size_t(tech)].at(x, y) += v;

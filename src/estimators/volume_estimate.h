@@ -33,6 +33,7 @@
 #include "core/image.h"
 #include "kernels/shared/ub_bvh.h"
 #include "kernels/shared/ub_upbp_records.h"
+#include "render/contribution_guard.h"
 #include "render/upbp_techniques.h"
 
 namespace ub {
@@ -53,6 +54,9 @@ struct VolumeEstimateInput {
     const std::vector<ub_query_point>* queryPoints = nullptr;
     const std::vector<ub_beam>* queryBeams = nullptr;
     ClRuntime* cl = nullptr;  ///< the OpenCL backend (kernels for what it has), or host only
+    /// Contribution guards per technique (UB_TECH_*; render/contribution_guard.h): each
+    /// query's estimate passes its technique's guard before it is added to its pixel.
+    ContributionGuard guards[4];
 };
 
 /// Per-iteration counts and times of the estimate pass.
@@ -63,6 +67,8 @@ struct VolumeEstimateStats {
     static constexpr size_t kNotCounted = ~size_t(0);
     double buildSeconds = 0, estimateSeconds = 0;
     size_t lookupBytes = 0;
+    /// Query estimates dropped by the guard (NaN, infinite or negative), per technique.
+    uint64_t rejected[4] = {0, 0, 0, 0};
 };
 
 /// Adds every enabled volumetric technique's estimate to its query's pixel of `image` (and

@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <atomic>
 #include <stdexcept>
 
 namespace ub {
@@ -11,22 +12,32 @@ void Film::reset(int width, int height) {
     width_ = width;
     height_ = height;
     iterations_ = 0;
+    rejected_ = 0;
     sum_.assign(size_t(width) * size_t(height) * 3, 0.0);
 }
 
 void Film::addIteration(const Image& iteration) {
     if (iteration.width != width_ || iteration.height != height_)
         throw std::logic_error("Film::addIteration: image size differs from the film size");
-    // Each pixel is summed by one task, in iteration order: deterministic.
+    // Each pixel is summed by one task, in iteration order: deterministic. The rejection count
+    // is an integer sum, so it does not depend on the partition either.
+    std::atomic<uint64_t> rejected{0};
     tbb::parallel_for(tbb::blocked_range<size_t>(0, iteration.pixels.size(), 4096),
                       [&](const tbb::blocked_range<size_t>& r) {
+                          uint64_t bad = 0;
                           for (size_t i = r.begin(); i != r.end(); ++i) {
                               const Rgb& p = iteration.pixels[i];
+                              if (!isValidContribution(p)) {
+                                  ++bad;
+                                  continue;
+                              }
                               sum_[3 * i + 0] += p.x;
                               sum_[3 * i + 1] += p.y;
                               sum_[3 * i + 2] += p.z;
                           }
+                          if (bad) rejected += bad;
                       });
+    rejected_ += rejected.load();
     ++iterations_;
 }
 
@@ -40,18 +51,22 @@ Image Film::average() const {
     return img;
 }
 
-void SplatBuffer::reset(int width, int height) {
+void SplatBuffer::reset(int width, int height, const ContributionGuard& guard) {
     width_ = width;
     height_ = height;
     chunks_.assign(kChunkCount, Chunk());
     for (auto& c : chunks_) {
         c.width_ = width;
         c.height_ = height;
+        c.guard_ = guard;
     }
 }
 
 void SplatBuffer::clear() {
-    for (auto& c : chunks_) c.splats_.clear();
+    for (auto& c : chunks_) {
+        c.splats_.clear();
+        c.rejected_ = 0;
+    }
 }
 
 std::pair<size_t, size_t> SplatBuffer::chunkRange(int chunk, size_t pathCount) {
@@ -80,6 +95,12 @@ void SplatBuffer::resolve(Image& image) const {
 size_t SplatBuffer::splatCount() const {
     size_t n = 0;
     for (const auto& c : chunks_) n += c.splats_.size();
+    return n;
+}
+
+uint64_t SplatBuffer::rejectedCount() const {
+    uint64_t n = 0;
+    for (const auto& c : chunks_) n += c.rejected_;
     return n;
 }
 

@@ -28,6 +28,10 @@
 //         for (size_t i = begin; i < end; ++i) { ... chunk.add(raster, value); ... }
 //     });
 //     splats.resolve(image);   // image += splats, in a fixed order
+//
+// Both are guarded (render/contribution_guard.h): a splat that is NaN, infinite or negative is
+// dropped and counted by its chunk (rejectedCount(), the chunks' counts summed), and
+// Film::addIteration drops and counts every such pixel of an iteration (rejected()).
 #pragma once
 
 #include <cstddef>
@@ -37,6 +41,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "render/contribution_guard.h"
 
 namespace ub {
 
@@ -46,8 +51,11 @@ class Film {
     Film(int width, int height) { reset(width, height); }
     void reset(int width, int height);
 
-    /// Adds one iteration's image (must have the film's size).
+    /// Adds one iteration's image (must have the film's size). A pixel with a NaN, infinite
+    /// or negative channel adds nothing and is counted in rejected().
     void addIteration(const Image& iteration);
+    /// Pixels of the added iterations rejected by the guard.
+    uint64_t rejected() const { return rejected_; }
     /// Average of the iterations added so far (black if none).
     Image average() const;
     int iterations() const { return iterations_; }
@@ -57,6 +65,7 @@ class Film {
   private:
     int width_ = 0, height_ = 0;
     int iterations_ = 0;
+    uint64_t rejected_ = 0;
     std::vector<double> sum_;  ///< 3 per pixel
 };
 
@@ -74,29 +83,36 @@ class SplatBuffer {
     class Chunk {
       public:
         /// Adds value to the pixel containing raster position (x right, y down); positions
-        /// outside the image are ignored.
+        /// outside the image are ignored. A NaN, infinite or negative value is dropped and
+        /// counted (rejected()).
         void add(const Vec2& raster, const Rgb& value) {
             if (!(raster.x >= 0 && raster.y >= 0)) return;  // also rejects NaN
             int x = int(raster.x), y = int(raster.y);
             if (x >= width_ || y >= height_) return;
-            splats_.push_back({uint32_t(y) * uint32_t(width_) + uint32_t(x), value});
+            addPixel(x, y, value);
         }
-        /// Adds value to pixel (x, y) (must be inside the image).
-        void addPixel(int x, int y, const Rgb& value) {
-            splats_.push_back({uint32_t(y) * uint32_t(width_) + uint32_t(x), value});
+        /// Adds value to pixel (x, y) (must be inside the image); guarded like add().
+        void addPixel(int x, int y, Rgb value) {
+            const uint32_t pixel = uint32_t(y) * uint32_t(width_) + uint32_t(x);
+            if (guard_.filter(pixel, &value, &rejected_)) splats_.push_back({pixel, value});
         }
         size_t size() const { return splats_.size(); }
+        /// Splats rejected by the guard since the last clear().
+        uint64_t rejected() const { return rejected_; }
 
       private:
         friend class SplatBuffer;
         int width_ = 0, height_ = 0;
+        uint64_t rejected_ = 0;
+        ContributionGuard guard_;
         std::vector<Splat> splats_;
     };
 
     SplatBuffer() = default;
     SplatBuffer(int width, int height) { reset(width, height); }
-    void reset(int width, int height);
-    /// Empties every chunk (keeps the allocations).
+    /// guard: the technique's guard (fault injection in tests; default: none).
+    void reset(int width, int height, const ContributionGuard& guard = ContributionGuard());
+    /// Empties every chunk (keeps the allocations) and zeroes the rejection counts.
     void clear();
 
     /// Index range [begin, end) of the paths that chunk `chunk` traces.
@@ -110,6 +126,8 @@ class SplatBuffer {
     void resolve(Image& image) const;
     /// Total number of splats recorded since clear().
     size_t splatCount() const;
+    /// Splats rejected by the guard since clear() (the chunks' counts, summed).
+    uint64_t rejectedCount() const;
 
   private:
     int width_ = 0, height_ = 0;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "render/contribution_guard.h"
 #include "scene/scene.h"
 
 namespace ub {
@@ -45,6 +46,9 @@ struct RenderOptions {
     std::string backend = "host";
     int clPlatform = -1, clDevice = -1;  ///< OpenCL device (-1, -1: the first one)
     std::string clCache;  ///< OpenCL program cache folder ("": the user's cache, "-": none)
+    /// Tests only (never set by the command-line program): makes one technique's contributions
+    /// invalid for some pixels, to check the contribution guard (render/contribution_guard.h).
+    ContributionFault testFault;
 };
 
 class Integrator {
@@ -60,6 +64,10 @@ class Integrator {
     virtual const std::vector<Image>* iterationLayers() const { return nullptr; }
     /// One line about the last iteration's work (counts of records etc.), or empty.
     virtual std::string iterationSummary() const { return ""; }
+    /// Contributions dropped by the guard (render/contribution_guard.h) in the iterations
+    /// rendered so far, per technique: every technique the integrator runs, zeros included,
+    /// in a fixed order (the -a algorithm, or UPBP's layer names).
+    virtual RejectionCounts rejectedContributions() const = 0;
     /// One line about how the integrator was set up (UPBP: where its estimate pass runs).
     virtual std::string setupNote() const { return ""; }
 };

@@ -74,7 +74,10 @@ ProgressiveResult renderProgressive(Integrator& integrator, int width, int heigh
         if (options.computeVariance) {
             for (size_t i = 0; i < iterationImage.pixels.size(); ++i)
                 for (int c = 0; c < 3; ++c) {
-                    const double x = iterationImage.pixels[i][c];
+                    // What the film adds: nothing for a pixel it rejects.
+                    const double x = isValidContribution(iterationImage.pixels[i])
+                                         ? double(iterationImage.pixels[i][c])
+                                         : 0.0;
                     double& mean = wMean[i * 3 + c];
                     const double delta = x - mean;
                     mean += delta / double(it + 1);
@@ -99,6 +102,10 @@ ProgressiveResult renderProgressive(Integrator& integrator, int width, int heigh
             options.progress(info);
         }
     }
+    result.rejected = integrator.rejectedContributions();
+    uint64_t filmRejected = film.rejected();
+    for (const Film& f : layerFilms) filmRejected += f.rejected();
+    result.rejected.emplace_back("film", filmRejected);
     result.iterations = film.iterations();
     result.seconds = elapsed();
     result.image = film.average();

@@ -57,6 +57,10 @@ struct ProgressiveResult {
     Image variance;
     /// The integrator's per-technique layers (Integrator::layerNames), averaged like image.
     std::vector<std::pair<std::string, Image>> layers;
+    /// Contributions dropped by the guard (render/contribution_guard.h): the integrator's
+    /// techniques (Integrator::rejectedContributions), then "film", the pixels of iteration
+    /// images (beauty and layers) the films dropped.
+    RejectionCounts rejected;
     int iterations = 0;
     double seconds = 0;        ///< wall-clock time of the iterations
     bool interrupted = false;  ///< stopped by the stop flag before the target was reached

@@ -26,6 +26,7 @@ uint64_t PtRayLog::shadowCount() const {
 
 PathTracer::PathTracer(const Scene& scene, const RenderOptions& options, PtStrategy strategy)
     : scene_(scene), options_(options), strategy_(strategy) {
+    guard_ = ContributionGuard(options.algorithm, options.testFault);
     misBeta_ = options.heuristic == MisHeuristic::Balance ? 1.0f : 2.0f;
     lightPickProb_ = scene.lights.empty() ? 0.0f : 1.0f / float(scene.lights.size());
 }
@@ -39,10 +40,19 @@ void PathTracer::renderIteration(int iteration, Image& out) {
     }
     // One task per block of rows; each pixel has its own random stream, so the
     // partitioning cannot change the result.
+    // Every pixel estimate passes the contribution guard; rejections are counted per row and
+    // summed in row order.
+    rowRejected_.assign(size_t(height), 0);
     tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
         for (int y = r.begin(); y != r.end(); ++y)
-            for (int x = 0; x < width; ++x) out.at(x, y) = tracePixel(x, y, iteration);
+            for (int x = 0; x < width; ++x) {
+                Rgb v = tracePixel(x, y, iteration);
+                guard_.filter(uint32_t(y) * uint32_t(width) + uint32_t(x), &v,
+                              &rowRejected_[size_t(y)]);
+                out.at(x, y) = v;
+            }
     });
+    for (uint64_t n : rowRejected_) rejected_ += n;
 }
 
 namespace {
@@ -189,6 +199,10 @@ Rgb PathTracer::tracePixel(int x, int y, int iteration) const {
 
 std::unique_ptr<Integrator> makePathTracer(const Scene& scene, const RenderOptions& options) {
     return std::make_unique<PathTracer>(scene, options);
+}
+
+RejectionCounts PathTracer::rejectedContributions() const {
+    return {{options_.algorithm, rejected_}};
 }
 
 }  // namespace ub

@@ -72,6 +72,8 @@ class PathTracer : public Integrator {
     /// Radiance estimate of one camera path through a random point of pixel (x, y) in
     /// iteration `iteration`.
     Rgb tracePixel(int x, int y, int iteration) const;
+    /// Technique options.algorithm: pixel estimates dropped by the guard.
+    RejectionCounts rejectedContributions() const override;
 
   private:
     const Scene& scene_;
@@ -80,6 +82,9 @@ class PathTracer : public Integrator {
     float misBeta_;        ///< 2 power heuristic, 1 balance heuristic
     float lightPickProb_;  ///< 1 / #lights (0 without lights)
     PtRayLog* rayLog_ = nullptr;
+    ContributionGuard guard_;
+    std::vector<uint64_t> rowRejected_;  ///< per row, the last iteration
+    uint64_t rejected_ = 0;              ///< all iterations
 };
 
 std::unique_ptr<Integrator> makePathTracer(const Scene& scene, const RenderOptions& options);

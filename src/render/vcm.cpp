@@ -198,7 +198,23 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
     }
     baseRadius_ = options.radius * (options.radiusIsRelative ? scene.sceneSphere.radius : 1.0f);
     lightPickProb_ = scene.lights.empty() ? 0.0f : 1.0f / float(scene.lights.size());
-    splats_.reset(scene.camera.width(), scene.camera.height());
+    techniques_ = layerNames_.empty() ? std::vector<std::string>{options.algorithm} : layerNames_;
+    for (const std::string& t : techniques_) guards_.emplace_back(t, options.testFault);
+    rejected_.assign(techniques_.size(), 0);
+    const char* volumeNames[4] = {"pp3d", "pb2d", "bp2d", "bb1d"};
+    for (size_t i = 0; i < layerNames_.size(); ++i) {
+        if (layerNames_[i] == "surf") surfTechnique_ = int(i);
+        for (int t = 0; t < 4; ++t)
+            if (layerNames_[i] == volumeNames[t]) volumeTechnique_[t] = int(i);
+    }
+    splats_.reset(scene.camera.width(), scene.camera.height(), guards_[0]);
+}
+
+RejectionCounts VertexCM::rejectedContributions() const {
+    RejectionCounts counts;
+    for (size_t i = 0; i < techniques_.size(); ++i)
+        counts.emplace_back(techniques_[i], rejected_[i]);
+    return counts;
 }
 
 VertexCM::~VertexCM() = default;
@@ -284,10 +300,16 @@ void VertexCM::renderIteration(int iteration, Image& out) {
             CameraRecords& rec = cameraRows_[size_t(y)];
             rec.points.clear();
             rec.beams.clear();
+            rec.rejected = 0;
             if (layered && useVM_) rec.surf.assign(size_t(width), Rgb(0.0f));
-            for (int x = 0; x < width; ++x) out.at(x, y) = traceCameraPath(x, y, iteration, &rec);
+            for (int x = 0; x < width; ++x) {
+                Rgb c = traceCameraPath(x, y, iteration, &rec);
+                guards_[0].filter(uint32_t(y) * uint32_t(width) + uint32_t(x), &c, &rec.rejected);
+                out.at(x, y) = c;
+            }
         }
     });
+    for (const CameraRecords& rec : cameraRows_) rejected_[0] += rec.rejected;
 
     // (4) Light-tracing splats, added in a fixed order. UPBP layers: the camera pass without
     // surface merging plus the splats is the first layer, surface merging its own.
@@ -306,16 +328,22 @@ void VertexCM::renderIteration(int iteration, Image& out) {
         const bool on[4] = {upbp_.pp3d, upbp_.pb2d, upbp_.bp2d, upbp_.bb1d};
         for (int t = 0; t < 4; ++t)
             if (on[t]) volumeLayers[t] = &layers_[next++];
-        if (surf)
+        if (surf) {
+            const ContributionGuard& guard = guards_[size_t(surfTechnique_)];
+            uint64_t& rejected = rejected_[size_t(surfTechnique_)];
             for (int y = 0; y < height; ++y)
                 for (int x = 0; x < width; ++x) {
-                    const Rgb m = cameraRows_[size_t(y)].surf[size_t(x)];
+                    Rgb m = cameraRows_[size_t(y)].surf[size_t(x)];
+                    if (!guard.filter(uint32_t(y) * uint32_t(width) + uint32_t(x), &m, &rejected))
+                        continue;
                     surf->at(x, y) = m;
                     out.at(x, y) += m;
                 }
+        }
     } else {
         splats_.resolve(out);
     }
+    rejected_[0] += splats_.rejectedCount();
 
     // (5) UPBP estimate pass: the volumetric estimators over the recorded queries, added to
     // their pixels in query order (estimators/volume_estimate.h).
@@ -340,6 +368,8 @@ void VertexCM::renderIteration(int iteration, Image& out) {
         in.queryPoints = &queryPoints_;
         in.queryBeams = &queryBeams_;
         in.cl = cl_.get();
+        for (int t = 0; t < 4; ++t)
+            if (volumeTechnique_[t] >= 0) in.guards[t] = guards_[size_t(volumeTechnique_[t])];
         std::array<Image, 4> perTech;
         if (layered)
             for (int t = 0; t < 4; ++t)
@@ -349,6 +379,8 @@ void VertexCM::renderIteration(int iteration, Image& out) {
         for (int t = 0; t < 4; ++t) {
             if (volumeLayers[t]) *volumeLayers[t] = std::move(perTech[size_t(t)]);
             lastPairs_[t] = stats.pairs[t];
+            if (volumeTechnique_[t] >= 0)
+                rejected_[size_t(volumeTechnique_[t])] += stats.rejected[t];
         }
         lastBuildSeconds_ = stats.buildSeconds;
         lastEstimateSeconds_ = stats.estimateSeconds;

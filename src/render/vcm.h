@@ -89,6 +89,8 @@ class VertexCM : public Integrator {
         return layerNames_.empty() ? nullptr : &layers_;
     }
     std::string iterationSummary() const override;
+    /// Techniques: UPBP's layer names, else the algorithm (render/contribution_guard.h).
+    RejectionCounts rejectedContributions() const override;
     /// Where the estimate pass runs, in words (UPBP; empty otherwise).
     std::string setupNote() const override { return backendNote_; }
 
@@ -176,6 +178,7 @@ class VertexCM : public Integrator {
         std::vector<ub_query_point> points;
         std::vector<ub_beam> beams;
         std::vector<Rgb> surf;  ///< UPBP layers: surface merging per pixel of the row
+        uint64_t rejected = 0;  ///< camera-pass pixel estimates dropped by the guard
     };
 
     // Light pass (vcm_light.cpp): traces light subpaths [begin, end) of an iteration.
@@ -238,6 +241,13 @@ class VertexCM : public Integrator {
     double lastBuildSeconds_ = 0, lastEstimateSeconds_ = 0;
     size_t lastPairs_[4] = {0, 0, 0, 0};
     SplatBuffer splats_;
+    // Contribution guard (render/contribution_guard.h): technique 0 is the camera pass and the
+    // light-tracing splats (the algorithm, or UPBP's first layer), then UPBP's other layers.
+    std::vector<std::string> techniques_;
+    std::vector<ContributionGuard> guards_;      ///< per technique
+    std::vector<uint64_t> rejected_;             ///< per technique, all iterations
+    int surfTechnique_ = -1;                     ///< UPBP layers: index of "surf"
+    int volumeTechnique_[4] = {-1, -1, -1, -1};  ///< UB_TECH_* -> technique index
 };
 
 /// Russian-roulette continuation probability of the bidirectional engine at a vertex with

@@ -38,6 +38,7 @@ float maxAlbedo(const MediumCoefficients& c) {
 
 VolPathTracer::VolPathTracer(const Scene& scene, const RenderOptions& options)
     : scene_(scene), options_(options) {
+    guard_ = ContributionGuard(options.algorithm, options.testFault);
     misBeta_ = options.heuristic == MisHeuristic::Balance ? 1.0f : 2.0f;
     lightPickProb_ = scene.lights.empty() ? 0.0f : 1.0f / float(scene.lights.size());
 }
@@ -45,10 +46,19 @@ VolPathTracer::VolPathTracer(const Scene& scene, const RenderOptions& options)
 void VolPathTracer::renderIteration(int iteration, Image& out) {
     const int width = scene_.camera.width(), height = scene_.camera.height();
     if (out.width != width || out.height != height) out = Image(width, height);
+    // Every pixel estimate passes the contribution guard; rejections are counted per row and
+    // summed in row order.
+    rowRejected_.assign(size_t(height), 0);
     tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
         for (int y = r.begin(); y != r.end(); ++y)
-            for (int x = 0; x < width; ++x) out.at(x, y) = tracePixel(x, y, iteration);
+            for (int x = 0; x < width; ++x) {
+                Rgb v = tracePixel(x, y, iteration);
+                guard_.filter(uint32_t(y) * uint32_t(width) + uint32_t(x), &v,
+                              &rowRejected_[size_t(y)]);
+                out.at(x, y) = v;
+            }
     });
+    for (uint64_t n : rowRejected_) rejected_ += n;
 }
 
 Rgb VolPathTracer::tracePixel(int x, int y, int iteration) const {
@@ -260,6 +270,10 @@ Rgb VolPathTracer::tracePixel(int x, int y, int iteration) const {
 
 std::unique_ptr<Integrator> makeVolPathTracer(const Scene& scene, const RenderOptions& options) {
     return std::make_unique<VolPathTracer>(scene, options);
+}
+
+RejectionCounts VolPathTracer::rejectedContributions() const {
+    return {{options_.algorithm, rejected_}};
 }
 
 }  // namespace ub

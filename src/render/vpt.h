@@ -50,7 +50,9 @@
 // Rng::forPath(seed, i, y * width + x); rows are rendered in parallel.
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "render/integrator.h"
 
@@ -62,12 +64,17 @@ class VolPathTracer : public Integrator {
     void renderIteration(int iteration, Image& out) override;
     /// Radiance estimate of one camera path through a random point of pixel (x, y).
     Rgb tracePixel(int x, int y, int iteration) const;
+    /// Technique options.algorithm: pixel estimates dropped by the guard.
+    RejectionCounts rejectedContributions() const override;
 
   private:
     const Scene& scene_;
     RenderOptions options_;
     float misBeta_;        ///< 2 power heuristic, 1 balance heuristic
     float lightPickProb_;  ///< 1 / #lights (0 without lights)
+    ContributionGuard guard_;
+    std::vector<uint64_t> rowRejected_;  ///< per row, the last iteration
+    uint64_t rejected_ = 0;              ///< all iterations
 };
 
 std::unique_ptr<Integrator> makeVolPathTracer(const Scene& scene, const RenderOptions& options);
