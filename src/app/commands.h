@@ -47,6 +47,9 @@ struct RenderArgs {
     std::string clCache;                         ///< --cl-cache DIR
     std::map<std::string, std::string> defines;  ///< -D name=value (Mitsuba XML parameters)
     std::string variancePath;                    ///< --variance: per-iteration variance EXR
+    std::string checkpointPath;                  ///< --checkpoint FILE
+    double checkpointEvery = 60;                 ///< --checkpoint-every SECONDS
+    std::string resumePath;                      ///< --resume FILE
 };
 
 struct CompareArgs {

@@ -268,6 +268,22 @@ int run(int argc, char** argv) {
                      "Also write the per-pixel sample variance of one iteration (OpenEXR; needs "
                      ">= 2 iterations; divide by the iteration count for the mean's variance)")
         ->type_name("FILE.exr");
+    render
+        ->add_option("--checkpoint", ra.checkpointPath,
+                     "Write the render's state to FILE every --checkpoint-every seconds and at "
+                     "the end (atomically), so --resume FILE can continue it")
+        ->type_name("FILE");
+    render
+        ->add_option("--checkpoint-every", ra.checkpointEvery,
+                     "Seconds between checkpoints (default 60)")
+        ->check(positiveReal())
+        ->type_name("SECONDS");
+    render
+        ->add_option("--resume", ra.resumePath,
+                     "Continue the render saved in FILE (same scene and options; -i / -t count "
+                     "the iterations and seconds already done); checkpoints go on into FILE "
+                     "unless --checkpoint names another")
+        ->type_name("FILE");
 
     // ---- info ----
     std::string infoScene;

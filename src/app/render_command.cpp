@@ -15,6 +15,7 @@
 #include "app/scene_access.h"
 #include "core/error.h"
 #include "core/image.h"
+#include "render/checkpoint.h"
 #include "render/integrator.h"
 #include "render/progressive.h"
 #include "render/upbp_techniques.h"
@@ -33,7 +34,7 @@ std::string lower(std::string s) {
 /// Throws UsageError unless `path` has extension `ext` and can be created or overwritten.
 void checkOutputPath(const std::string& path, const std::string& ext, const std::string& flag) {
     fs::path p(path);
-    if (lower(p.extension().string()) != ext)
+    if (!ext.empty() && lower(p.extension().string()) != ext)
         throw UsageError(flag + ": output file '" + path + "' must end in " + ext);
     fs::path dir = p.parent_path();
     if (dir.empty()) dir = ".";
@@ -48,6 +49,30 @@ void checkOutputPath(const std::string& path, const std::string& ext, const std:
                          "' is not writable");
     if (fs::exists(p, ec) && ::access(p.c_str(), W_OK) != 0)
         throw UsageError(flag + ": cannot write '" + path + "': file is not writable");
+}
+
+/// The options that affect the image, one "key=value" line each (checkpoint.h): a resumed
+/// render must have the same. Iteration counts, time limits, threads, outputs and the
+/// backend (host and OpenCL agree to float rounding only) are left out, except the backend,
+/// which is kept because the two differ in the last bits.
+std::string imageOptionsText(const RenderOptions& o, const RenderArgs& args, const Scene& scene) {
+    std::ostringstream t;
+    t.precision(9);
+    t << "algorithm=" << o.algorithm << "\nresolution=" << scene.camera.width() << "x"
+      << scene.camera.height() << "\nmaxPathLength=" << o.maxPathLength
+      << "\nminPathLength=" << o.minPathLength << "\nseed=" << o.seed
+      << "\nmis=" << (o.heuristic == MisHeuristic::Balance ? "balance" : "power")
+      << "\nradius=" << o.radius << "\nalpha=" << o.alpha << "\nradiusPP3D=" << o.radiusPP3D
+      << "\nradiusPB2D=" << o.radiusPB2D << "\nradiusBP2D=" << o.radiusBP2D
+      << "\nradiusBB1D=" << o.radiusBB1D << "\nalphaPP3D=" << o.alphaPP3D
+      << "\nalphaPB2D=" << o.alphaPB2D << "\nalphaBP2D=" << o.alphaBP2D
+      << "\nalphaBB1D=" << o.alphaBB1D
+      << "\nphotonBeams=" << (o.shortPhotonBeams ? "short" : "long")
+      << "\nqueryBeams=" << (o.shortQueryBeams ? "short" : "long") << "\nbeamPaths=" << o.beamPaths
+      << "\nbackend=" << o.backend << "\nvariance=" << (args.variancePath.empty() ? "no" : "yes")
+      << "\n";
+    for (const auto& [k, v] : args.defines) t << "define." << k << "=" << v << "\n";
+    return t.str();
 }
 
 }  // namespace
@@ -156,10 +181,37 @@ int runRender(const RenderArgs& args) {
     if (!integrator->setupNote().empty())
         std::fprintf(stderr, "unibeam: %s\n", integrator->setupNote().c_str());
 
+    // ---- checkpoints ----
+    const std::string checkpointPath =
+        !args.checkpointPath.empty() ? args.checkpointPath : args.resumePath;
+    CheckpointHeader header;
+    std::unique_ptr<ProgressiveState> resumed;
+    if (!checkpointPath.empty() || !args.resumePath.empty()) {
+        header.version = UNIBEAM_VERSION;
+        header.sceneDigest = digestFile(args.scene);
+        header.options = imageOptionsText(options, args, *scene);
+        header.width = uint32_t(scene->camera.width());
+        header.height = uint32_t(scene->camera.height());
+    }
+    if (!checkpointPath.empty()) checkOutputPath(checkpointPath, "", "--checkpoint");
+    if (!args.resumePath.empty()) {
+        if (!fs::is_regular_file(args.resumePath))
+            throw UsageError("--resume: checkpoint '" + args.resumePath + "' does not exist");
+        resumed = std::make_unique<ProgressiveState>(readCheckpoint(args.resumePath, header));
+        std::fprintf(stderr, "unibeam: resuming %s: %d iterations, %.1f s done\n",
+                     args.resumePath.c_str(), resumed->iterations, resumed->seconds);
+    }
     ProgressiveOptions prog;
     prog.iterations = args.iterations;
     prog.timeLimitSeconds = args.timeLimit;
     prog.computeVariance = !args.variancePath.empty();
+    prog.resume = resumed.get();
+    if (!checkpointPath.empty()) {
+        prog.checkpointEverySeconds = args.checkpointEvery;
+        prog.checkpoint = [&](const ProgressiveState& state) {
+            writeCheckpoint(checkpointPath, header, state);
+        };
+    }
     if (prog.iterations <= 0 && prog.timeLimitSeconds <= 0) prog.iterations = kDefaultIterations;
     ProgressBar bar(stderr, ::isatty(::fileno(stderr)) != 0);
     prog.progress = [&](const ProgressInfo& info) { bar.update(info); };

@@ -37,6 +37,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -59,6 +60,16 @@ class Film {
     /// Average of the iterations added so far (black if none).
     Image average() const;
     int iterations() const { return iterations_; }
+    /// The sums (3 per pixel, double) and the rejection count, for checkpoints.
+    const std::vector<double>& sums() const { return sum_; }
+    /// Continues from a checkpoint: `iterations` iterations whose sums are `sums`.
+    void restore(int iterations, const std::vector<double>& sums, uint64_t rejected) {
+        if (sums.size() != sum_.size())
+            throw std::logic_error("Film::restore: the sums do not have the film's size");
+        iterations_ = iterations;
+        sum_ = sums;
+        rejected_ = rejected;
+    }
     int width() const { return width_; }
     int height() const { return height_; }
 

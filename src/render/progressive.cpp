@@ -1,5 +1,6 @@
 #include "render/progressive.h"
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <stdexcept>
@@ -57,10 +58,66 @@ ProgressiveResult renderProgressive(Integrator& integrator, int width, int heigh
         wMean.assign(size_t(width) * height * 3, 0.0);
         wM2.assign(size_t(width) * height * 3, 0.0);
     }
-    for (int it = 0;; ++it) {
+    const ProgressiveState* resume = options.resume;
+    double secondsBefore = 0;
+    int firstIteration = 0;
+    if (resume) {
+        if (resume->layers.size() != layerFilms.size() ||
+            resume->hasVariance != options.computeVariance)
+            throw std::invalid_argument(
+                "renderProgressive: the checkpoint's layers or variance do not match the render");
+        for (size_t l = 0; l < layerFilms.size(); ++l) {
+            if (resume->layerNames[l] != layerNames[l])
+                throw std::invalid_argument("renderProgressive: checkpoint layer '" +
+                                            resume->layerNames[l] + "' is not '" + layerNames[l] +
+                                            "'");
+            layerFilms[l].restore(resume->iterations, resume->layers[l], resume->layerRejected[l]);
+        }
+        film.restore(resume->iterations, resume->film, resume->filmRejected);
+        if (options.computeVariance) {
+            wMean = resume->varianceMean;
+            wM2 = resume->varianceM2;
+        }
+        secondsBefore = resume->seconds;
+        firstIteration = resume->iterations;
+    }
+    auto totalSeconds = [&] { return secondsBefore + elapsed(); };
+    // The integrator's rejection counts, plus those of the checkpoint resumed from.
+    auto rejectedSoFar = [&] {
+        RejectionCounts counts = integrator.rejectedContributions();
+        if (resume)
+            for (const auto& [name, n] : resume->rejected) {
+                auto it = std::find_if(counts.begin(), counts.end(),
+                                       [&](const auto& c) { return c.first == name; });
+                if (it == counts.end())
+                    counts.emplace_back(name, n);
+                else
+                    it->second += n;
+            }
+        return counts;
+    };
+    auto makeState = [&] {
+        ProgressiveState st;
+        st.iterations = film.iterations();
+        st.seconds = totalSeconds();
+        st.film = film.sums();
+        st.filmRejected = film.rejected();
+        st.layerNames = layerNames;
+        for (const Film& f : layerFilms) {
+            st.layers.push_back(f.sums());
+            st.layerRejected.push_back(f.rejected());
+        }
+        st.hasVariance = options.computeVariance;
+        st.varianceMean = wMean;
+        st.varianceM2 = wM2;
+        st.rejected = rejectedSoFar();
+        return st;
+    };
+    double lastCheckpoint = 0;
+    for (int it = firstIteration;; ++it) {
         if (options.iterations > 0 && it >= options.iterations) break;
         if (it > 0) {
-            if (options.timeLimitSeconds > 0 && elapsed() >= options.timeLimitSeconds) break;
+            if (options.timeLimitSeconds > 0 && totalSeconds() >= options.timeLimitSeconds) break;
             if (stop.load(std::memory_order_relaxed)) {
                 result.interrupted = true;
                 break;
@@ -89,7 +146,7 @@ ProgressiveResult renderProgressive(Integrator& integrator, int width, int heigh
             ProgressInfo info;
             info.iteration = it + 1;
             info.targetIterations = std::max(0, options.iterations);
-            info.elapsedSeconds = elapsed();
+            info.elapsedSeconds = totalSeconds();
             info.timeLimitSeconds = std::max(0.0, options.timeLimitSeconds);
             double perIteration = info.elapsedSeconds / info.iteration;
             double eta = -1;
@@ -101,13 +158,19 @@ ProgressiveResult renderProgressive(Integrator& integrator, int width, int heigh
             info.etaSeconds = eta;
             options.progress(info);
         }
+        if (options.checkpoint && options.checkpointEverySeconds > 0 &&
+            elapsed() - lastCheckpoint >= options.checkpointEverySeconds) {
+            options.checkpoint(makeState());
+            lastCheckpoint = elapsed();
+        }
     }
-    result.rejected = integrator.rejectedContributions();
+    if (options.checkpoint) options.checkpoint(makeState());
+    result.rejected = rejectedSoFar();
     uint64_t filmRejected = film.rejected();
     for (const Film& f : layerFilms) filmRejected += f.rejected();
     result.rejected.emplace_back("film", filmRejected);
     result.iterations = film.iterations();
-    result.seconds = elapsed();
+    result.seconds = totalSeconds();
     result.image = film.average();
     for (size_t l = 0; l < layerFilms.size(); ++l)
         result.layers.emplace_back(layerNames[l], layerFilms[l].average());

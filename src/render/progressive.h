@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "render/checkpoint.h"
 #include "render/integrator.h"
 
 namespace ub {
@@ -47,6 +48,14 @@ struct ProgressiveOptions {
     const std::atomic<bool>* stop = nullptr;
     /// Also estimate the per-pixel variance of one iteration (ProgressiveResult::variance).
     bool computeVariance = false;
+    /// Continue from this state (render/checkpoint.h): its iterations count towards
+    /// `iterations`, its seconds towards `timeLimitSeconds`. Must match the render (size,
+    /// layers, variance), else std::invalid_argument.
+    const ProgressiveState* resume = nullptr;
+    /// Called with the accumulated state every checkpointEverySeconds (> 0) after an
+    /// iteration, and once at the end; on the calling thread.
+    double checkpointEverySeconds = 0;
+    std::function<void(const ProgressiveState&)> checkpoint;
 };
 
 struct ProgressiveResult {
