@@ -108,6 +108,28 @@ TEST(OpenClEstimate, Pp3dKernelEqualsHostTwinPerQuery) {
             nonzero += host[i][c] != 0.0f;
         }
     EXPECT_GT(nonzero, 300u);
+
+    // Batches: 256 queries each, and 2 launches failing with CL_OUT_OF_RESOURCES (each
+    // answered by halving the batch): the same results, bit for bit.
+    std::vector<Rgb> batched;
+    cl.setMaxBatchForTest(256);
+    cl.failLaunchesForTest(2);
+    const size_t before = cl.batches();
+    cl.estimatePP3D(photons, grid, queries, args, &batched);
+    EXPECT_EQ(cl.batchRetries(), 2u);
+    EXPECT_GT(cl.batches() - before, queries.size() / 256);
+    ASSERT_EQ(batched.size(), device.size());
+    for (size_t i = 0; i < device.size(); ++i)
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(batched[i][c], device[i][c]) << "query " << i;
+    // Out of resources even at the smallest batch: a clear error, not a hang.
+    cl.setMaxBatchForTest(64);
+    cl.failLaunchesForTest(1);
+    try {
+        cl.estimatePP3D(photons, grid, queries, args, &batched);
+        ADD_FAILURE() << "no error";
+    } catch (const ClError& e) {
+        EXPECT_NE(std::string(e.what()).find("out of resources"), std::string::npos) << e.what();
+    }
 }
 
 // A whole upbp iteration (all six techniques; homogeneous medium, so every volumetric

@@ -393,49 +393,125 @@ ClRuntime::Arg scalarArg(const T& v) {
 }
 }  // namespace
 
+namespace {
+
+bool outOfResources(cl_int err) {
+    return err == CL_OUT_OF_RESOURCES || err == CL_MEM_OBJECT_ALLOCATION_FAILURE ||
+           err == CL_OUT_OF_HOST_MEMORY;
+}
+
+struct MemList {
+    std::vector<cl_mem> mems;
+    ~MemList() { clear(); }
+    void clear() {
+        for (cl_mem m : mems) clReleaseMemObject(m);
+        mems.clear();
+    }
+};
+
+}  // namespace
+
 void ClRuntime::runEstimate(cl_kernel kernel, const char* name, const std::vector<Arg>& lookup,
                             const Arg& queries, size_t count, const EstimateArgs& a,
                             std::vector<Rgb>* out) {
     out->assign(count, Rgb(0.0f));
     if (count == 0) return;
-    const cl_uint n = cl_uint(count);
-    std::vector<Arg> args = lookup;
-    for (const Arg& x :
-         {queries, scalarArg(n), bufferArg(*a.media), scalarArg(a.mis), scalarArg(a.radius),
-          scalarArg(a.normalization), scalarArg(a.minLength), scalarArg(a.maxLength)})
-        args.push_back(x);
-    struct Buffers {
-        std::vector<cl_mem> mems;
-        ~Buffers() {
-            for (cl_mem m : mems) clReleaseMemObject(m);
-        }
-    } b;
-    cl_int err = CL_SUCCESS;
+    // The lookups (and the media) are uploaded once; the queries go in batches that fit the
+    // device's largest allocation and what its global memory leaves after the lookups. A
+    // launch, allocation or read-back that runs out of resources is retried with half the
+    // batch (down to 64 queries). Each query's result depends on that query alone, so the
+    // results do not depend on the batch size.
+    std::vector<Arg> fixed = lookup;
+    size_t lookupBytes = 0;
+    for (const Arg& x : lookup) {
+        if (!x.buffer) continue;
+        lookupBytes += x.bytes;
+        if (desc_.maxAllocBytes > 0 && x.bytes > desc_.maxAllocBytes)
+            throw ClError(std::string("OpenCL: ") + name + ": a lookup buffer needs " +
+                          std::to_string(x.bytes >> 20) +
+                          " MB, more than the device's largest "
+                          "allocation (" +
+                          std::to_string(desc_.maxAllocBytes >> 20) +
+                          " MB): a smaller --resolution or fewer --beam-paths need less");
+    }
+    if (desc_.globalMemBytes > 0 && lookupBytes > desc_.globalMemBytes)
+        throw ClError(std::string("OpenCL: ") + name + ": the lookups need " +
+                      std::to_string(lookupBytes >> 20) + " MB, more than the device's " +
+                      std::to_string(desc_.globalMemBytes >> 20) +
+                      " MB: a smaller --resolution or fewer --beam-paths need less");
+    MemList fixedMems;
     cl_uint index = 0;
-    for (const Arg& x : args) {
+    for (const Arg& x : fixed) {
         if (x.buffer) {
             cl_mem m = upload(context_, x.data, x.bytes);
-            b.mems.push_back(m);
+            fixedMems.mems.push_back(m);
             check(clSetKernelArg(kernel, index++, sizeof(cl_mem), &m), "clSetKernelArg");
         } else {
             check(clSetKernelArg(kernel, index++, x.bytes, x.data), "clSetKernelArg");
         }
     }
-    cl_mem res =
-        clCreateBuffer(context_, CL_MEM_WRITE_ONLY, count * 3 * sizeof(float), nullptr, &err);
-    check(err, "clCreateBuffer(results)");
-    b.mems.push_back(res);
-    check(clSetKernelArg(kernel, index++, sizeof(cl_mem), &res), "clSetKernelArg");
+    const cl_uint queryIndex = index++, countIndex = index++;
+    cl_mem media = upload(context_, a.media->data(), a.media->size() * sizeof(ub_medium_info));
+    fixedMems.mems.push_back(media);
+    check(clSetKernelArg(kernel, index++, sizeof(cl_mem), &media), "clSetKernelArg");
+    for (const Arg& x : {scalarArg(a.mis), scalarArg(a.radius), scalarArg(a.normalization),
+                         scalarArg(a.minLength), scalarArg(a.maxLength)})
+        check(clSetKernelArg(kernel, index++, x.bytes, x.data), "clSetKernelArg");
+    const cl_uint resultIndex = index++;
+
+    const size_t querySize = queries.bytes / count, perQuery = querySize + 3 * sizeof(float);
+    size_t batch = count;
+    if (maxBatchForTest_ > 0) batch = std::min(batch, maxBatchForTest_);
+    if (desc_.maxAllocBytes > 0) batch = std::min(batch, size_t(desc_.maxAllocBytes / perQuery));
+    if (desc_.globalMemBytes > lookupBytes)
+        batch = std::min(batch, size_t((desc_.globalMemBytes - lookupBytes) / 2 / perQuery));
+    batch = std::max<size_t>(batch, 1);
     const size_t local = 64;
-    const size_t global = (count + local - 1) / local * local;
-    check(clEnqueueNDRangeKernel(queue_, kernel, 1, nullptr, &global, &local, 0, nullptr, nullptr),
-          name);
-    std::vector<float> host(count * 3);
-    check(clEnqueueReadBuffer(queue_, res, CL_TRUE, 0, host.size() * sizeof(float), host.data(), 0,
-                              nullptr, nullptr),
-          "clEnqueueReadBuffer(results)");
-    for (size_t i = 0; i < count; ++i)
-        (*out)[i] = Rgb(host[3 * i], host[3 * i + 1], host[3 * i + 2]);
+    std::vector<float> host;
+    const char* base = static_cast<const char*>(queries.data);
+    for (size_t begin = 0; begin < count;) {
+        const size_t n = std::min(batch, count - begin);
+        MemList batchMems;
+        cl_int err = CL_SUCCESS;
+        const char* step = "clCreateBuffer(queries)";
+        cl_mem q = clCreateBuffer(context_, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, n * querySize,
+                                  const_cast<char*>(base + begin * querySize), &err);
+        if (err == CL_SUCCESS) {
+            batchMems.mems.push_back(q);
+            step = "clCreateBuffer(results)";
+            cl_mem res =
+                clCreateBuffer(context_, CL_MEM_WRITE_ONLY, n * 3 * sizeof(float), nullptr, &err);
+            if (err == CL_SUCCESS) {
+                batchMems.mems.push_back(res);
+                const cl_uint nq = cl_uint(n);
+                check(clSetKernelArg(kernel, queryIndex, sizeof(cl_mem), &q), "clSetKernelArg");
+                check(clSetKernelArg(kernel, countIndex, sizeof(nq), &nq), "clSetKernelArg");
+                check(clSetKernelArg(kernel, resultIndex, sizeof(cl_mem), &res), "clSetKernelArg");
+                const size_t global = (n + local - 1) / local * local;
+                step = name;
+                err = failLaunchesForTest_ > 0
+                          ? (--failLaunchesForTest_, CL_OUT_OF_RESOURCES)
+                          : clEnqueueNDRangeKernel(queue_, kernel, 1, nullptr, &global, &local, 0,
+                                                   nullptr, nullptr);
+                if (err == CL_SUCCESS) {
+                    host.resize(n * 3);
+                    step = "clEnqueueReadBuffer(results)";
+                    err = clEnqueueReadBuffer(queue_, res, CL_TRUE, 0, host.size() * sizeof(float),
+                                              host.data(), 0, nullptr, nullptr);
+                }
+            }
+        }
+        if (outOfResources(err) && batch > 64) {
+            batch = std::max<size_t>(64, batch / 2);  // retry this range in smaller batches
+            ++batchRetries_;
+            continue;
+        }
+        check(err, step);
+        for (size_t i = 0; i < n; ++i)
+            (*out)[begin + i] = Rgb(host[3 * i], host[3 * i + 1], host[3 * i + 2]);
+        begin += n;
+        ++batches_;
+    }
 }
 
 void ClRuntime::estimatePP3D(const std::vector<ub_photon_point>& photons, const HashGrid& grid,

@@ -3,6 +3,9 @@
 // the host twins compile; cmake/EmbedKernels.cmake; $UNIBEAM_KERNEL_DIR makes it read them
 // from a folder instead), the on-disk program cache, buffers and kernel launches.
 //
+// Queries go to the device in batches that fit its largest allocation and global memory;
+// running out of resources halves the batch and retries (runEstimate).
+//
 // Status: pp3d runs as a kernel (kernels/pp3d.cl) in every medium; pb2d, bp2d and bb1d
 // (kernels/beams.cl) in scenes whose media are all homogeneous, else on the host (the
 // regular tracking through NanoVDB grids along beams is not in kernels/shared yet).
@@ -93,6 +96,14 @@ class ClRuntime {
                       const Bvh& bvh, const std::vector<ub_beam>& queries, const EstimateArgs& a,
                       std::vector<Rgb>* out);
 
+    /// Batches launched so far, and retries with a smaller batch after the device ran out of
+    /// resources (runEstimate).
+    size_t batches() const { return batches_; }
+    size_t batchRetries() const { return batchRetries_; }
+    /// Tests: at most n queries per batch (0: the device's limits only), and make the next
+    /// k launches fail with CL_OUT_OF_RESOURCES.
+    void setMaxBatchForTest(size_t n) { maxBatchForTest_ = n; }
+    void failLaunchesForTest(int k) { failLaunchesForTest_ = k; }
     /// A kernel argument: host data uploaded as a buffer, or a scalar/struct by value.
     struct Arg {
         const void* data;
@@ -110,6 +121,8 @@ class ClRuntime {
     cl_command_queue queue_ = nullptr;
     cl_program program_ = nullptr;
     cl_kernel pp3d_ = nullptr, pb2d_ = nullptr, bp2d_ = nullptr, bb1d_ = nullptr;
+    size_t batches_ = 0, batchRetries_ = 0, maxBatchForTest_ = 0;
+    int failLaunchesForTest_ = 0;
     /// Runs estimate kernel `kernel` over `count` queries: its arguments are `lookup`, then
     /// the queries (a buffer), their count and the EstimateArgs tail, then the results, read
     /// back as 3 floats per query.
