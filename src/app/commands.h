@@ -50,6 +50,7 @@ struct RenderArgs {
     std::string checkpointPath;                  ///< --checkpoint FILE
     double checkpointEvery = 60;                 ///< --checkpoint-every SECONDS
     std::string resumePath;                      ///< --resume FILE
+    std::string maxMemory;                       ///< --max-memory SIZE (empty: half the RAM)
 };
 
 struct CompareArgs {

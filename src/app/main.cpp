@@ -18,6 +18,7 @@
 
 #include "app/commands.h"
 #include "core/error.h"
+#include "core/memory_budget.h"
 #include "render/integrator.h"
 
 namespace {
@@ -279,6 +280,12 @@ int run(int argc, char** argv) {
         ->check(positiveReal())
         ->type_name("SECONDS");
     render
+        ->add_option("--max-memory", ra.maxMemory,
+                     "Bound on the per-iteration records (light vertices, photons, beams, "
+                     "queries) and lookups, e.g. 512M or 8G; checked before they grow (default: "
+                     "half of the machine's memory)")
+        ->type_name("SIZE");
+    render
         ->add_option("--resume", ra.resumePath,
                      "Continue the render saved in FILE (same scene and options; -i / -t count "
                      "the iterations and seconds already done); checkpoints go on into FILE "
@@ -478,6 +485,9 @@ int run(int argc, char** argv) {
             if (studySurfRadiusOpt->count() > 0) sa.render.radius = studySurfRadius;
             return ub::app::runStudy(sa);
         }
+    } catch (const ub::MemoryBudgetError& e) {
+        std::fprintf(stderr, "unibeam: error: %s\n", e.what());
+        return kExitBadInput;
     } catch (const ub::app::UsageError& e) {
         std::fprintf(stderr, "unibeam: error: %s\n", e.what());
         return kExitBadInput;

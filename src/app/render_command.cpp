@@ -15,6 +15,7 @@
 #include "app/scene_access.h"
 #include "core/error.h"
 #include "core/image.h"
+#include "core/memory_budget.h"
 #include "render/checkpoint.h"
 #include "render/integrator.h"
 #include "render/progressive.h"
@@ -127,6 +128,15 @@ RenderOptions makeRenderOptions(const RenderArgs& args, const Scene& scene) {
     if (!args.queryBeams.empty()) options.shortQueryBeams = args.queryBeams == "short";
     if (args.beamPaths) options.beamPaths = *args.beamPaths;
     options.backend = args.backend;
+    if (args.maxMemory.empty()) {
+        options.maxMemoryBytes = defaultMemoryBudget();
+    } else {
+        try {
+            options.maxMemoryBytes = parseMemorySize(args.maxMemory);
+        } catch (const std::invalid_argument& e) {
+            throw UsageError(std::string("--max-memory: ") + e.what());
+        }
+    }
     options.clCache = args.clCache;
     if (!args.clDevice.empty()) {
         int p = -1, d = -1;
@@ -223,7 +233,10 @@ int runRender(const RenderArgs& args) {
 
     ProgressiveResult result = renderProgressive(*integrator, w, h, prog);
     bar.finish();
-    if (result.interrupted)
+    if (!result.stopError.empty())
+        std::fprintf(stderr, "unibeam: stopped after %d iterations: %s; writing the image\n",
+                     result.iterations, result.stopError.c_str());
+    else if (result.interrupted)
         std::fprintf(stderr, "unibeam: stopped by %s after %d iterations; writing the image\n",
                      lastStopSignal() == SIGTERM ? "SIGTERM" : "SIGINT", result.iterations);
 
@@ -290,6 +303,10 @@ int runRender(const RenderArgs& args) {
     // Always printed, zeros included (docs/cli.md, "Rejected contributions").
     std::fprintf(stderr, "unibeam: rejected contributions (NaN, Inf or negative): %s\n",
                  formatRejections(result.rejected).c_str());
+    if (!result.stopError.empty()) {
+        std::fprintf(stderr, "unibeam: error: %s\n", result.stopError.c_str());
+        return 2;
+    }
     const std::string summary = integrator->iterationSummary();
     if (!summary.empty()) std::fprintf(stderr, "unibeam: %s\n", summary.c_str());
     std::fprintf(stderr, "unibeam: %d iterations in %s (%.3f s/iteration)\n", result.iterations,

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "cl/cl_runtime.h"
+#include "core/memory_budget.h"
 #include "estimators/beam_medium.h"
 #include "estimators/bvh.h"
 #include "estimators/hash_grid.h"
@@ -56,13 +57,26 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     const size_t nPoints = in.queryPoints->size(), nBeams = in.queryBeams->size();
 
     auto t0 = std::chrono::steady_clock::now();
+    // Lookups reserve their memory in the budget before they are built (freed at the end).
+    const char* kLookupAdvice =
+        "a smaller --resolution, fewer --beam-paths or a smaller --max-length need less";
+    std::vector<std::unique_ptr<MemoryReservation>> reservations;
+    auto reserve = [&](size_t bytes, const char* what) {
+        reservations.push_back(
+            std::make_unique<MemoryReservation>(in.budget, bytes, what, kLookupAdvice));
+    };
     HashGrid grid;
     if (t.pp3d && !photons.empty()) {
+        // Cell ends (one per photon at least) and indices.
+        reserve(photons.size() * 3 * sizeof(uint32_t) + 64, "pp3d lookup (hashed grid)");
         grid.build(reinterpret_cast<const Vec3*>(photons.data()->pos), photons.size(),
                    sizeof(ub_photon_point), in.radius[UB_TECH_PP3D]);
     }
     Bvh spheres;
     if (t.pb2d) {
+        // Boxes, nodes (at most 2 n / leaf size + 1) and the primitive list.
+        reserve(photons.size() * (sizeof(Bounds3) + sizeof(Vec3) + 4 + 2 * sizeof(BvhNode)),
+                "pb2d lookup (photon-point BVH)");
         const float r = in.radius[UB_TECH_PB2D];
         std::vector<Bounds3> boxes(photons.size());
         for (size_t i = 0; i < photons.size(); ++i) {
@@ -77,10 +91,20 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     if (t.photonBeams()) {
         const float r = std::max(t.bp2d ? in.radius[UB_TECH_BP2D] : 0.0f,
                                  t.bb1d ? in.radius[UB_TECH_BB1D] : 0.0f);
+        auto partCount = [&](const ub_beam& b) {
+            return int(std::min(64.0f, std::max(1.0f, std::ceil(b.length / (4.0f * r)))));
+        };
+        size_t total = 0;
+        for (const ub_beam& b : beams) total += size_t(partCount(b));
+        reserve(
+            total * (sizeof(BeamPart) + sizeof(Bounds3) + sizeof(Vec3) + 4 + 2 * sizeof(BvhNode)),
+            "bp2d/bb1d lookup (beam-part BVH)");
         std::vector<Bounds3> boxes;
+        parts.reserve(total);
+        boxes.reserve(total);
         for (uint32_t i = 0; i < beams.size(); ++i) {
             const ub_beam& b = beams[i];
-            const int n = int(std::min(64.0f, std::max(1.0f, std::ceil(b.length / (4.0f * r)))));
+            const int n = partCount(b);
             for (int k = 0; k < n; ++k) {
                 const float a = b.length * float(k) / float(n);
                 const float e = k + 1 == n ? b.length : b.length * float(k + 1) / float(n);
@@ -96,7 +120,12 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         photonMedia[i].reset(*in.scene, beams[i]);
         photonMedia[i].build();
     });
-    for (const BeamMedium& m : photonMedia) st.lookupBytes += m.bytes();
+    size_t mediaBytes = photonMedia.size() * sizeof(BeamMedium);
+    for (const BeamMedium& m : photonMedia) mediaBytes += m.bytes();
+    // Tabulated after the walk (its size is known only then): at most this one structure
+    // goes over the budget before the render stops.
+    reserve(mediaBytes, "photon-beam medium tables");
+    st.lookupBytes += mediaBytes;
     st.buildSeconds = secondsSince(t0);
     st.lookupBytes += spheres.bytes() + beamBvh.bytes() + parts.size() * sizeof(BeamPart);
 

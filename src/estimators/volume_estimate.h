@@ -38,6 +38,8 @@
 
 namespace ub {
 
+class MemoryBudget;
+
 class Scene;
 class ClRuntime;
 
@@ -53,7 +55,8 @@ struct VolumeEstimateInput {
     const std::vector<ub_beam>* photonBeams = nullptr;
     const std::vector<ub_query_point>* queryPoints = nullptr;
     const std::vector<ub_beam>* queryBeams = nullptr;
-    ClRuntime* cl = nullptr;  ///< the OpenCL backend (kernels for what it has), or host only
+    ClRuntime* cl = nullptr;         ///< the OpenCL backend (kernels for what it has), or host only
+    MemoryBudget* budget = nullptr;  ///< lookups reserve here while they live (--max-memory)
     /// Contribution guards per technique (UB_TECH_*; render/contribution_guard.h): each
     /// query's estimate passes its technique's guard before it is added to its pixel.
     ContributionGuard guards[4];

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/memory_budget.h"
 #include "scene/medium.h"
 #include "scene/scene.h"
 
@@ -46,7 +47,7 @@ float escapingBeamLength(const Scene& scene, const Medium& m, const Vec3& o, con
 
 void appendChainBeams(const Scene& scene, const MediumTrace& trace, const Vec3& dir,
                       const ChainVisit& visit, const ChainVertex& cv, const ChainBeamSource& src,
-                      std::vector<ub_beam>* out) {
+                      std::vector<ub_beam>* out, MemoryBudget* budget) {
     // Pieces: short beams the visited segments (the last one up to the vertex), long beams
     // every segment of the chain.
     const int count = src.shortBeams ? visit.count : trace.count;
@@ -88,7 +89,9 @@ void appendChainBeams(const Scene& scene, const MediumTrace& trace, const Vec3& 
                 b.flags = (src.applyDistSqr ? UB_BEAM_APPLY_DIST2 : 0u) |
                           (k == 0 && src.fromMedium ? UB_BEAM_ORIGIN_IN_PIECE : 0u);
                 b.pixel = src.tag;
-                out->push_back(b);
+                pushBudgeted(
+                    *out, b, budget, src.budgetName,
+                    "fewer --beam-paths, a smaller --resolution or --max-length need less");
             }
             if (k + 1 == count) break;  // nothing after the last piece needs its values
             if (visited) {

@@ -31,6 +31,8 @@
 
 namespace ub {
 
+class MemoryBudget;
+
 class Scene;
 
 /// The subpath that emits the beams of one chain.
@@ -41,13 +43,14 @@ struct ChainBeamSource {
     bool fromMedium = false;   ///< x is a medium vertex
     bool applyDistSqr = true;  ///< false on the first segment of a light at infinity
     bool shortBeams = true;
-    uint32_t tag = 0;  ///< ub_beam::pixel
+    uint32_t tag = 0;                  ///< ub_beam::pixel
+    const char* budgetName = "beams";  ///< what the memory budget calls them
 };
 
 /// Appends the pieces of the beam along `trace` (direction dir), as free-flight sampling
 /// visited it (`visit`, `cv`), to out.
 void appendChainBeams(const Scene& scene, const MediumTrace& trace, const Vec3& dir,
                       const ChainVisit& visit, const ChainVertex& cv, const ChainBeamSource& src,
-                      std::vector<ub_beam>* out);
+                      std::vector<ub_beam>* out, MemoryBudget* budget = nullptr);
 
 }  // namespace ub

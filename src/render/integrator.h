@@ -44,6 +44,8 @@ struct RenderOptions {
     /// Where UPBP's estimate pass runs: "host" (the C++ twins), "opencl" (kernels; an error if
     /// no device works), "auto" (OpenCL when a device works, else the host, saying why).
     std::string backend = "host";
+    /// Bound on the per-iteration records and lookups (core/memory_budget.h); 0: none.
+    size_t maxMemoryBytes = 0;
     int clPlatform = -1, clDevice = -1;  ///< OpenCL device (-1, -1: the first one)
     std::string clCache;  ///< OpenCL program cache folder ("": the user's cache, "-": none)
     /// Tests only (never set by the command-line program): makes one technique's contributions

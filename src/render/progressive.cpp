@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "core/memory_budget.h"
 #include "render/film.h"
 
 namespace ub {
@@ -123,7 +124,14 @@ ProgressiveResult renderProgressive(Integrator& integrator, int width, int heigh
                 break;
             }
         }
-        integrator.renderIteration(it, iterationImage);
+        try {
+            integrator.renderIteration(it, iterationImage);
+        } catch (const MemoryBudgetError& e) {
+            if (film.iterations() == 0) throw;
+            result.stopError = e.what();
+            result.interrupted = true;
+            break;
+        }
         film.addIteration(iterationImage);
         if (const std::vector<Image>* layers = integrator.iterationLayers())
             for (size_t l = 0; l < layerFilms.size() && l < layers->size(); ++l)

@@ -73,6 +73,9 @@ struct ProgressiveResult {
     int iterations = 0;
     double seconds = 0;        ///< wall-clock time of the iterations
     bool interrupted = false;  ///< stopped by the stop flag before the target was reached
+    /// Non-empty: an iteration after the first ran over the memory budget (MemoryBudgetError;
+    /// the first iteration's error propagates); the result holds the finished iterations.
+    std::string stopError;
 };
 
 /// Renders width x height iterations of `integrator`. Throws std::invalid_argument if

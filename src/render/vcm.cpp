@@ -57,7 +57,10 @@ MediumStack lightStartStack(const Scene& scene, const Light& light) {
 }  // namespace
 
 VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
-    : scene_(scene), options_(options), algorithm_(parseAlgorithm(options.algorithm)) {
+    : scene_(scene),
+      options_(options),
+      algorithm_(parseAlgorithm(options.algorithm)),
+      budget_(std::make_unique<MemoryBudget>(options.maxMemoryBytes)) {
     switch (algorithm_) {
         case Algorithm::LightTrace:
             lightTraceOnly_ = true;
@@ -277,6 +280,20 @@ void VertexCM::renderIteration(int iteration, Image& out) {
     photonPoints_.clear();
     photonBeams_.clear();
     pathEnds_.assign(pathCount, 0);
+    {
+        size_t nv = 0, np = 0, nb = 0;
+        for (const LightChunk& chunk : lightChunks_) {
+            nv += chunk.vertices.size();
+            np += chunk.photons.size();
+            nb += chunk.beams.size();
+        }
+        const char* advice =
+            "a smaller --resolution (fewer light subpaths) or --max-length needs less";
+        reserveFor(lightVertices_, nv, budget_.get(), "light vertices", advice);
+        reserveFor(photonPoints_, np, budget_.get(), "photon points", advice);
+        reserveFor(photonBeams_, nb, budget_.get(), "photon beams",
+                   "fewer --beam-paths, a smaller --resolution or --max-length need less");
+    }
     for (int c = 0; c < chunkCount; ++c) {
         auto range = SplatBuffer::chunkRange(c, pathCount);
         const LightChunk& chunk = lightChunks_[size_t(c)];
@@ -350,6 +367,14 @@ void VertexCM::renderIteration(int iteration, Image& out) {
     if (upbp_.anyVolume()) {
         queryPoints_.clear();
         queryBeams_.clear();
+        size_t nq = 0, nb = 0;
+        for (const CameraRecords& rec : cameraRows_) {
+            nq += rec.points.size();
+            nb += rec.beams.size();
+        }
+        const char* advice = "a smaller --resolution or --max-length needs less";
+        reserveFor(queryPoints_, nq, budget_.get(), "query points", advice);
+        reserveFor(queryBeams_, nb, budget_.get(), "query beams", advice);
         for (const CameraRecords& rec : cameraRows_) {
             queryPoints_.insert(queryPoints_.end(), rec.points.begin(), rec.points.end());
             queryBeams_.insert(queryBeams_.end(), rec.beams.begin(), rec.beams.end());
@@ -368,6 +393,7 @@ void VertexCM::renderIteration(int iteration, Image& out) {
         in.queryPoints = &queryPoints_;
         in.queryBeams = &queryBeams_;
         in.cl = cl_.get();
+        in.budget = budget_.get();
         for (int t = 0; t < 4; ++t)
             if (volumeTechnique_[t] >= 0) in.guards[t] = guards_[size_t(volumeTechnique_[t])];
         std::array<Image, 4> perTech;
@@ -417,7 +443,8 @@ bool VertexCM::traceToVertex(Rng& rng, SubPath& state, PathVertex* v, bool* esca
         src.applyDistSqr = state.pathLength > 1 || state.isFiniteLight;
         src.shortBeams = state.fromLight ? options_.shortPhotonBeams : options_.shortQueryBeams;
         src.tag = tag;
-        appendChainBeams(scene_, trace, state.ray.dir, visit, cv, src, beams);
+        src.budgetName = state.fromLight ? "photon beams" : "query beams";
+        appendChainBeams(scene_, trace, state.ray.dir, visit, cv, src, beams, budget_.get());
     }
     state.throughput *= cv.weight;
     v->distPdfFwd = cv.distPdfFwd;

@@ -55,6 +55,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/memory_budget.h"
 #include "estimators/hash_grid.h"
 #include "kernels/shared/ub_mis_volume.h"
 #include "kernels/shared/ub_upbp_records.h"
@@ -226,6 +227,8 @@ class VertexCM : public Integrator {
     ub_mis_constants mis_{};
     float lightSubPathCount_ = 0;
     float vmNormalization_ = 0;  ///< 1 / (pi r^2 N_L)
+    /// --max-memory: every record container and lookup reserves here before it grows.
+    std::unique_ptr<MemoryBudget> budget_;
     std::vector<LightVertex> lightVertices_;
     std::vector<uint32_t> pathEnds_;  ///< light subpath i owns [pathEnds_[i-1], pathEnds_[i])
     HashGrid grid_;

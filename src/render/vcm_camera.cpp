@@ -6,6 +6,7 @@
 // kernels/shared/ub_mis.h.
 #include <cmath>
 
+#include "core/memory_budget.h"
 #include "core/rng.h"
 #include "render/vcm.h"
 #include "render/vertex_scatter.h"
@@ -93,7 +94,8 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
             q.dVM = state.mis.dVM;
             q.contProb = scatter.continuationProb();
             q.pixel = uint32_t(pixelIndex);
-            records->points.push_back(q);
+            pushBudgeted(records->points, q, budget_.get(), "query points",
+                         "a smaller --resolution or --max-length needs less");
         }
 
         if (!atLimit && !scatter.isDelta() && useVC_) {

@@ -3,11 +3,17 @@
 // See vcm.h and kernels/shared/ub_mis.h.
 #include <cmath>
 
+#include "core/memory_budget.h"
 #include "core/rng.h"
 #include "render/vcm.h"
 #include "render/vertex_scatter.h"
 
 namespace ub {
+
+namespace {
+const char* const kLightAdvice =
+    "a smaller --resolution (fewer light subpaths) or --max-length needs less";
+}  // namespace
 
 namespace {
 /// Random-stream salts: light subpaths and camera subpaths of the same index differ.
@@ -105,7 +111,7 @@ void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuf
                 }
                 // UPBP: surface vertices are connected and merged on surfaces; medium
                 // vertices are connected, and merged through the photon points below.
-                vertices.push_back(lv);
+                pushBudgeted(vertices, lv, budget_.get(), "light vertices", kLightAdvice);
             }
             if (v.inMedium && upbp_.photonPoints() && state.pathLength + 1 <= maxLength) {
                 ub_photon_point ph{};
@@ -123,7 +129,7 @@ void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuf
                 ph.rPhotonL = rIn;
                 ph.dVCM = state.mis.dVCM;
                 ph.dVM = state.mis.dVM;
-                out.photons.push_back(ph);
+                pushBudgeted(out.photons, ph, budget_.get(), "photon points", kLightAdvice);
             }
             // Light tracing: connect to the camera (a path of pathLength + 1 segments).
             if (!scatter.isDelta() && (useVC_ || lightTraceOnly_) &&
