@@ -88,7 +88,9 @@ TEST(OpenClHeaders, EverySharedHeaderBuildsAsOpenClC) {
         cl_program prog = clCreateProgramWithSource(ctx, 1, &s, &len, &err);
         ASSERT_EQ(err, CL_SUCCESS);
         // PoCL does not strip quotes from -I; the source path must not contain spaces.
-        std::string options = "-cl-std=CL1.2 -I" + includeDir;
+        // NanoVDB's C header (ub_grid_medium.h includes it) from libnanovdb-dev.
+        std::string options =
+            "-cl-std=CL1.2 -I" + includeDir + " -I" + std::string(UNIBEAM_CNANOVDB_DIR);
         cl_int buildErr = clBuildProgram(prog, 1, &dev.device, options.c_str(), nullptr, nullptr);
         size_t logSize = 0;
         clGetProgramBuildInfo(prog, dev.device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &logSize);

@@ -27,6 +27,7 @@
 #include "core/error.h"
 #include "core/rng.h"
 #include "estimators/beam_medium.h"
+#include "estimators/grid_access.h"
 #include "render/integrator.h"
 #include "render/upbp_techniques.h"
 #include "render/vcm.h"
@@ -452,6 +453,15 @@ TEST(Upbp, TabulatedBeamMediumEqualsTheWalk) {
             ASSERT_TRUE(near(e.stopRevStartL, s.pdfScatterRevL())) << n << " t " << t;
             ASSERT_TRUE(near(e.passProb, s.probPass())) << n << " t " << t;
             for (int a = 0; a < 3; ++a) ASSERT_TRUE(near(e.sigmaS[a], s.sigmaS1[a])) << n;
+            // The kernels' DDA (kernels/shared/ub_grid_medium.h) with the host's voxel fetch.
+            ub_grid_accessor acc{scene->media[0].grid->grid().getAccessor()};
+            const ub_segment_eval k2 = ub_grid_segment(gridInfo(scene->media[0], 0), &acc, b, t);
+            ASSERT_TRUE(near(k2.transmittance[0], e.transmittance[0])) << n << " t " << t;
+            ASSERT_TRUE(near(k2.stopFwdL, e.stopFwdL)) << n << " t " << t;
+            ASSERT_TRUE(near(k2.stopRevStartL, e.stopRevStartL)) << n << " t " << t;
+            ASSERT_TRUE(near(k2.passProb, e.passProb)) << n << " t " << t;
+            ASSERT_TRUE(near(k2.sigmaS[1], e.sigmaS[1])) << n << " t " << t;
+            ASSERT_TRUE(near(k2.contProb, e.contProb)) << n << " t " << t;
             ++compared;
         }
     }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "estimators/grid_access.h"
 #include "estimators/volume_estimate.h"
 #include "scene/medium.h"
 #include "scene/scene.h"
@@ -17,6 +18,23 @@ void BeamMedium::reset(const Scene& scene, const ub_beam& b) {
     built_ = false;
     pieces_.clear();
     info_ = mediumInfo(*medium_);
+}
+
+ub_grid_info gridInfo(const Medium& m, uint32_t gridOffset) {
+    ub_grid_info g{};
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) g.worldToCell[4 * r + c] = m.worldToCell.m[r][c];
+    g.densityScale = m.densityScale;
+    g.background = m.grid->background();
+    for (int a = 0; a < 3; ++a) g.albedo[a] = m.albedo[a];
+    g.g = m.g;
+    const nanovdb::CoordBBox& bb = m.grid->indexBounds();
+    for (int a = 0; a < 3; ++a) {
+        g.lo[a] = bb.min()[a];
+        g.hi[a] = bb.max()[a] + 1;
+    }
+    g.gridOffset = gridOffset;
+    return g;
 }
 
 ub_medium_info mediumInfo(const Medium& m) {

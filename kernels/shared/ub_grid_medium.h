@@ -1,0 +1,190 @@
+/* A NanoVDB grid medium along a beam: regular tracking (Novak et al. 2018, Sec. 4.1) by a
+ * 3D-DDA through the voxels (Amanatides and Woo 1987), skipping 8^3 blocks without a leaf,
+ * in the cell space of scene/medium.h (index space + 1/2: voxel v covers [v, v + 1)), so the
+ * pieces are those of the host walk (scene/medium.cpp forEachPiece) and the optical depth
+ * is exact: piecewise linear in t. Used by the beam kernels (kernels/beams.cl) through
+ * CNanoVDB.h, and by the host (src/estimators/grid_access.h) through NanoVDB's C++
+ * accessor; only the voxel fetch differs.
+ *
+ * The voxel fetch: a type ub_grid_accessor and
+ *   float ub_grid_probe(UB_PRIVATE ub_grid_accessor* acc, int i, int j, int k,
+ *                       UB_PRIVATE int* inLeaf);
+ * returning the density of voxel (i, j, k) and whether a leaf node holds it. OpenCL C: defined
+ * below over CNanoVDB.h's read accessor (libnanovdb-dev; embedded with the kernels). Host:
+ * src/estimators/grid_access.h defines them over NanoVDB's C++ accessor and then includes
+ * this header.
+ *
+ * The medium is grey in sigma_t (sigma_t = densityScale * density) with a constant RGB
+ * albedo; media with an albedo grid or trilinear filtering stay on the host. */
+#ifndef UB_GRID_MEDIUM_H
+#define UB_GRID_MEDIUM_H
+
+#include "ub_medium_homogeneous.h"
+
+#ifdef __OPENCL_C_VERSION__
+#include "CNanoVDB.h"
+typedef cnanovdb_readaccessor ub_grid_accessor;
+/* After a lookup the accessor caches the leaf it descended to (mNode[0]), and clears that
+ * slot when the voxel lies outside the cached leaf: so mNode[0] != 0 says "in a leaf". */
+UB_INLINE float ub_grid_probe(UB_PRIVATE ub_grid_accessor* acc, int i, int j, int k,
+                              UB_PRIVATE int* inLeaf) {
+    cnanovdb_coord c;
+    c.mVec[0] = i;
+    c.mVec[1] = j;
+    c.mVec[2] = k;
+    const float v = cnanovdb_readaccessor_getValueF(acc, &c);
+    *inLeaf = acc->mNode[0] != 0;
+    return v;
+}
+#elif !defined(UB_HOST_GRID_ACCESSOR)
+#error "include src/estimators/grid_access.h, which defines the host's grid accessor"
+#endif
+
+/* A grid medium as the kernels see it. 112 bytes. */
+typedef struct {
+    float worldToCell[12]; /* rows 0-2 of the 4x4 world -> cell-space matrix */
+    float densityScale;
+    float background; /* density outside the grid's index bounds */
+    float albedo[3];
+    float g;
+    int lo[3]; /* cell-space box [lo, hi) of the grid's index bounds */
+    int hi[3];
+    ub_uint gridOffset; /* byte offset of the NanoVDB grid in the grid buffer */
+    ub_uint pad[3];
+} ub_grid_info;
+
+/* The optical depth of [0, tMax] along o + t d (world space, t in world units) and the
+ * extinction of its first and last non-empty pieces (at t = 0 and where the walk ends).
+ * tMax = 0: no piece; *sigmaTFirst and *sigmaTLast are then the extinction of the piece a
+ * walk starting at o would visit first (over [0, firstLength]). */
+UB_INLINE float ub_grid_optical_depth(ub_grid_info g, UB_PRIVATE ub_grid_accessor* acc, ub_float3 o,
+                                      ub_float3 d, float tMax, float firstLength,
+                                      UB_PRIVATE float* sigmaTFirst, UB_PRIVATE float* sigmaTLast) {
+    const int onlyFirst = !(tMax > 0.0f);
+    if (onlyFirst) tMax = firstLength;
+    float tau = 0.0f;
+    int visited = 0;
+    const float bgT = g.densityScale * g.background;
+    *sigmaTFirst = bgT;
+    *sigmaTLast = bgT;
+    if (!(tMax > 0.0f)) return 0.0f;
+    float P[3], D[3];
+    for (int r = 0; r < 3; ++r) {
+        P[r] = g.worldToCell[4 * r] * o.x + g.worldToCell[4 * r + 1] * o.y +
+               g.worldToCell[4 * r + 2] * o.z + g.worldToCell[4 * r + 3];
+        D[r] = g.worldToCell[4 * r] * d.x + g.worldToCell[4 * r + 1] * d.y +
+               g.worldToCell[4 * r + 2] * d.z;
+    }
+    /* Slab test against the cell box [lo, hi). */
+    float tEnter = 0.0f, tExit = tMax, invD[3];
+    int step[3];
+    for (int a = 0; a < 3; ++a) {
+        step[a] = D[a] > 0.0f ? 1 : (D[a] < 0.0f ? -1 : 0);
+        if (step[a] == 0) {
+            invD[a] = 0.0f;
+            if (P[a] < (float)g.lo[a] || P[a] >= (float)g.hi[a]) tExit = -1.0f;
+            continue;
+        }
+        invD[a] = 1.0f / D[a];
+        float t0 = ((float)g.lo[a] - P[a]) * invD[a], t1 = ((float)g.hi[a] - P[a]) * invD[a];
+        if (t0 > t1) {
+            float s = t0;
+            t0 = t1;
+            t1 = s;
+        }
+        tEnter = ub_fmax(tEnter, t0);
+        tExit = ub_fmin(tExit, t1);
+    }
+/* One piece [ta, tb) of extinction st. */
+#define UB_GRID_PIECE(ta, tb, st)          \
+    {                                      \
+        if (!visited) *sigmaTFirst = (st); \
+        *sigmaTLast = (st);                \
+        visited = 1;                       \
+        tau += (st) * ((tb) - (ta));       \
+        if (onlyFirst) return 0.0f;        \
+    }
+    if (!(tEnter < tExit)) {
+        UB_GRID_PIECE(0.0f, tMax, bgT)
+        return tau;
+    }
+    if (tEnter > 0.0f) UB_GRID_PIECE(0.0f, tEnter, bgT)
+    int v[3];
+    for (int a = 0; a < 3; ++a) {
+        int c = (int)ub_floor(P[a] + D[a] * tEnter);
+        v[a] = c < g.lo[a] ? g.lo[a] : (c > g.hi[a] - 1 ? g.hi[a] - 1 : c);
+    }
+    float t = tEnter;
+    for (;;) {
+        int inLeaf = 0;
+        const float density = ub_grid_probe(acc, v[0], v[1], v[2], &inLeaf);
+        const int dim = inLeaf ? 1 : 8;
+        int blockLo[3];
+        for (int a = 0; a < 3; ++a) blockLo[a] = inLeaf ? v[a] : (v[a] & ~7);
+        float tNext = tExit;
+        int axis = -1;
+        for (int a = 0; a < 3; ++a) {
+            if (step[a] == 0) continue;
+            const int boundary = step[a] > 0 ? blockLo[a] + dim : blockLo[a];
+            const float tb = ((float)boundary - P[a]) * invD[a];
+            if (tb < tNext) {
+                tNext = tb;
+                axis = a;
+            }
+        }
+        tNext = ub_fmax(tNext, t);
+        if (tNext > t) UB_GRID_PIECE(t, tNext, g.densityScale * density)
+        if (axis < 0) break; /* reached tExit inside this block */
+        t = tNext;
+        for (int b = 0; b < 3; ++b) {
+            if (b == axis) continue;
+            int c = (int)ub_floor(P[b] + D[b] * t);
+            v[b] =
+                c < blockLo[b] ? blockLo[b] : (c > blockLo[b] + dim - 1 ? blockLo[b] + dim - 1 : c);
+        }
+        v[axis] = step[axis] > 0 ? blockLo[axis] + dim : blockLo[axis] - 1;
+        if (v[axis] < g.lo[axis] || v[axis] >= g.hi[axis]) break;
+    }
+    if (tExit < tMax) UB_GRID_PIECE(tExit, tMax, bgT)
+#undef UB_GRID_PIECE
+    return tau;
+}
+
+/* The ub_segment_eval of [0, t] along beam b in grid medium g (as the host's tabulated
+ * BeamMedium::eval gives it): T = exp(-tau), sigma_s = albedo sigma_t at the end, the
+ * stopping densities sigma_t T at either end, passing T. */
+UB_INLINE ub_segment_eval ub_grid_segment(ub_grid_info g, UB_PRIVATE ub_grid_accessor* acc,
+                                          ub_beam b, float t) {
+    float sFirst = 0.0f, sLast = 0.0f;
+    const float tau = ub_grid_optical_depth(g, acc, ub_f3_from(b.origin), ub_f3_from(b.dir), t,
+                                            b.length, &sFirst, &sLast);
+    const float T = ub_exp(-tau);
+    ub_segment_eval e;
+    for (int a = 0; a < 3; ++a) {
+        e.transmittance[a] = T;
+        e.sigmaS[a] = g.albedo[a] * sLast;
+    }
+    e.stopFwdL = sLast * T;
+    e.stopRevStartL = sFirst * T;
+    e.passProb = T;
+    e.contProb = ub_medium_cont_prob(e.sigmaS[0], e.sigmaS[1], e.sigmaS[2], sLast, sLast, sLast);
+    return e;
+}
+
+#ifdef __OPENCL_C_VERSION__
+/* The accessor of medium g's grid in the concatenated grid buffer. */
+UB_INLINE void ub_grid_accessor_init(UB_PRIVATE ub_grid_accessor* acc,
+                                     __global const uchar* gridData, ub_grid_info g) {
+    const __global cnanovdb_griddata* grid =
+        (const __global cnanovdb_griddata*)(gridData + g.gridOffset);
+    cnanovdb_readaccessor_init(acc, cnanovdb_treedata_rootF(cnanovdb_griddata_tree(grid)));
+}
+#else
+#include <cstddef>
+static_assert(sizeof(ub_grid_info) == 112, "ub_grid_info layout");
+static_assert(offsetof(ub_grid_info, densityScale) == 48, "ub_grid_info layout");
+static_assert(offsetof(ub_grid_info, lo) == 72, "ub_grid_info layout");
+static_assert(offsetof(ub_grid_info, gridOffset) == 96, "ub_grid_info layout");
+#endif
+
+#endif /* UB_GRID_MEDIUM_H */
