@@ -1,11 +1,15 @@
-/* Estimate kernels of the beam estimators in homogeneous media: one work-item per query,
- * walking the BVH (kernels/shared/ub_bvh.h) depth first, left child first, as the host twin
- * does (src/estimators/bvh.h), and evaluating each pair with the shared per-estimator math
- * (ub_pb2d.h, ub_bp2d.h, ub_bb1d.h) and the closed-form medium (ub_medium_homogeneous.h).
- * Scenes with grid media run these estimators on the host. out: 3 floats per query. */
+/* Estimate kernels of the beam estimators: one work-item per query, walking the BVH
+ * (kernels/shared/ub_bvh.h) depth first, left child first, as the host twin does
+ * (src/estimators/bvh.h), and evaluating each pair with the shared per-estimator math
+ * (ub_pb2d.h, ub_bp2d.h, ub_bb1d.h) and the medium along the beam: the closed form in
+ * homogeneous media (ub_medium_homogeneous.h), regular tracking through the NanoVDB grid
+ * in grid media (ub_grid_medium.h; grids[m] describes medium m's grid in gridData). Grid
+ * media with an albedo grid or trilinear filtering run these estimators on the host.
+ * out: 3 floats per query. */
 #include "ub_bb1d.h"
 #include "ub_bp2d.h"
 #include "ub_bvh.h"
+#include "ub_grid_medium.h"
 #include "ub_medium_homogeneous.h"
 #include "ub_pb2d.h"
 
@@ -37,6 +41,7 @@
 /* pb2d: query beams x photon points (BVH over the photons' kernel spheres). */
 __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
                                __global const ub_bvh_node* nodes, __global const uint* prims,
+                               __global const ub_grid_info* grids, __global const uchar* gridData,
                                __global const ub_beam* queries, uint queryCount,
                                __global const ub_medium_info* media, ub_mis_constants mis,
                                float radius, float normalization, uint minLength, uint maxLength,
@@ -45,6 +50,9 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     if (i >= queryCount) return;
     ub_beam qb = queries[i];
     ub_medium_info m = media[qb.mediumId];
+    ub_grid_info gi = grids[qb.mediumId];
+    ub_grid_accessor acc;
+    if (!m.homogeneous) ub_grid_accessor_init(&acc, gridData, gi);
     ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
     ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
@@ -52,7 +60,8 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
         ub_photon_point ph = photons[prims[k]];
         float t = 0.0f;
         if (!ub_pb2d_pair(ph, qb, radius * radius, minLength, maxLength, &t)) continue;
-        ub_segment_eval s = ub_homogeneous_segment(m, t);
+        ub_segment_eval s =
+            m.homogeneous ? ub_homogeneous_segment(m, t) : ub_grid_segment(gi, &acc, qb, t);
         ub_float3 c = ub_pb2d_contribution(mis, ph, qb, s, t, m.g, normalization);
         sx += c.x;
         sy += c.y;
@@ -64,6 +73,7 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
 /* bp2d: query points x photon beams (BVH over the diced beam parts). */
 __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_beam_part* parts,
                                __global const ub_bvh_node* nodes, __global const uint* prims,
+                               __global const ub_grid_info* grids, __global const uchar* gridData,
                                __global const ub_query_point* queries, uint queryCount,
                                __global const ub_medium_info* media, ub_mis_constants mis,
                                float radius, float normalization, uint minLength, uint maxLength,
@@ -72,6 +82,9 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
     if (i >= queryCount) return;
     ub_query_point q = queries[i];
     ub_medium_info m = media[q.mediumId];
+    ub_grid_info gi = grids[q.mediumId];
+    ub_grid_accessor acc;
+    if (!m.homogeneous) ub_grid_accessor_init(&acc, gridData, gi);
     ub_float3 p = ub_f3_from(q.pos);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     UB_BVH_WALK(nodes, ub_bvh_contains(n, p), {
@@ -79,7 +92,8 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
         ub_beam pb = beams[part.beam];
         float t = 0.0f;
         if (!ub_bp2d_pair(q, pb, part, radius * radius, minLength, maxLength, &t)) continue;
-        ub_segment_eval s = ub_homogeneous_segment(m, t);
+        ub_segment_eval s =
+            m.homogeneous ? ub_homogeneous_segment(m, t) : ub_grid_segment(gi, &acc, pb, t);
         ub_float3 c = ub_bp2d_contribution(mis, pb, q, s, t, m.g, normalization);
         sx += c.x;
         sy += c.y;
@@ -91,6 +105,7 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
 /* bb1d: query beams x photon beams (BVH over the diced beam parts). */
 __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_beam_part* parts,
                                __global const ub_bvh_node* nodes, __global const uint* prims,
+                               __global const ub_grid_info* grids, __global const uchar* gridData,
                                __global const ub_beam* queries, uint queryCount,
                                __global const ub_medium_info* media, ub_mis_constants mis,
                                float radius, float normalization, uint minLength, uint maxLength,
@@ -99,6 +114,9 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
     if (i >= queryCount) return;
     ub_beam qb = queries[i];
     ub_medium_info m = media[qb.mediumId];
+    ub_grid_info gi = grids[qb.mediumId];
+    ub_grid_accessor acc;
+    if (!m.homogeneous) ub_grid_accessor_init(&acc, gridData, gi);
     ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
     ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
@@ -108,8 +126,10 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
         float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
         if (!ub_bb1d_pair(qb, pb, part, radius * radius, minLength, maxLength, &tc, &tl, &sinTheta))
             continue;
-        ub_segment_eval sl = ub_homogeneous_segment(m, tl);
-        ub_segment_eval sc = ub_homogeneous_segment(m, tc);
+        ub_segment_eval sl =
+            m.homogeneous ? ub_homogeneous_segment(m, tl) : ub_grid_segment(gi, &acc, pb, tl);
+        ub_segment_eval sc =
+            m.homogeneous ? ub_homogeneous_segment(m, tc) : ub_grid_segment(gi, &acc, qb, tc);
         ub_float3 c =
             ub_bb1d_contribution(mis, pb, qb, sl, sc, tl, tc, sinTheta, m.g, normalization);
         sx += c.x;

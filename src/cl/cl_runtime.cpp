@@ -514,6 +514,11 @@ void ClRuntime::runEstimate(cl_kernel kernel, const char* name, const std::vecto
     }
 }
 
+namespace {
+const std::vector<ub_grid_info> kNoGrids;
+const std::vector<uint8_t> kNoGridData;
+}  // namespace
+
 void ClRuntime::estimatePP3D(const std::vector<ub_photon_point>& photons, const HashGrid& grid,
                              const std::vector<ub_query_point>& queries, const EstimateArgs& a,
                              std::vector<Rgb>* out) {
@@ -529,7 +534,9 @@ void ClRuntime::estimatePB2D(const std::vector<ub_photon_point>& photons, const 
                              std::vector<Rgb>* out) {
     if (photons.empty() || spheres.empty()) return out->assign(queries.size(), Rgb(0.0f));
     runEstimate(pb2d_, "clEnqueueNDRangeKernel(ub_pb2d_estimate)",
-                {bufferArg(photons), bufferArg(spheres.nodes()), bufferArg(spheres.prims())},
+                {bufferArg(photons), bufferArg(spheres.nodes()), bufferArg(spheres.prims()),
+                 bufferArg(a.grids ? *a.grids : kNoGrids),
+                 bufferArg(a.gridData ? *a.gridData : kNoGridData)},
                 bufferArg(queries), queries.size(), a, out);
 }
 
@@ -538,10 +545,11 @@ void ClRuntime::estimateBP2D(const std::vector<ub_beam>& beams,
                              const std::vector<ub_query_point>& queries, const EstimateArgs& a,
                              std::vector<Rgb>* out) {
     if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
-    runEstimate(
-        bp2d_, "clEnqueueNDRangeKernel(ub_bp2d_estimate)",
-        {bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()), bufferArg(bvh.prims())},
-        bufferArg(queries), queries.size(), a, out);
+    runEstimate(bp2d_, "clEnqueueNDRangeKernel(ub_bp2d_estimate)",
+                {bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()), bufferArg(bvh.prims()),
+                 bufferArg(a.grids ? *a.grids : kNoGrids),
+                 bufferArg(a.gridData ? *a.gridData : kNoGridData)},
+                bufferArg(queries), queries.size(), a, out);
 }
 
 void ClRuntime::estimateBB1D(const std::vector<ub_beam>& beams,
@@ -549,10 +557,11 @@ void ClRuntime::estimateBB1D(const std::vector<ub_beam>& beams,
                              const std::vector<ub_beam>& queries, const EstimateArgs& a,
                              std::vector<Rgb>* out) {
     if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
-    runEstimate(
-        bb1d_, "clEnqueueNDRangeKernel(ub_bb1d_estimate)",
-        {bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()), bufferArg(bvh.prims())},
-        bufferArg(queries), queries.size(), a, out);
+    runEstimate(bb1d_, "clEnqueueNDRangeKernel(ub_bb1d_estimate)",
+                {bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()), bufferArg(bvh.prims()),
+                 bufferArg(a.grids ? *a.grids : kNoGrids),
+                 bufferArg(a.gridData ? *a.gridData : kNoGridData)},
+                bufferArg(queries), queries.size(), a, out);
 }
 
 }  // namespace ub

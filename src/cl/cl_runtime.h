@@ -6,9 +6,10 @@
 // Queries go to the device in batches that fit its largest allocation and global memory;
 // running out of resources halves the batch and retries (runEstimate).
 //
-// Status: pp3d runs as a kernel (kernels/pp3d.cl) in every medium; pb2d, bp2d and bb1d
-// (kernels/beams.cl) in scenes whose media are all homogeneous, else on the host (the
-// regular tracking through NanoVDB grids along beams is not in kernels/shared yet).
+// pp3d runs as a kernel (kernels/pp3d.cl) in every medium; pb2d, bp2d and bb1d
+// (kernels/beams.cl) in homogeneous media and in nearest-filtered NanoVDB grids without an
+// albedo grid (regular tracking through the grid read with CNanoVDB.h,
+// kernels/shared/ub_grid_medium.h); scenes with other grid media run them on the host.
 // Results come back one per query and are added to pixels on the host in query order, so
 // no float atomics are needed and images are deterministic.
 #pragma once
@@ -23,6 +24,7 @@
 #include <vector>
 
 #include "core/vec.h"
+#include "estimators/grid_access.h"
 #include "kernels/shared/ub_bvh.h"
 #include "kernels/shared/ub_medium_homogeneous.h"
 #include "kernels/shared/ub_upbp_records.h"
@@ -79,6 +81,10 @@ class ClRuntime {
     /// from the same records and lookups. media[m] describes medium m (ub_medium_info).
     struct EstimateArgs {
         const std::vector<ub_medium_info>* media = nullptr;
+        /// Beam kernels: grids[m] describes medium m's NanoVDB grid inside gridData (grid
+        /// media; unused entries for homogeneous ones). nullptr: no grid media.
+        const std::vector<ub_grid_info>* grids = nullptr;
+        const std::vector<uint8_t>* gridData = nullptr;
         ub_mis_constants mis{};
         float radius = 0, normalization = 0;
         uint32_t minLength = 0, maxLength = 0;

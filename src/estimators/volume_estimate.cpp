@@ -12,6 +12,7 @@
 #include "core/memory_budget.h"
 #include "estimators/beam_medium.h"
 #include "estimators/bvh.h"
+#include "estimators/grid_access.h"
 #include "estimators/hash_grid.h"
 #include "kernels/shared/ub_bb1d.h"
 #include "kernels/shared/ub_bp2d.h"
@@ -131,17 +132,35 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
 
     t0 = std::chrono::steady_clock::now();
     std::vector<Rgb> perPoint[4], perBeam[4];
-    // The beam estimators' kernels evaluate homogeneous media only (kernels/beams.cl).
+    // The beam kernels evaluate homogeneous media in closed form and nearest-filtered grids
+    // without an albedo grid by regular tracking through the grid (kernels/beams.cl); the
+    // grids go to the device concatenated, each at a 32-byte aligned offset (NanoVDB's
+    // alignment). Other grid media keep these estimators on the host.
     std::vector<ub_medium_info> media;
-    bool allHomogeneous = true;
-    for (const Medium& m : in.scene->media) {
+    std::vector<ub_grid_info> grids(in.scene->media.size());
+    std::vector<uint8_t> gridData;
+    bool beamsOnDevice = true;
+    for (size_t i = 0; i < in.scene->media.size(); ++i) {
+        const Medium& m = in.scene->media[i];
         media.push_back(mediumInfo(m));
-        allHomogeneous &= m.type == MediumType::kHomogeneous;
+        if (m.type == MediumType::kHomogeneous || !in.cl || !t.photonBeams() && !t.pb2d) continue;
+        if (!gridMediumOnDevice(m)) {
+            beamsOnDevice = false;
+            continue;
+        }
+        const size_t offset = (gridData.size() + 31) & ~size_t(31);
+        const nanovdb::FloatGrid& g = m.grid->grid();
+        const uint8_t* bytes = reinterpret_cast<const uint8_t*>(&g);
+        gridData.resize(offset);
+        gridData.insert(gridData.end(), bytes, bytes + g.gridSize());
+        grids[i] = gridInfo(m, uint32_t(offset));
     }
-    ClRuntime* beamCl = allHomogeneous ? in.cl : nullptr;
+    ClRuntime* beamCl = beamsOnDevice ? in.cl : nullptr;
     auto clArgs = [&](int tech, float normalization) {
         ClRuntime::EstimateArgs a;
         a.media = &media;
+        a.grids = &grids;
+        a.gridData = &gridData;
         a.mis = in.mis;
         a.radius = in.radius[tech];
         a.normalization = normalization;

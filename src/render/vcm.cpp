@@ -13,6 +13,7 @@
 #include "cl/cl_runtime.h"
 #include "core/error.h"
 #include "core/rng.h"
+#include "estimators/grid_access.h"
 #include "estimators/volume_estimate.h"
 #include "render/chain_beams.h"
 #include "render/medium_walk.h"
@@ -183,14 +184,15 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
             try {
                 cl_ = std::make_unique<ClRuntime>(options.clPlatform, options.clDevice,
                                                   options.clCache);
-                bool homogeneous = true;
+                bool beamKernels = true;
                 for (const Medium& m : scene.media)
-                    homogeneous &= m.type == MediumType::kHomogeneous;
+                    beamKernels &= m.type == MediumType::kHomogeneous || gridMediumOnDevice(m);
                 backendNote_ = "estimate pass on OpenCL device '" + cl_->device().device + "' (" +
                                cl_->device().platform + ")" +
-                               (homogeneous ? ""
-                                            : ": pp3d; pb2d, bp2d, bb1d on the host (grid "
-                                              "media have no beam kernel yet)") +
+                               (beamKernels ? ""
+                                            : ": pp3d; pb2d, bp2d, bb1d on the host (a grid "
+                                              "medium with an albedo grid or trilinear filtering "
+                                              "has no beam kernel)") +
                                "; " + cl_->programNote();
             } catch (const ClError& e) {
                 if (options.backend == "opencl") throw InputError("", e.what());
