@@ -485,7 +485,7 @@ int run(int argc, char** argv) {
             if (studySurfRadiusOpt->count() > 0) sa.render.radius = studySurfRadius;
             return ub::app::runStudy(sa);
         }
-    } catch (const ub::MemoryBudgetError& e) {
+    } catch (const ub::ResourceError& e) {
         std::fprintf(stderr, "unibeam: error: %s\n", e.what());
         return kExitBadInput;
     } catch (const ub::app::UsageError& e) {

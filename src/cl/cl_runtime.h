@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "core/memory_budget.h"
 #include "core/vec.h"
 #include "estimators/grid_access.h"
 #include "kernels/shared/ub_bvh.h"
@@ -36,9 +37,9 @@ class Bvh;
 
 /// An OpenCL problem (no platform, bad device index, build failure, out of resources):
 /// the message says what and, for build failures, includes the build log and options.
-class ClError : public std::runtime_error {
+class ClError : public ResourceError {
   public:
-    using std::runtime_error::runtime_error;
+    using ResourceError::ResourceError;
 };
 
 struct ClDeviceDescription {

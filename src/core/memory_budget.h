@@ -18,9 +18,17 @@
 
 namespace ub {
 
-class MemoryBudgetError : public std::runtime_error {
+/// A render ran out of a resource it was given: the memory budget, or an OpenCL device's
+/// resources (cl/cl_runtime.h ClError). The CLI answers with exit status 2, after writing
+/// the iterations that finished.
+class ResourceError : public std::runtime_error {
   public:
     using std::runtime_error::runtime_error;
+};
+
+class MemoryBudgetError : public ResourceError {
+  public:
+    using ResourceError::ResourceError;
 };
 
 class MemoryBudget {

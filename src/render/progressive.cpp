@@ -126,7 +126,7 @@ ProgressiveResult renderProgressive(Integrator& integrator, int width, int heigh
         }
         try {
             integrator.renderIteration(it, iterationImage);
-        } catch (const MemoryBudgetError& e) {
+        } catch (const ResourceError& e) {
             if (film.iterations() == 0) throw;
             result.stopError = e.what();
             result.interrupted = true;

@@ -73,8 +73,9 @@ struct ProgressiveResult {
     int iterations = 0;
     double seconds = 0;        ///< wall-clock time of the iterations
     bool interrupted = false;  ///< stopped by the stop flag before the target was reached
-    /// Non-empty: an iteration after the first ran over the memory budget (MemoryBudgetError;
-    /// the first iteration's error propagates); the result holds the finished iterations.
+    /// Non-empty: an iteration after the first ran out of a resource (ResourceError: the
+    /// memory budget, an OpenCL device; the first iteration's error propagates); the result
+    /// holds the finished iterations.
     std::string stopError;
 };
 
