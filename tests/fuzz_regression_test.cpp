@@ -152,6 +152,14 @@ const std::vector<Case> kCases = {
      {"mesh.ply:6: error: at /shapes/0: PLY header has no 'end_header' line (expected the "
       "element and property lines to end with 'end_header'; truncated or corrupt file?)",
       "scene.json:3:", "mesh file 'mesh.ply' could not be loaded"}},
+    // Heap overflow: tinyobjloader reads "f 3/ 2/1 3/1" as corner 3/2, texture coordinate 2 of
+    // 1, which validateObj had read as a vertex-only corner; the loader indexed past the array.
+    {"fuzz_mesh_obj",
+     "corner-with-trailing-slash.obj",
+     2,
+     {"mesh.obj:10:4: error: at /shapes/0: face corner '3/' ends with '/' (expected v, v/vt, "
+      "v//vn or v/vt/vn)",
+      "scene.json:3:", "mesh file 'mesh.obj' could not be loaded"}},
     // A seed (tests/data/mitsuba/media.xml with its include): UBSan's alignment check in
     // oneTBB's concurrent_hash_map under OpenVDB (fuzz/ubsan_ignorelist.txt); it loads.
     {"fuzz_mitsuba_scene", "tbb-hash-map-sentinel-downcast.xml", 0, {}},

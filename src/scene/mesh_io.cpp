@@ -141,6 +141,16 @@ bool validateObj(const std::string& text, Reporter& rep) {
                 const int col = int(q) + 1;
                 ++corners;
                 // v, v/vt, v//vn or v/vt/vn
+                // A trailing '/' ("3/", "3/1/") is no corner: tinyobjloader would read the
+                // next corner's number as its index (found by fuzz_mesh_obj: "f 3/ 2/1 3/1"
+                // read texture coordinate 2 of 1, past the end of the array).
+                if (corner.back() == '/') {
+                    rep.error("face corner '" + corner +
+                                  "' ends with '/' (expected v, v/vt, v//vn or v/vt/vn)",
+                              lineNo, col);
+                    q = qe;
+                    continue;
+                }
                 const char* names[3] = {"vertex", "texture coordinate", "normal"};
                 const size_t seen[3] = {seenV, seenVt, seenVn};
                 const size_t total[3] = {totalV, totalVt, totalVn};
@@ -260,6 +270,23 @@ bool loadObj(const std::string& path, const std::string& text, Reporter& rep, Tr
         rep.error("OBJ file has no triangles (expected faces: 'f' lines)");
         return false;
     }
+    // Every index within tinyobjloader's arrays, whatever validateObj accepted: a corner the
+    // two read differently must be an error, never an out-of-bounds read.
+    const size_t counts[3] = {attrib.vertices.size() / 3, attrib.texcoords.size() / 2,
+                              attrib.normals.size() / 3};
+    for (const tinyobj::shape_t& shape : reader.GetShapes())
+        for (const tinyobj::index_t& ix : shape.mesh.indices) {
+            const int idx[3] = {ix.vertex_index, hasUvs ? ix.texcoord_index : -1,
+                                hasNormals ? ix.normal_index : -1};
+            const char* names[3] = {"vertex", "texture coordinate", "normal"};
+            for (int a = 0; a < 3; ++a)
+                if ((a == 0 && idx[a] < 0) || (idx[a] >= 0 && size_t(idx[a]) >= counts[a])) {
+                    rep.error("a face refers to " + std::string(names[a]) + " " +
+                              std::to_string(idx[a] + 1) + " of " + std::to_string(counts[a]) +
+                              " (expected indices within the file's 'v', 'vt' and 'vn' lines)");
+                    return false;
+                }
+        }
     std::unordered_map<CornerKey, uint32_t, CornerHash> remap;
     TriangleMesh& m = *out;
     for (const tinyobj::shape_t& shape : reader.GetShapes()) {
