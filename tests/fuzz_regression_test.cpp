@@ -152,6 +152,12 @@ const std::vector<Case> kCases = {
      {"mesh.ply:6: error: at /shapes/0: PLY header has no 'end_header' line (expected the "
       "element and property lines to end with 'end_header'; truncated or corrupt file?)",
       "scene.json:3:", "mesh file 'mesh.ply' could not be loaded"}},
+    // The same hang with "ply" followed by NUL bytes (Assimp checks only the first 3 bytes).
+    {"fuzz_mesh_ply",
+     "hang-magic-then-nul-bytes.ply",
+     2,
+     {"mesh.ply:10: error: at /shapes/0: PLY header has no 'end_header' line",
+      "mesh file 'mesh.ply' could not be loaded"}},
     // Heap overflow: tinyobjloader reads "f 3/ 2/1 3/1" as corner 3/2, texture coordinate 2 of
     // 1, which validateObj had read as a vertex-only corner; the loader indexed past the array.
     {"fuzz_mesh_obj",
