@@ -158,6 +158,12 @@ const std::vector<Case> kCases = {
      2,
      {"mesh.ply:10: error: at /shapes/0: PLY header has no 'end_header' line",
       "mesh file 'mesh.ply' could not be loaded"}},
+    // And with the magic in mixed case ("plY"), which Assimp also accepts.
+    {"fuzz_mesh_ply",
+     "hang-mixed-case-magic.ply",
+     2,
+     {"mesh.ply:3: error: at /shapes/0: PLY header has no 'end_header' line",
+      "mesh file 'mesh.ply' could not be loaded"}},
     // Heap overflow: tinyobjloader reads "f 3/ 2/1 3/1" as corner 3/2, texture coordinate 2 of
     // 1, which validateObj had read as a vertex-only corner; the loader indexed past the array.
     {"fuzz_mesh_obj",

@@ -399,9 +399,12 @@ bool checkPlyCounts(const std::string& path, Reporter& rep) {
         in.seekg(0);
         std::string first;
         std::getline(in, first);
-        // Assimp takes any file starting with these three bytes for a PLY (found by
-        // fuzz_mesh_ply: "ply" followed by NUL bytes hung as well).
-        if (first.compare(0, 3, "ply") != 0 && first.compare(0, 3, "PLY") != 0) return true;
+        // Assimp takes any file starting with these three letters, in any case, for a PLY
+        // (found by fuzz_mesh_ply: "ply" then NUL bytes, and "plY", hung as well).
+        const bool magic = first.size() >= 3 && std::tolower((unsigned char)first[0]) == 'p' &&
+                           std::tolower((unsigned char)first[1]) == 'l' &&
+                           std::tolower((unsigned char)first[2]) == 'y';
+        if (!magic) return true;
         rep.error("PLY header has no 'end_header' line" +
                       std::string(lineNo >= 10000 ? " in its first 10000 lines" : "") +
                       " (expected the element and property lines to end with 'end_header'; "
