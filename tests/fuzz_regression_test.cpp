@@ -144,26 +144,36 @@ const std::vector<Case> kCases = {
      2,
      {"mesh.ply: error: at /shapes/0: cannot read PLY file: Cannot parse string",
       "scene.json:3:", "mesh file 'mesh.ply' could not be loaded"}},
-    // Assimp 5.2 looks for end_header for ever when a PLY header has none (a hang, over 10 s
-    // per input and for ever in the CLI); the header check now reports it.
+    // Hangs: Assimp 5.2 looks for end_header for ever when a file starting with "ply" (any
+    // case) has none, and it crashed (SEGV) on a header line it could not read. The header
+    // check now reports both: a missing end_header, and any line that is not PLY's.
+    {"fuzz_mesh_ply",
+     "hang-valid-lines-no-end-header.ply",
+     2,
+     {"mesh.ply:5: error: at /shapes/0: PLY header has no 'end_header' line (expected the "
+      "element and property lines to end with 'end_header'; truncated or corrupt file?)",
+      "scene.json:3:", "mesh file 'mesh.ply' could not be loaded"}},
     {"fuzz_mesh_ply",
      "hang-header-without-end-header.ply",
      2,
-     {"mesh.ply:6: error: at /shapes/0: PLY header has no 'end_header' line (expected the "
-      "element and property lines to end with 'end_header'; truncated or corrupt file?)",
-      "scene.json:3:", "mesh file 'mesh.ply' could not be loaded"}},
-    // The same hang with "ply" followed by NUL bytes (Assimp checks only the first 3 bytes).
+     {"mesh.ply:3: error: at /shapes/0: unknown PLY header line 'elem%nt vert",
+      "(expected format, element, property, comment, obj_info or end_header)"}},
     {"fuzz_mesh_ply",
      "hang-magic-then-nul-bytes.ply",
      2,
-     {"mesh.ply:10: error: at /shapes/0: PLY header has no 'end_header' line",
-      "mesh file 'mesh.ply' could not be loaded"}},
-    // And with the magic in mixed case ("plY"), which Assimp also accepts.
+     {"mesh.ply:4: error: at /shapes/0: PLY property line 'property float!x' (expected "
+      "'property TYPE NAME' or 'property list COUNT_TYPE INDEX_TYPE NAME' with PLY's scalar "
+      "types)"}},
     {"fuzz_mesh_ply",
      "hang-mixed-case-magic.ply",
      2,
-     {"mesh.ply:3: error: at /shapes/0: PLY header has no 'end_header' line",
-      "mesh file 'mesh.ply' could not be loaded"}},
+     {"mesh.ply:2: error: at /shapes/0: PLY format 'binary_littl' (expected ascii, "
+      "binary_little_endian or binary_big_endian)"}},
+    {"fuzz_mesh_ply",
+     "assimp-segv-bad-format-line.ply",
+     2,
+     {"mesh.ply:2: error: at /shapes/0: PLY format 'binary_comment' (expected ascii, "
+      "binary_little_endian or binary_big_endian)"}},
     // Heap overflow: tinyobjloader reads "f 3/ 2/1 3/1" as corner 3/2, texture coordinate 2 of
     // 1, which validateObj had read as a vertex-only corner; the loader indexed past the array.
     {"fuzz_mesh_obj",

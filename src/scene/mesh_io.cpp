@@ -359,11 +359,27 @@ bool checkPlyCounts(const std::string& path, Reporter& rep) {
             ended = true;
             break;
         }
+        // Every header line must be one of PLY's: Assimp 5.2 crashes on some it cannot read
+        // (found by fuzz_mesh_ply: "format binary_comment" and a "propert|" line, SEGV).
         if (kw == "format") {
             std::string f;
             ls >> f;
             ascii = f == "ascii";
-        } else if (kw == "element") {
+            if (f != "ascii" && f != "binary_little_endian" && f != "binary_big_endian") {
+                rep.error("PLY format '" + f +
+                              "' (expected ascii, binary_little_endian or binary_big_endian)",
+                          lineNo);
+                return false;
+            }
+        } else if (lineNo > 1 && !kw.empty() && kw != "element" && kw != "property" &&
+                   kw != "comment" && kw != "obj_info") {
+            rep.error("unknown PLY header line '" + line.substr(0, 40) +
+                          "' (expected format, element, property, comment, obj_info or "
+                          "end_header)",
+                      lineNo);
+            return false;
+        }
+        if (kw == "element") {
             Element e;
             std::string count;
             ls >> e.name >> count;
@@ -381,6 +397,21 @@ bool checkPlyCounts(const std::string& path, Reporter& rep) {
         } else if (kw == "property" && !elements.empty()) {
             std::string type;
             ls >> type;
+            {
+                std::istringstream check(line);
+                std::string k, t1, t2, t3, name;
+                check >> k >> t1;
+                const bool ok = t1 == "list" ? bool(check >> t2 >> t3 >> name) &&
+                                                   scalarBytes(t2) > 0 && scalarBytes(t3) > 0
+                                             : scalarBytes(t1) > 0 && bool(check >> name);
+                if (!ok) {
+                    rep.error("PLY property line '" + line.substr(0, 60) +
+                                  "' (expected 'property TYPE NAME' or 'property list "
+                                  "COUNT_TYPE INDEX_TYPE NAME' with PLY's scalar types)",
+                              lineNo);
+                    return false;
+                }
+            }
             if (ascii) {
                 elements.back().minBytes += 2;
             } else if (type == "list") {
