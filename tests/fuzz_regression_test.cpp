@@ -170,6 +170,11 @@ const std::vector<Case> kCases = {
      {"mesh.ply:2: error: at /shapes/0: PLY format 'binary_littl' (expected ascii, "
       "binary_little_endian or binary_big_endian)"}},
     {"fuzz_mesh_ply",
+     "hang-end-header-vertical-tab.ply",
+     2,
+     {"mesh.ply:15:11: error: at /shapes/0: PLY header line has control character 0x0b at "
+      "column 11 (expected header lines of printable text, words separated by spaces)"}},
+    {"fuzz_mesh_ply",
      "assimp-segv-bad-format-line.ply",
      2,
      {"mesh.ply:2: error: at /shapes/0: PLY format 'binary_comment' (expected ascii, "
