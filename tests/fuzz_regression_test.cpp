@@ -144,6 +144,49 @@ const std::vector<Case> kCases = {
      2,
      {"mesh.ply: error: at /shapes/0: cannot read PLY file: Cannot parse string",
       "scene.json:3:", "mesh file 'mesh.ply' could not be loaded"}},
+    // Hangs: Assimp 5.2 looks for end_header for ever when a file starting with "ply" (any
+    // case) has none, and it crashed (SEGV) on a header line it could not read. The header
+    // check now reports both: a missing end_header, and any line that is not PLY's.
+    {"fuzz_mesh_ply",
+     "hang-valid-lines-no-end-header.ply",
+     2,
+     {"mesh.ply:5: error: at /shapes/0: PLY header has no 'end_header' line (expected the "
+      "element and property lines to end with 'end_header'; truncated or corrupt file?)",
+      "scene.json:3:", "mesh file 'mesh.ply' could not be loaded"}},
+    {"fuzz_mesh_ply",
+     "hang-header-without-end-header.ply",
+     2,
+     {"mesh.ply:3: error: at /shapes/0: unknown PLY header line 'elem%nt vert",
+      "(expected format, element, property, comment, obj_info or end_header)"}},
+    {"fuzz_mesh_ply",
+     "hang-magic-then-nul-bytes.ply",
+     2,
+     {"mesh.ply:4: error: at /shapes/0: PLY property line 'property float!x' (expected "
+      "'property TYPE NAME' or 'property list COUNT_TYPE INDEX_TYPE NAME' with PLY's scalar "
+      "types)"}},
+    {"fuzz_mesh_ply",
+     "hang-mixed-case-magic.ply",
+     2,
+     {"mesh.ply:2: error: at /shapes/0: PLY format 'binary_littl' (expected ascii, "
+      "binary_little_endian or binary_big_endian)"}},
+    {"fuzz_mesh_ply",
+     "hang-end-header-vertical-tab.ply",
+     2,
+     {"mesh.ply:15:11: error: at /shapes/0: PLY header line has control character 0x0b at "
+      "column 11 (expected header lines of printable text, words separated by spaces)"}},
+    {"fuzz_mesh_ply",
+     "assimp-segv-bad-format-line.ply",
+     2,
+     {"mesh.ply:2: error: at /shapes/0: PLY format 'binary_comment' (expected ascii, "
+      "binary_little_endian or binary_big_endian)"}},
+    // Heap overflow: tinyobjloader reads "f 3/ 2/1 3/1" as corner 3/2, texture coordinate 2 of
+    // 1, which validateObj had read as a vertex-only corner; the loader indexed past the array.
+    {"fuzz_mesh_obj",
+     "corner-with-trailing-slash.obj",
+     2,
+     {"mesh.obj:10:4: error: at /shapes/0: face corner '3/' ends with '/' (expected v, v/vt, "
+      "v//vn or v/vt/vn)",
+      "scene.json:3:", "mesh file 'mesh.obj' could not be loaded"}},
     // A seed (tests/data/mitsuba/media.xml with its include): UBSan's alignment check in
     // oneTBB's concurrent_hash_map under OpenVDB (fuzz/ubsan_ignorelist.txt); it loads.
     {"fuzz_mitsuba_scene", "tbb-hash-map-sentinel-downcast.xml", 0, {}},

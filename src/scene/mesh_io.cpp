@@ -19,6 +19,7 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -141,6 +142,16 @@ bool validateObj(const std::string& text, Reporter& rep) {
                 const int col = int(q) + 1;
                 ++corners;
                 // v, v/vt, v//vn or v/vt/vn
+                // A trailing '/' ("3/", "3/1/") is no corner: tinyobjloader would read the
+                // next corner's number as its index (found by fuzz_mesh_obj: "f 3/ 2/1 3/1"
+                // read texture coordinate 2 of 1, past the end of the array).
+                if (corner.back() == '/') {
+                    rep.error("face corner '" + corner +
+                                  "' ends with '/' (expected v, v/vt, v//vn or v/vt/vn)",
+                              lineNo, col);
+                    q = qe;
+                    continue;
+                }
                 const char* names[3] = {"vertex", "texture coordinate", "normal"};
                 const size_t seen[3] = {seenV, seenVt, seenVn};
                 const size_t total[3] = {totalV, totalVt, totalVn};
@@ -260,6 +271,23 @@ bool loadObj(const std::string& path, const std::string& text, Reporter& rep, Tr
         rep.error("OBJ file has no triangles (expected faces: 'f' lines)");
         return false;
     }
+    // Every index within tinyobjloader's arrays, whatever validateObj accepted: a corner the
+    // two read differently must be an error, never an out-of-bounds read.
+    const size_t counts[3] = {attrib.vertices.size() / 3, attrib.texcoords.size() / 2,
+                              attrib.normals.size() / 3};
+    for (const tinyobj::shape_t& shape : reader.GetShapes())
+        for (const tinyobj::index_t& ix : shape.mesh.indices) {
+            const int idx[3] = {ix.vertex_index, hasUvs ? ix.texcoord_index : -1,
+                                hasNormals ? ix.normal_index : -1};
+            const char* names[3] = {"vertex", "texture coordinate", "normal"};
+            for (int a = 0; a < 3; ++a)
+                if ((a == 0 && idx[a] < 0) || (idx[a] >= 0 && size_t(idx[a]) >= counts[a])) {
+                    rep.error("a face refers to " + std::string(names[a]) + " " +
+                              std::to_string(idx[a] + 1) + " of " + std::to_string(counts[a]) +
+                              " (expected indices within the file's 'v', 'vt' and 'vn' lines)");
+                    return false;
+                }
+        }
     std::unordered_map<CornerKey, uint32_t, CornerHash> remap;
     TriangleMesh& m = *out;
     for (const tinyobj::shape_t& shape : reader.GetShapes()) {
@@ -325,6 +353,23 @@ bool checkPlyCounts(const std::string& path, Reporter& rep) {
     while (lineNo < 10000 && std::getline(in, line)) {
         ++lineNo;
         headerBytes += line.size() + 1;
+        // Control characters other than tab (and a final CR): the stream reads \v or \f as a
+        // separator, Assimp does not, and it then looks for end_header for ever (found by
+        // fuzz_mesh_ply: "end_header\v0 0 0 ..." hung).
+        // (Not on the first line: Assimp reports a file without the magic itself.)
+        for (size_t i = 0; lineNo > 1 && i < line.size(); ++i) {
+            const unsigned char c = static_cast<unsigned char>(line[i]);
+            if (c < 0x20 && c != '\t' && !(c == '\r' && i + 1 == line.size())) {
+                char hex[8];
+                std::snprintf(hex, sizeof(hex), "0x%02x", unsigned(c));
+                rep.error(std::string("PLY header line has control character ") + hex +
+                              " at column " + std::to_string(i + 1) +
+                              " (expected header lines of printable text, words separated by "
+                              "spaces)",
+                          lineNo, int(i) + 1);
+                return false;
+            }
+        }
         std::istringstream ls(line);
         std::string kw;
         ls >> kw;
@@ -332,11 +377,27 @@ bool checkPlyCounts(const std::string& path, Reporter& rep) {
             ended = true;
             break;
         }
+        // Every header line must be one of PLY's: Assimp 5.2 crashes on some it cannot read
+        // (found by fuzz_mesh_ply: "format binary_comment" and a "propert|" line, SEGV).
         if (kw == "format") {
             std::string f;
             ls >> f;
             ascii = f == "ascii";
-        } else if (kw == "element") {
+            if (f != "ascii" && f != "binary_little_endian" && f != "binary_big_endian") {
+                rep.error("PLY format '" + f +
+                              "' (expected ascii, binary_little_endian or binary_big_endian)",
+                          lineNo);
+                return false;
+            }
+        } else if (lineNo > 1 && !kw.empty() && kw != "element" && kw != "property" &&
+                   kw != "comment" && kw != "obj_info") {
+            rep.error("unknown PLY header line '" + line.substr(0, 40) +
+                          "' (expected format, element, property, comment, obj_info or "
+                          "end_header)",
+                      lineNo);
+            return false;
+        }
+        if (kw == "element") {
             Element e;
             std::string count;
             ls >> e.name >> count;
@@ -354,6 +415,21 @@ bool checkPlyCounts(const std::string& path, Reporter& rep) {
         } else if (kw == "property" && !elements.empty()) {
             std::string type;
             ls >> type;
+            {
+                std::istringstream check(line);
+                std::string k, t1, t2, t3, name;
+                check >> k >> t1;
+                const bool ok = t1 == "list" ? bool(check >> t2 >> t3 >> name) &&
+                                                   scalarBytes(t2) > 0 && scalarBytes(t3) > 0
+                                             : scalarBytes(t1) > 0 && bool(check >> name);
+                if (!ok) {
+                    rep.error("PLY property line '" + line.substr(0, 60) +
+                                  "' (expected 'property TYPE NAME' or 'property list "
+                                  "COUNT_TYPE INDEX_TYPE NAME' with PLY's scalar types)",
+                              lineNo);
+                    return false;
+                }
+            }
             if (ascii) {
                 elements.back().minBytes += 2;
             } else if (type == "list") {
@@ -365,7 +441,26 @@ bool checkPlyCounts(const std::string& path, Reporter& rep) {
             }
         }
     }
-    if (!ended) return true;  // Assimp reports the malformed header
+    if (!ended) {
+        // Without the magic Assimp reports the file as no PLY at all. With it, Assimp 5.2
+        // looks for end_header for ever (found by fuzz_mesh_ply: a 79-byte file hung).
+        in.clear();
+        in.seekg(0);
+        std::string first;
+        std::getline(in, first);
+        // Assimp takes any file starting with these three letters, in any case, for a PLY
+        // (found by fuzz_mesh_ply: "ply" then NUL bytes, and "plY", hung as well).
+        const bool magic = first.size() >= 3 && std::tolower((unsigned char)first[0]) == 'p' &&
+                           std::tolower((unsigned char)first[1]) == 'l' &&
+                           std::tolower((unsigned char)first[2]) == 'y';
+        if (!magic) return true;
+        rep.error("PLY header has no 'end_header' line" +
+                      std::string(lineNo >= 10000 ? " in its first 10000 lines" : "") +
+                      " (expected the element and property lines to end with 'end_header'; "
+                      "truncated or corrupt file?)",
+                  lineNo);
+        return false;
+    }
     const uintmax_t available = fileBytes > headerBytes ? fileBytes - headerBytes : 0;
     uintmax_t needed = 0;
     for (const Element& e : elements) {
