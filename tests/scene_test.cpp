@@ -574,3 +574,41 @@ TEST(Scene, ConcurrentQueriesMatchSerial) {
     }
     EXPECT_GT(hits, n / 2);  // most rays aim at the unit sphere
 }
+
+// Coordinates beyond what the tracer handles are scene errors naming the value; rays built
+// at run time that Embree would reject (NaN, huge) are misses and block shadow rays instead
+// of aborting inside Embree (its `ray.valid()` assertion; issue: a camera at z = 1e9).
+TEST(Scene, OutOfRangeCoordinatesAreErrorsAndBadRaysAreGuarded) {
+    {
+        Scene scene;
+        scene.addSphere({0, 0, 0}, 1, 0, -1, "ball");
+        scene.camera.setup({0.0f, 4294967296.0f, 0.0f}, {0, 0, 0}, {0, 0, 1}, 45.0f, 8, 8);
+        try {
+            scene.commit();
+            ADD_FAILURE() << "no error";
+        } catch (const InputError& e) {
+            const std::string m = e.diagnostics().at(0).format();
+            EXPECT_NE(m.find("camera position"), std::string::npos) << m;
+            EXPECT_NE(m.find("coordinate y = 4294967296"), std::string::npos) << m;
+        }
+    }
+    {
+        Scene scene;
+        scene.addSphere({2e7f, 0, 0}, 1, 0, -1, "far ball");
+        try {
+            scene.commit();
+            ADD_FAILURE() << "no error";
+        } catch (const InputError& e) {
+            EXPECT_NE(e.diagnostics().at(0).format().find("shape 'far ball'"), std::string::npos);
+        }
+    }
+    Scene scene;
+    scene.addSphere({0, 0, 0}, 1, 0, -1, "ball");
+    scene.commit();
+    Hit h;
+    const float nan = std::nanf("");
+    EXPECT_FALSE(scene.intersect(makeRay({nan, 0, 5}, {0, 0, -1}), &h));
+    EXPECT_FALSE(scene.intersect(makeRay({0, 0, 5}, {0, nan, -1}), &h));
+    EXPECT_FALSE(scene.intersect(makeRay({0, 0, 1e19f}, {0, 0, -1}), &h));
+    EXPECT_TRUE(scene.intersect(makeRay({0, 0, 5}, {0, 0, -1}), &h));  // still hits
+}

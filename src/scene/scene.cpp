@@ -50,6 +50,20 @@ namespace ub {
 
 namespace {
 
+/// Embree's own check (RayK::valid): finite origin and direction within 1.844e18, tnear and
+/// tfar not NaN. An invalid ray would abort in Embree's assertion; such rays come only from
+/// NaN arithmetic upstream (a contribution the film's guard drops anyway).
+bool embreeRayValid(const Vec3& o, const Vec3& d, float tNear, float tFar) {
+    const float kLarge = 1.844e18f;
+    for (int a = 0; a < 3; ++a)
+        if (!(std::fabs(o[a]) <= kLarge) || !(std::fabs(d[a]) <= kLarge)) return false;
+    return !std::isnan(tNear) && !std::isnan(tFar);
+}
+
+}  // namespace
+
+namespace {
+
 constexpr float kRayEpsilon = 1e-5f;
 constexpr double kPiD = 3.14159265358979323846;
 
@@ -415,6 +429,36 @@ void Scene::commit() {
             throw InputError(std::move(diags));
         }
     }
+    // Coordinates the tracer handles: Embree asserts |origin| <= 1.8e18 on every ray, and
+    // float's spacing reaches 1 unit at 1.7e7, where the origin offsets of secondary rays
+    // (offsetOrigin) no longer move a point off its surface. Scenes reaching beyond
+    // kMaxCoordinate are rejected with the value; rays built at run time are guarded in
+    // intersect() / occluded().
+    {
+        auto checkPoint = [&](const Vec3& p, const std::string& where) {
+            for (int a = 0; a < 3; ++a)
+                if (!(std::fabs(p[a]) <= kMaxCoordinate)) {
+                    Diagnostic d;
+                    d.file = sourceFile;
+                    d.where = where;
+                    d.message = std::string("coordinate ") + "xyz"[a] + " = " +
+                                std::to_string(p[a]) +
+                                " is out of the range the tracer handles (|value| <= 1e7: "
+                                "beyond it float spacing exceeds 1 unit and rays cannot "
+                                "leave surfaces); scale or move the scene";
+                    throw InputError({d});
+                }
+        };
+        checkPoint(camera.position(), "camera position");
+        for (const ShapeInfo& s : shapes) {
+            if (s.bounds.empty()) continue;
+            checkPoint(s.bounds.lo, "shape '" + s.name + "'");
+            checkPoint(s.bounds.hi, "shape '" + s.name + "'");
+        }
+        for (size_t i = 0; i < lights.size(); ++i)
+            if (lights[i].type == LightType::Point || lights[i].type == LightType::Spot)
+                checkPoint(lights[i].position, "light " + std::to_string(i));
+    }
     rtcCommitScene(impl_->scene);
     impl_->check("building the BVH");
 
@@ -456,6 +500,7 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    if (!embreeRayValid(ray.org, ray.dir, ray.tMin, ray.tMax)) return false;  // e.g. NaN
     rtcIntersect1(impl_->scene, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
 
@@ -520,6 +565,8 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
 namespace {
 
 bool occludedRay(RTCScene scene, const Vec3& org, const Vec3& dir, float tMax) {
+    // A ray Embree would reject (NaN, beyond its range): no light passes it.
+    if (!embreeRayValid(org, dir, 0.0f, tMax)) return true;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRay r;

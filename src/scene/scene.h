@@ -108,6 +108,10 @@ struct ShapeInfo {
     bool imaginary = false;  ///< changes the medium only: never scatters nor emits
 };
 
+/// Largest |coordinate| of the camera, shapes and point lights a scene may have (see
+/// Scene::commit).
+constexpr float kMaxCoordinate = 1e7f;
+
 class Scene {
   public:
     Scene();
