@@ -24,6 +24,9 @@
 // RenderOptions::testFault, which the command-line program never sets.
 #pragma once
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -85,5 +88,25 @@ class ContributionGuard {
 std::string formatRejections(const RejectionCounts& counts);
 /// EXR header attributes: "unibeam.rejected.<technique>" = count, one per technique.
 std::vector<std::pair<std::string, std::string>> rejectionAttributes(const RejectionCounts& counts);
+
+/// Renders one value per pixel in parallel over rows: out(x, y) = trace(x, y) after the
+/// guard, rejections counted per row (rowRejected, resized here) and added to *rejected in row
+/// order, so the count does not depend on the thread count (pt, vpt).
+template <class Image, class Trace>
+void renderGuardedRows(int width, int height, const ContributionGuard& guard,
+                       std::vector<uint64_t>& rowRejected, uint64_t* rejected, Image& out,
+                       Trace&& trace) {
+    rowRejected.assign(size_t(height), 0);
+    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
+        for (int y = r.begin(); y != r.end(); ++y)
+            for (int x = 0; x < width; ++x) {
+                Rgb v = trace(x, y);
+                guard.filter(uint32_t(y) * uint32_t(width) + uint32_t(x), &v,
+                             &rowRejected[size_t(y)]);
+                out.at(x, y) = v;
+            }
+    });
+    for (uint64_t n : rowRejected) *rejected += n;
+}
 
 }  // namespace ub

@@ -48,17 +48,8 @@ void VolPathTracer::renderIteration(int iteration, Image& out) {
     if (out.width != width || out.height != height) out = Image(width, height);
     // Every pixel estimate passes the contribution guard; rejections are counted per row and
     // summed in row order.
-    rowRejected_.assign(size_t(height), 0);
-    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
-        for (int y = r.begin(); y != r.end(); ++y)
-            for (int x = 0; x < width; ++x) {
-                Rgb v = tracePixel(x, y, iteration);
-                guard_.filter(uint32_t(y) * uint32_t(width) + uint32_t(x), &v,
-                              &rowRejected_[size_t(y)]);
-                out.at(x, y) = v;
-            }
-    });
-    for (uint64_t n : rowRejected_) rejected_ += n;
+    renderGuardedRows(width, height, guard_, rowRejected_, &rejected_, out,
+                      [&](int x, int y) { return tracePixel(x, y, iteration); });
 }
 
 Rgb VolPathTracer::tracePixel(int x, int y, int iteration) const {
