@@ -60,8 +60,7 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
         ub_photon_point ph = photons[prims[k]];
         float t = 0.0f;
         if (!ub_pb2d_pair(ph, qb, radius * radius, minLength, maxLength, &t)) continue;
-        ub_segment_eval s =
-            m.homogeneous ? ub_homogeneous_segment(m, t) : ub_grid_segment(gi, &acc, qb, t);
+        ub_segment_eval s = ub_beam_segment(m, gi, &acc, qb, t);
         ub_float3 c = ub_pb2d_contribution(mis, ph, qb, s, t, m.g, normalization);
         sx += c.x;
         sy += c.y;
@@ -92,8 +91,7 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
         ub_beam pb = beams[part.beam];
         float t = 0.0f;
         if (!ub_bp2d_pair(q, pb, part, radius * radius, minLength, maxLength, &t)) continue;
-        ub_segment_eval s =
-            m.homogeneous ? ub_homogeneous_segment(m, t) : ub_grid_segment(gi, &acc, pb, t);
+        ub_segment_eval s = ub_beam_segment(m, gi, &acc, pb, t);
         ub_float3 c = ub_bp2d_contribution(mis, pb, q, s, t, m.g, normalization);
         sx += c.x;
         sy += c.y;
@@ -126,10 +124,8 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
         float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
         if (!ub_bb1d_pair(qb, pb, part, radius * radius, minLength, maxLength, &tc, &tl, &sinTheta))
             continue;
-        ub_segment_eval sl =
-            m.homogeneous ? ub_homogeneous_segment(m, tl) : ub_grid_segment(gi, &acc, pb, tl);
-        ub_segment_eval sc =
-            m.homogeneous ? ub_homogeneous_segment(m, tc) : ub_grid_segment(gi, &acc, qb, tc);
+        ub_segment_eval sl = ub_beam_segment(m, gi, &acc, pb, tl);
+        ub_segment_eval sc = ub_beam_segment(m, gi, &acc, qb, tc);
         ub_float3 c =
             ub_bb1d_contribution(mis, pb, qb, sl, sc, tl, tc, sinTheta, m.g, normalization);
         sx += c.x;

@@ -171,6 +171,13 @@ UB_INLINE ub_segment_eval ub_grid_segment(ub_grid_info g, UB_PRIVATE ub_grid_acc
     return e;
 }
 
+/* The medium along beam b from its piece start to t, whatever kind medium m is: the closed
+ * form in a homogeneous medium, regular tracking through grid g otherwise (the kernels). */
+UB_INLINE ub_segment_eval ub_beam_segment(ub_medium_info m, ub_grid_info g,
+                                          UB_PRIVATE ub_grid_accessor* acc, ub_beam b, float t) {
+    return m.homogeneous ? ub_homogeneous_segment(m, t) : ub_grid_segment(g, acc, b, t);
+}
+
 #ifdef __OPENCL_C_VERSION__
 /* The accessor of medium g's grid in the concatenated grid buffer. */
 UB_INLINE void ub_grid_accessor_init(UB_PRIVATE ub_grid_accessor* acc,
