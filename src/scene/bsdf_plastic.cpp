@@ -202,47 +202,7 @@ float Bsdf::plasticTransmittance(float cosTheta) const {
 }
 
 float Bsdf::plasticSpecularProb(float cosTheta) const {
-    const float reflectance = mat_->type == MaterialType::Plastic
-                                  ? ub_fresnel_dielectric(cosTheta, mat_->ior)
-                                  : 1.0f - plasticTransmittance(cosTheta);
-    const float ps = reflectance * specularWeight_;
-    const float pd = (1.0f - reflectance) * (1.0f - specularWeight_);
-    return ps + pd > 0.0f ? ps / (ps + pd) : 0.0f;
-}
-
-Rgb Bsdf::evalPlastic(const Vec3& gen, float* directPdfW, float* reversePdfW) const {
-    const Vec3& fix = localDirFix_;
-    if (fix.z <= 0.0f || gen.z <= 0.0f) return Rgb(0.0f);
-    const float eta = mat_->ior;
-    const float fresnelGen = ub_fresnel_dielectric(gen.z, eta);
-    *directPdfW = (1.0f - plasticSpecularProb(fix.z)) * ub_lambert_pdf(gen.z);
-    *reversePdfW = (1.0f - plasticSpecularProb(gen.z)) * ub_lambert_pdf(fix.z);
-    return plasticBase_ * ((1.0f - fresnelFix_) * (1.0f - fresnelGen) * kInvPi / (eta * eta));
-}
-
-Rgb Bsdf::evalRoughPlastic(const Vec3& gen, float* directPdfW, float* reversePdfW) const {
-    const Vec3& fix = localDirFix_;
-    if (fix.z <= 0.0f || gen.z <= 0.0f) return Rgb(0.0f);
-    const float eta = mat_->ior, alpha = plasticAlpha(*mat_);
-    // Both directions above the surface: h = normalize(fix + gen) has h.z > 0 and
-    // fix.h = gen.h > 0.
-    const Vec3 h = normalize(fix + gen);
-    const float cosFixH = dot(fix, h), cosGenH = dot(gen, h);
-    const float d = ub_ggx_d(h.z, alpha);
-    const float g = ub_ggx_g2_separable(fix.z, gen.z, alpha);
-    const float fresnel = ub_fresnel_dielectric(cosFixH, eta);
-    const float probSpecFix = plasticSpecularProb(fix.z), probSpecGen = plasticSpecularProb(gen.z);
-    // Visible-normal density times the reflection Jacobian (Walter eq. 14), mixed with the
-    // cosine lobe by the selection probabilities.
-    *directPdfW = probSpecFix * ub_ggx_visible_pdf(fix.z, cosFixH, h.z, alpha) *
-                      ub_jacobian_reflect(cosGenH) +
-                  (1.0f - probSpecFix) * ub_lambert_pdf(gen.z);
-    *reversePdfW = probSpecGen * ub_ggx_visible_pdf(gen.z, cosGenH, h.z, alpha) *
-                       ub_jacobian_reflect(cosFixH) +
-                   (1.0f - probSpecGen) * ub_lambert_pdf(fix.z);
-    const Rgb glossy = colors_.specular * (fresnel * d * g / (4.0f * fix.z * gen.z));
-    const float transmit = plasticTransmittance(fix.z) * plasticTransmittance(gen.z);
-    return glossy + plasticBase_ * (transmit * kInvPi / (eta * eta));
+    return ub_bsdf_plastic_specular_prob(&shared_, coating_, cosTheta);
 }
 
 }  // namespace ub
