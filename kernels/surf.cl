@@ -18,23 +18,39 @@ __kernel void ub_surf_estimate(__global const ub_light_vertex* photons,
                                __global float* out) {
     uint i = get_global_id(0);
     if (i >= queryCount) return;
-    ub_surface_query q = queries[i];
-    __global const float* coating = tables + UB_ROUGH_PLASTIC_TABLE_SIZE * q.bsdf.tableIndex;
+    /* The query (240 bytes) and a photon (112 bytes) are copied to private memory only for a
+     * photon within the radius: most candidates of a bucket are farther. ub_surf_contribution
+     * tests the distance again, the same test as the host twin's grid query. */
+    __global const ub_surface_query* gq = queries + i;
+    ub_float3 qp = ub_make_float3(gq->pos[0], gq->pos[1], gq->pos[2]);
+    float r2 = radius * radius;
+    ub_surface_query q;
+    int loaded = 0;
     ub_uint buckets[8];
-    int nb = ub_hash_buckets(grid, ub_f3_from(q.pos), buckets);
+    int nb = ub_hash_buckets(grid, qp, buckets);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     for (int k = 0; k < nb; ++k) {
         uint b = buckets[k];
         uint begin = b == 0 ? 0u : cellEnds[b - 1], end = cellEnds[b];
         for (uint j = begin; j < end; ++j) {
-            ub_light_vertex lv = photons[indices[j]];
-            ub_float3 c = ub_surf_contribution(mis, &lv, &q, coating, radius * radius, minLength,
-                                               maxLength, 0u);
+            __global const ub_light_vertex* gp = photons + indices[j];
+            float dx = gp->position[0] - qp.x, dy = gp->position[1] - qp.y,
+                  dz = gp->position[2] - qp.z;
+            if (dx * dx + dy * dy + dz * dz > r2) continue;
+            if (!loaded) {
+                q = *gq;
+                loaded = 1;
+            }
+            ub_light_vertex lv = *gp;
+            __global const float* coating =
+                tables + UB_ROUGH_PLASTIC_TABLE_SIZE * q.bsdf.tableIndex;
+            ub_float3 c = ub_surf_contribution(mis, &lv, &q, coating, r2, minLength, maxLength, 0u);
             sx += c.x;
             sy += c.y;
             sz += c.z;
         }
     }
-    ub_store_f3(out, i, sx * q.throughput[0] * normalization, sy * q.throughput[1] * normalization,
-                sz * q.throughput[2] * normalization);
+    float tx = loaded ? q.throughput[0] : 0.0f, ty = loaded ? q.throughput[1] : 0.0f,
+          tz = loaded ? q.throughput[2] : 0.0f;
+    ub_store_f3(out, i, sx * tx * normalization, sy * ty * normalization, sz * tz * normalization);
 }

@@ -156,11 +156,14 @@ void expandIncludes(const std::string& name, std::set<std::string>& done, std::s
 }
 
 /// A device buffer copied from host data (at least one element, so empty inputs work).
-cl_mem upload(cl_context ctx, const void* data, size_t bytes) {
+/// A read-only buffer with a copy of data, or (useHost: a CPU device, data alive until the
+/// kernel has run) over the host memory itself, which saves the copy on a CPU device.
+cl_mem upload(cl_context ctx, const void* data, size_t bytes, bool useHost = false) {
     cl_int err = CL_SUCCESS;
     static const uint32_t dummy = 0;
-    cl_mem m = clCreateBuffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                              bytes > 0 ? bytes : sizeof(dummy),
+    const cl_mem_flags flags =
+        CL_MEM_READ_ONLY | (useHost && bytes > 0 ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR);
+    cl_mem m = clCreateBuffer(ctx, flags, bytes > 0 ? bytes : sizeof(dummy),
                               const_cast<void*>(bytes > 0 ? data : &dummy), &err);
     check(err, "clCreateBuffer");
     return m;
@@ -462,7 +465,8 @@ void ClRuntime::runEstimate(cl_kernel kernel, const char* name, const std::vecto
         if (x.mem) {
             check(clSetKernelArg(kernel, index++, sizeof(cl_mem), &x.mem), "clSetKernelArg");
         } else if (x.buffer) {
-            cl_mem m = upload(context_, x.data, x.bytes);
+            // On a CPU device the kernel reads the lookups in place (they outlive this call).
+            cl_mem m = upload(context_, x.data, x.bytes, desc_.type == "CPU");
             fixedMems.mems.push_back(m);
             check(clSetKernelArg(kernel, index++, sizeof(cl_mem), &m), "clSetKernelArg");
         } else {
@@ -493,7 +497,9 @@ void ClRuntime::runEstimate(cl_kernel kernel, const char* name, const std::vecto
         MemList batchMems;
         cl_int err = CL_SUCCESS;
         const char* step = "clCreateBuffer(queries)";
-        cl_mem q = clCreateBuffer(context_, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, n * querySize,
+        const cl_mem_flags queryFlags =
+            CL_MEM_READ_ONLY | (desc_.type == "CPU" ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR);
+        cl_mem q = clCreateBuffer(context_, queryFlags, n * querySize,
                                   const_cast<char*>(base + begin * querySize), &err);
         if (err == CL_SUCCESS) {
             batchMems.mems.push_back(q);
