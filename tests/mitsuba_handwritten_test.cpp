@@ -50,8 +50,9 @@ std::string caseName(const ::testing::TestParamInfo<HandCase>& info) {
 // finds them by light tracing (measured: bpt +1% over the image, z = 19-27, max per-pixel
 // |z| 45 under the glass sphere). That is the reference missing light, not unibeam adding it.
 const HandCase kCases[] = {
-    {"surfaces", "pt", 512}, {"surfaces", "bpt", 256}, {"lights", "pt", 512},
-    {"media", "vpt", 256},   {"media", "vbpt", 128},
+    {"surfaces", "pt", 512},  {"surfaces", "bpt", 256}, {"lights", "pt", 512},
+    {"media", "vpt", 256},    {"media", "vbpt", 128},   {"beckmann", "pt", 512},
+    {"beckmann", "bpt", 256},
 };
 
 class MitsubaHandWritten : public ::testing::TestWithParam<HandCase> {};

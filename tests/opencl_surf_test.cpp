@@ -6,8 +6,9 @@
 // order; the device compiler may contract multiply-adds differently and its pow/sqrt may
 // differ in the last ulp). The queries cover every material type with a density (diffuse,
 // Phong, rough conductor with both masking forms, rough dielectric from both sides, plastic,
-// rough plastic with its coating table) and a delta one (mirror: zero), with the geometric
-// guard on and off and perturbed shading normals. A missing OpenCL platform fails the test.
+// rough plastic with its coating table, Beckmann conductor and plastic) and a delta one (mirror:
+// zero), with the geometric guard on and off and perturbed shading normals. A missing OpenCL
+// platform fails the test.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -29,7 +30,7 @@ Vec3 randomUnit(Rng& rng) {
 }
 
 std::vector<Material> testMaterials() {
-    std::vector<Material> mats(9);
+    std::vector<Material> mats(11);
     mats[0].type = MaterialType::Diffuse;
     mats[0].diffuse = Rgb(0.7f, 0.5f, 0.3f);
     mats[1].type = MaterialType::Phong;
@@ -54,6 +55,12 @@ std::vector<Material> testMaterials() {
     mats[7].type = MaterialType::Mirror;
     mats[8].type = MaterialType::Diffuse;  // one-sided: black from the back
     mats[8].twoSided = false;
+    mats[9].type = MaterialType::RoughConductor;  // Beckmann microfacets
+    mats[9].alpha = 0.3f;
+    mats[9].distribution = MicrofacetDistribution::kBeckmann;
+    mats[10].type = MaterialType::RoughPlastic;
+    mats[10].alpha = 0.25f;
+    mats[10].distribution = MicrofacetDistribution::kBeckmann;
     for (Material& m : mats) prepareMaterial(m);
     return mats;
 }

@@ -7,10 +7,9 @@
  * Lobes and references (details in src/scene/bsdf.cpp and bsdf_plastic.cpp):
  *   Diffuse, Phong   Lambert rho/pi plus the modified Phong lobe (Lafortune & Willems
  *                    1994), mixture pdf by lobe-selection probabilities (SmallVCM);
- *   RoughConductor   GGX, Walter et al. 2007 eq. 20, visible-normal pdf (Heitz 2018)
- *                    times the reflection Jacobian (Walter eq. 14);
- *   RoughDielectric  Walter et al. 2007 eq. 20 (reflection) and eq. 21 (refraction,
- *                    Jacobian eq. 17), Fresnel lobe selection;
+ *   RoughConductor   GGX or Beckmann (ub_microfacet.h), Walter et al. 2007 eq. 20, visible-normal
+ * pdf (Heitz 2018) times the reflection Jacobian (Walter eq. 14); RoughDielectric  Walter et al.
+ * 2007 eq. 20 (reflection) and eq. 21 (refraction, Jacobian eq. 17), Fresnel lobe selection;
  *   Plastic, RoughPlastic  Mitsuba 3's coated diffuse (kernels/shared/ub_plastic.h).
  * Delta lobes (Mirror, Dielectric, ThinDielectric, the plastic coating) have no density:
  * they are sampled on the host only and evaluate to zero here.
@@ -44,8 +43,9 @@
 #define UB_BSDF_FROM_LIGHT 2u      /* light subpath: importance transport (bsdf.h) */
 #define UB_BSDF_GEOMETRIC_GUARD 4u /* the geometric-normal guard is on (bsdf.h) */
 #define UB_BSDF_SEPARABLE 8u       /* separable Smith G2 for GGX reflection (Material) */
+#define UB_BSDF_BECKMANN 16u       /* Beckmann microfacets instead of GGX */
 
-/* Smallest GGX roughness used (alpha -> 0 is a delta lobe floats cannot represent). */
+/* Smallest microfacet roughness used (alpha -> 0 is a delta lobe floats cannot represent). */
 #define UB_MIN_GGX_ALPHA 1e-4f
 /* |cos| below which a direction counts as grazing (no evaluation). */
 #define UB_EPS_COSINE 1e-6f
@@ -77,6 +77,11 @@ typedef struct {
     ub_uint tableIndex;   /* rough plastic: the material whose coating table applies */
     float pad0, pad1;
 } ub_bsdf;
+
+/* The microfacet distribution of b (UB_MF_*). */
+UB_INLINE ub_uint ub_bsdf_distribution(UB_PRIVATE const ub_bsdf* b) {
+    return (b->flags & UB_BSDF_BECKMANN) ? UB_MF_BECKMANN : UB_MF_GGX;
+}
 
 UB_INLINE ub_float3 ub_bsdf_to_local(UB_PRIVATE const ub_bsdf* b, ub_float3 v) {
     return ub_make_float3(v.x * b->frameS[0] + v.y * b->frameS[1] + v.z * b->frameS[2],
@@ -143,17 +148,20 @@ UB_INLINE ub_float3 ub_bsdf_eval_phong(UB_PRIVATE const ub_bsdf* b, ub_float3 ge
 UB_INLINE ub_float3 ub_bsdf_eval_rough_conductor(UB_PRIVATE const ub_bsdf* b, ub_float3 gen,
                                                  UB_PRIVATE float* directPdfW,
                                                  UB_PRIVATE float* reversePdfW) {
+    ub_uint dist = ub_bsdf_distribution(b);
     ub_float3 fix = ub_f3_from(b->localFix);
     if (fix.z <= 0.0f || gen.z <= 0.0f) return ub_make_float3(0.0f, 0.0f, 0.0f);
     float alpha = ub_fmax(b->alpha, UB_MIN_GGX_ALPHA);
     ub_float3 h = ub_f3_normalize(ub_f3_add(fix, gen)); /* h.z > 0, fix.h = gen.h > 0 */
     float cosFixH = ub_f3_dot(fix, h), cosGenH = ub_f3_dot(gen, h);
-    float d = ub_ggx_d(h.z, alpha);
-    float g2 = (b->flags & UB_BSDF_SEPARABLE) ? ub_ggx_g2_separable(fix.z, gen.z, alpha)
-                                              : ub_ggx_g2_correlated(fix.z, gen.z, alpha);
+    float d = ub_mf_d(dist, h.z, alpha);
+    float g2 = (b->flags & UB_BSDF_SEPARABLE) ? ub_mf_g2_separable(dist, fix.z, gen.z, alpha)
+                                              : ub_mf_g2_correlated(dist, fix.z, gen.z, alpha);
     /* visible-normal density times the reflection Jacobian (Walter et al. 2007, eq. 14) */
-    *directPdfW = ub_ggx_visible_pdf(fix.z, cosFixH, h.z, alpha) * ub_jacobian_reflect(cosGenH);
-    *reversePdfW = ub_ggx_visible_pdf(gen.z, cosGenH, h.z, alpha) * ub_jacobian_reflect(cosFixH);
+    *directPdfW =
+        ub_mf_visible_pdf(dist, fix.z, cosFixH, h.z, alpha) * ub_jacobian_reflect(cosGenH);
+    *reversePdfW =
+        ub_mf_visible_pdf(dist, gen.z, cosGenH, h.z, alpha) * ub_jacobian_reflect(cosFixH);
     /* Walter et al. 2007, eq. 20: F D G / (4 |i.n| |o.n|) */
     float s = d * g2 / (4.0f * fix.z * gen.z);
     return ub_make_float3(b->specular[0] * ub_fresnel_conductor(cosFixH, b->eta[0], b->k[0]) * s,
@@ -164,6 +172,7 @@ UB_INLINE ub_float3 ub_bsdf_eval_rough_conductor(UB_PRIVATE const ub_bsdf* b, ub
 UB_INLINE ub_float3 ub_bsdf_eval_rough_dielectric(UB_PRIVATE const ub_bsdf* b, ub_float3 gen,
                                                   UB_PRIVATE float* directPdfW,
                                                   UB_PRIVATE float* reversePdfW) {
+    ub_uint dist = ub_bsdf_distribution(b);
     ub_float3 fix = ub_f3_from(b->localFix);
     ub_float3 zero = ub_make_float3(0.0f, 0.0f, 0.0f);
     float alpha = ub_fmax(b->alpha, UB_MIN_GGX_ALPHA);
@@ -181,17 +190,17 @@ UB_INLINE ub_float3 ub_bsdf_eval_rough_dielectric(UB_PRIVATE const ub_bsdf* b, u
     if (cosFixH * fix.z <= 0.0f || cosGenH * gen.z <= 0.0f) return zero;
     float cFix = ub_fabs(fix.z), cGen = ub_fabs(gen.z);
     float aFix = ub_fabs(cosFixH), aGen = ub_fabs(cosGenH);
-    float d = ub_ggx_d(h.z, alpha);
-    float visFix = ub_ggx_visible_pdf(cFix, aFix, h.z, alpha);
-    float visGen = ub_ggx_visible_pdf(cGen, aGen, h.z, alpha);
+    float d = ub_mf_d(dist, h.z, alpha);
+    float visFix = ub_mf_visible_pdf(dist, cFix, aFix, h.z, alpha);
+    float visGen = ub_mf_visible_pdf(dist, cGen, aGen, h.z, alpha);
     float etaRel = b->etaOther / b->etaFix;
     if (reflect) {
         float fresnelFix = ub_fresnel_dielectric(aFix, etaRel);
         float fresnelGen = ub_fresnel_dielectric(aGen, etaRel);
         *directPdfW = fresnelFix * visFix * ub_jacobian_reflect(aGen);
         *reversePdfW = fresnelGen * visGen * ub_jacobian_reflect(aFix);
-        float g2 = (b->flags & UB_BSDF_SEPARABLE) ? ub_ggx_g2_separable(cFix, cGen, alpha)
-                                                  : ub_ggx_g2_correlated(cFix, cGen, alpha);
+        float g2 = (b->flags & UB_BSDF_SEPARABLE) ? ub_mf_g2_separable(dist, cFix, cGen, alpha)
+                                                  : ub_mf_g2_correlated(dist, cFix, cGen, alpha);
         /* F at the mean of fix.h and gen.h (equal in exact arithmetic) keeps f(fix, gen) =
          * f(gen, fix) bit for bit; the pdfs keep F(fix.h), what the sampler used */
         float fresnelSym = ub_fresnel_dielectric(0.5f * (aFix + aGen), etaRel);
@@ -207,7 +216,7 @@ UB_INLINE ub_float3 ub_bsdf_eval_rough_dielectric(UB_PRIVATE const ub_bsdf* b, u
     /* Walter eq. 21 with o the camera side: eta_o = etaFix for radiance, etaGen for
      * importance (the adjoint BTDF) */
     float etaO = (b->flags & UB_BSDF_FROM_LIGHT) ? etaGen : b->etaFix;
-    float g2 = ub_ggx_g2_separable(cFix, cGen, alpha);
+    float g2 = ub_mf_g2_separable(dist, cFix, cGen, alpha);
     return ub_f3_scale(ub_f3_from(b->specular),
                        transmit * d * g2 * aFix * aGen * etaO * etaO / (cFix * cGen * denom));
 }
@@ -232,21 +241,22 @@ UB_INLINE ub_float3 ub_bsdf_eval_rough_plastic(UB_PRIVATE const ub_bsdf* b,
                                                UB_GLOBAL const float* coating, ub_float3 gen,
                                                UB_PRIVATE float* directPdfW,
                                                UB_PRIVATE float* reversePdfW) {
+    ub_uint dist = ub_bsdf_distribution(b);
     ub_float3 fix = ub_f3_from(b->localFix);
     if (fix.z <= 0.0f || gen.z <= 0.0f) return ub_make_float3(0.0f, 0.0f, 0.0f);
     float eta = b->ior, alpha = ub_fmax(b->alpha, UB_MIN_GGX_ALPHA);
     ub_float3 h = ub_f3_normalize(ub_f3_add(fix, gen));
     float cosFixH = ub_f3_dot(fix, h), cosGenH = ub_f3_dot(gen, h);
-    float d = ub_ggx_d(h.z, alpha);
-    float g = ub_ggx_g2_separable(fix.z, gen.z, alpha);
+    float d = ub_mf_d(dist, h.z, alpha);
+    float g = ub_mf_g2_separable(dist, fix.z, gen.z, alpha);
     float fresnel = ub_fresnel_dielectric(cosFixH, eta);
     float probSpecFix = ub_bsdf_plastic_specular_prob(b, coating, fix.z);
     float probSpecGen = ub_bsdf_plastic_specular_prob(b, coating, gen.z);
     /* Walter et al. 2007 eq. 14 for the coating, mixed with the cosine lobe */
-    *directPdfW = probSpecFix * ub_ggx_visible_pdf(fix.z, cosFixH, h.z, alpha) *
+    *directPdfW = probSpecFix * ub_mf_visible_pdf(dist, fix.z, cosFixH, h.z, alpha) *
                       ub_jacobian_reflect(cosGenH) +
                   (1.0f - probSpecFix) * ub_lambert_pdf(gen.z);
-    *reversePdfW = probSpecGen * ub_ggx_visible_pdf(gen.z, cosGenH, h.z, alpha) *
+    *reversePdfW = probSpecGen * ub_mf_visible_pdf(dist, gen.z, cosGenH, h.z, alpha) *
                        ub_jacobian_reflect(cosFixH) +
                    (1.0f - probSpecGen) * ub_lambert_pdf(fix.z);
     float glossy = fresnel * d * g / (4.0f * fix.z * gen.z);

@@ -55,6 +55,7 @@
 #include "kernels/shared/ub_fresnel.h"
 #include "kernels/shared/ub_microfacet.h"
 #include "kernels/shared/ub_phong.h"
+#include "scene/microfacet_sampling.h"
 
 namespace ub {
 
@@ -212,7 +213,8 @@ void Bsdf::packShared() {
     b.flags = (valid_ && !isDelta_ && !black_ ? UB_BSDF_EVALUABLE : 0u) |
               (fromLight_ ? UB_BSDF_FROM_LIGHT : 0u) |
               (geometricGuard_ ? UB_BSDF_GEOMETRIC_GUARD : 0u) |
-              (m.separableMasking ? UB_BSDF_SEPARABLE : 0u);
+              (m.separableMasking ? UB_BSDF_SEPARABLE : 0u) |
+              (m.distribution == MicrofacetDistribution::kBeckmann ? UB_BSDF_BECKMANN : 0u);
     b.cosGeoFix = cosGeoFix_;
     b.exponent = m.exponent;
     b.alpha = m.alpha;
@@ -269,9 +271,8 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
             }
             break;
         case MaterialType::RoughConductor: {
-            Vec3 m;
-            ub_ggx_sample_visible(fix.x, fix.y, fix.z, ggxAlpha(*mat_), rnd.x, rnd.y, &m.x, &m.y,
-                                  &m.z);
+            const Vec3 m = sampleVisibleNormal(uint32_t(mat_->distribution), fix, ggxAlpha(*mat_),
+                                               rnd.x, rnd.y);
             gen = 2.0f * dot(fix, m) * m - fix;
             break;
         }
@@ -284,9 +285,8 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
             break;
         case MaterialType::RoughPlastic:
             if (rnd.z < plasticSpecularProb(fix.z)) {
-                Vec3 m;
-                ub_ggx_sample_visible(fix.x, fix.y, fix.z, ggxAlpha(*mat_), rnd.x, rnd.y, &m.x,
-                                      &m.y, &m.z);
+                const Vec3 m = sampleVisibleNormal(uint32_t(mat_->distribution), fix,
+                                                   ggxAlpha(*mat_), rnd.x, rnd.y);
                 gen = 2.0f * dot(fix, m) * m - fix;
             } else {
                 gen = sampleCosineHemisphere(Vec2(rnd.x, rnd.y));
@@ -297,9 +297,8 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
             // Work mirrored to dirFix's side (GGX is symmetric under z -> -z).
             const float side = fix.z < 0.0f ? -1.0f : 1.0f;
             const Vec3 fixUp(fix.x, fix.y, side * fix.z);
-            Vec3 m;
-            ub_ggx_sample_visible(fixUp.x, fixUp.y, fixUp.z, ggxAlpha(*mat_), rnd.x, rnd.y, &m.x,
-                                  &m.y, &m.z);
+            const Vec3 m = sampleVisibleNormal(uint32_t(mat_->distribution), fixUp, ggxAlpha(*mat_),
+                                               rnd.x, rnd.y);
             const float cosI = dot(fixUp, m);
             float cosT;
             const float fresnel = ub_fresnel_dielectric_ct(cosI, etaOther_ / etaFix_, &cosT);

@@ -52,6 +52,7 @@
 #include "kernels/shared/ub_phong.h"
 #include "kernels/shared/ub_plastic.h"
 #include "scene/bsdf.h"
+#include "scene/microfacet_sampling.h"
 
 namespace ub {
 
@@ -102,7 +103,7 @@ void gaussLegendre(int n, std::vector<double>* nodes, std::vector<double>* weigh
 /// wi's side) reflects (transmit = false) or transmits (true) for wi = (sin, 0, mu),
 /// single scattering: E over visible normals of F or 1 - F, times G1 of the outgoing
 /// direction, zero where it leaves on the wrong side.
-double roughInterfaceEnergy(float mu, float eta, float alpha, bool transmit) {
+double roughInterfaceEnergy(float mu, float eta, float alpha, uint32_t dist, bool transmit) {
     std::vector<double> nodes, weights;
     gaussLegendre(eta > 1.0f ? 32 : 128, &nodes, &weights);
     const Vec3 wi(std::sqrt(std::max(0.0f, 1.0f - mu * mu)), 0.0f, mu);
@@ -110,8 +111,7 @@ double roughInterfaceEnergy(float mu, float eta, float alpha, bool transmit) {
     for (size_t a = 0; a < nodes.size(); ++a)
         for (size_t b = 0; b < nodes.size(); ++b) {
             const float u1 = float(0.5 * nodes[a] + 0.5), u2 = float(0.5 * nodes[b] + 0.5);
-            Vec3 m;
-            ub_ggx_sample_visible(wi.x, wi.y, wi.z, alpha, u1, u2, &m.x, &m.y, &m.z);
+            const Vec3 m = sampleVisibleNormal(dist, wi, alpha, u1, u2);
             const float cosI = dot(wi, m);
             if (!(cosI > 0.0f)) continue;
             float cosT;
@@ -122,11 +122,11 @@ double roughInterfaceEnergy(float mu, float eta, float alpha, bool transmit) {
                 // Snell with relative IOR eta: t = -wi / eta + (cosI / eta - cosT) m.
                 const Vec3 wo = -wi / eta + (cosI / eta - cosT) * m;
                 if (!(wo.z < 0.0f)) continue;
-                value = (1.0 - fresnel) * ub_ggx_g1(-wo.z, alpha);
+                value = (1.0 - fresnel) * ub_mf_g1(dist, -wo.z, alpha);
             } else {
                 const Vec3 wo = 2.0f * cosI * m - wi;
                 if (!(wo.z > 0.0f)) continue;
-                value = fresnel * ub_ggx_g1(wo.z, alpha);
+                value = fresnel * ub_mf_g1(dist, wo.z, alpha);
             }
             sum += value * weights[a] * weights[b] * 0.25;
         }
@@ -142,13 +142,14 @@ void prepareMaterial(Material& m) {
             break;
         case MaterialType::RoughPlastic: {
             const float alpha = plasticAlpha(m);
+            const uint32_t dist = uint32_t(m.distribution);
             const int n = UB_ROUGH_PLASTIC_TABLE_SIZE;
             double internal = 0.0;
             for (int k = 0; k < n; ++k) {
                 const float mu = std::max(1e-6f, float(k) / float(n - 1));
                 m.coatingTransmittance[size_t(k)] =
-                    float(roughInterfaceEnergy(mu, m.ior, alpha, true));
-                internal += roughInterfaceEnergy(mu, 1.0f / m.ior, alpha, false) * mu;
+                    float(roughInterfaceEnergy(mu, m.ior, alpha, dist, true));
+                internal += roughInterfaceEnergy(mu, 1.0f / m.ior, alpha, dist, false) * mu;
             }
             m.internalReflectance = float(2.0 * internal / n);
             break;
@@ -158,6 +159,7 @@ void prepareMaterial(Material& m) {
     }
     m.preparedIor = m.ior;
     m.preparedAlpha = m.alpha;
+    m.preparedDistribution = m.distribution;
 }
 
 // ---- Bsdf members ------------------------------------------------------------------
@@ -171,7 +173,8 @@ void Bsdf::setupPlastic() {
                                  colors_.transmittance * (1.0f - fresnelFix_));
         return;
     }
-    if (mat.preparedIor != mat.ior || mat.preparedAlpha != mat.alpha)
+    if (mat.preparedIor != mat.ior || mat.preparedAlpha != mat.alpha ||
+        mat.preparedDistribution != mat.distribution)
         throw std::logic_error("Bsdf::setup: plastic material '" + mat.name +
                                "' was not prepared (call prepareMaterial after setting ior/alpha)");
     const float meanDiffuse = mean3(colors_.diffuse), meanSpecular = mean3(colors_.specular);
