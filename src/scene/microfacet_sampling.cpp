@@ -21,11 +21,11 @@ namespace {
 
 constexpr double kSqrtPi = 1.7724538509055160273;
 
-/// Solves f(x) = target for x in [lo, hi], f increasing with derivative df; Newton steps,
-/// bisection when a step leaves the bracket, to |dx| < 1e-13.
+/// Solves f(x) = target for x in [lo, hi], f increasing with derivative df, from the guess
+/// x0: Newton steps, bisection when a step leaves the bracket, to |dx| < 1e-11.
 template <class F, class DF>
-double solveIncreasing(F f, DF df, double target, double lo, double hi) {
-    double x = 0.5 * (lo + hi);
+double solveIncreasing(F f, DF df, double target, double lo, double hi, double x0) {
+    double x = x0 > lo && x0 < hi ? x0 : 0.5 * (lo + hi);
     for (int i = 0; i < 200; ++i) {
         const double v = f(x) - target;
         if (v > 0.0)
@@ -33,12 +33,25 @@ double solveIncreasing(F f, DF df, double target, double lo, double hi) {
         else
             lo = x;
         const double d = df(x);
+        if (v == 0.0) return x;
         double next = d > 0.0 ? x - v / d : 0.5 * (lo + hi);
+        if (std::fabs(next - x) < 1e-11) return next;  // converged (before the bracket test:
+                                                       // a last step may touch its ends)
         if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-        if (std::fabs(next - x) < 1e-13 || hi - lo < 1e-13) return next;
+        if (hi - lo < 1e-11) return next;
         x = next;
     }
     return x;
+}
+
+/// A starting point for Newton: Winitzki's closed-form approximation of erfinv(t), relative
+/// error below 2e-3 (S. Winitzki 2008, "A handy approximation for the error function and its
+/// inverse", eq. 7 inverted, a = 0.147).
+double erfinvGuess(double t) {
+    t = std::min(std::max(t, -1.0 + 1e-15), 1.0 - 1e-15);
+    const double a = 0.147, ln = std::log(1.0 - t * t);
+    const double b = 2.0 / (3.14159265358979323846 * a) + 0.5 * ln;
+    return std::copysign(std::sqrt(std::sqrt(b * b - ln / a) - b), t);
 }
 
 }  // namespace
@@ -47,7 +60,7 @@ double inverseNormalCdfErf(double u) {
     const double target = 2.0 * u - 1.0;
     return solveIncreasing([](double x) { return std::erf(x); },
                            [](double x) { return 2.0 / kSqrtPi * std::exp(-x * x); }, target, -9.0,
-                           9.0);
+                           9.0, erfinvGuess(target));
 }
 
 Vec3 sampleVisibleNormal(uint32_t dist, const Vec3& v, float alpha, float u1, float u2) {
@@ -78,7 +91,9 @@ Vec3 sampleVisibleNormal(uint32_t dist, const Vec3& v, float alpha, float u1, fl
     auto pdf = [&](double x) { return (cosTheta - x * sinTheta) * std::exp(-x * x); };
     const double lo = -9.0, total = cdf(xMax), base = cdf(lo);
     const double target = base + double(u1) * (total - base);
-    const double slopeX = solveIncreasing(cdf, pdf, target, lo, xMax);
+    // Guess: the Gaussian the slopes follow at normal incidence.
+    const double slopeX = solveIncreasing(
+        cdf, pdf, target, lo, xMax, std::min(erfinvGuess(2.0 * double(u1) - 1.0), xMax - 1e-3));
     const double slopeY = inverseNormalCdfErf(std::min(std::max(double(u2), 1e-300), 1.0 - 1e-16));
     // Steps 3-4: rotate by phi, unstretch, and turn the slope into a normal.
     const double rx = cosPhi * slopeX - sinPhi * slopeY;
