@@ -6,7 +6,8 @@
 // order; the device compiler may contract multiply-adds differently and its pow/sqrt may
 // differ in the last ulp). The queries cover every material type with a density (diffuse,
 // Phong, rough conductor with both masking forms, rough dielectric from both sides, plastic,
-// rough plastic with its coating table, Beckmann conductor and plastic) and a delta one (mirror:
+// rough plastic with its coating table, Beckmann conductor and plastic, SmallUPBP's multi-lobe
+// material with and without refraction) and a delta one (mirror:
 // zero), with the geometric guard on and off and perturbed shading normals. A missing OpenCL
 // platform fails the test.
 #include <gtest/gtest.h>
@@ -30,7 +31,7 @@ Vec3 randomUnit(Rng& rng) {
 }
 
 std::vector<Material> testMaterials() {
-    std::vector<Material> mats(11);
+    std::vector<Material> mats(13);
     mats[0].type = MaterialType::Diffuse;
     mats[0].diffuse = Rgb(0.7f, 0.5f, 0.3f);
     mats[1].type = MaterialType::Phong;
@@ -61,6 +62,16 @@ std::vector<Material> testMaterials() {
     mats[10].type = MaterialType::RoughPlastic;
     mats[10].alpha = 0.25f;
     mats[10].distribution = MicrofacetDistribution::kBeckmann;
+    mats[11].type = MaterialType::MultiLobe;  // SmallUPBP's lobes with refraction
+    mats[11].diffuse = Rgb(0.3f, 0.2f, 0.1f);
+    mats[11].glossy = Rgb(0.2f);
+    mats[11].exponent = 20.0f;
+    mats[11].specular = Rgb(0.8f);
+    mats[11].refract = true;
+    mats[11].ior = 1.4f;
+    mats[12].type = MaterialType::MultiLobe;  // and without
+    mats[12].diffuse = Rgb(0.4f);
+    mats[12].specular = Rgb(0.3f);
     for (Material& m : mats) prepareMaterial(m);
     return mats;
 }

@@ -225,6 +225,39 @@ TEST(JsonLoaderErrors, TexturedPhongEnergyUsesMaxima) {
         << d[0].format();
 }
 
+// multi_lobe (SmallUPBP's sum of lobes): the lobes are read; a material whose lobes add up
+// to more than 1 is an error unless allow_energy_gain says it is meant.
+TEST(JsonLoader, MultiLobeMaterialAndItsEnergyCheck) {
+    const std::string ok = R"json(
+"wax": {"type": "multi_lobe", "diffuse_reflectance": 0.588, "ior": 1.0, "allow_energy_gain": true},
+"lacquer": {"type": "multi_lobe", "diffuse_reflectance": 0.3, "glossy_reflectance": 0.2, "exponent": 40, "mirror_reflectance": 0.4})json";
+    const std::string shapes = R"json({"type": "rectangle", "material": "wax"},
+{"type": "sphere", "radius": 0.5, "material": "lacquer"})json";
+    auto s = loadJsonSceneFromString(sceneWith(ok, shapes, kPoint), "scene.json", ".");
+    ASSERT_EQ(s->materials.size(), 2u);
+    for (const Material& m : s->materials) {
+        EXPECT_EQ(m.type, MaterialType::MultiLobe);
+        if (m.name == "wax") {
+            EXPECT_TRUE(m.refract);
+            EXPECT_FLOAT_EQ(m.ior, 1.0f);
+            EXPECT_FLOAT_EQ(m.diffuse.x, 0.588f);
+        } else {
+            EXPECT_FALSE(m.refract);
+            EXPECT_FLOAT_EQ(m.specular.y, 0.4f);
+            EXPECT_FLOAT_EQ(m.exponent, 40.0f);
+        }
+    }
+    const std::string gain = R"json(
+"w": {"type": "multi_lobe", "diffuse_reflectance": 0.5, "ior": 1.3})json";
+    auto d =
+        errorsOf(sceneWith(gain, R"json({"type": "rectangle", "material": "w"})json", kPoint), ".");
+    ASSERT_EQ(d.size(), 1u) << allErrors(d);
+    EXPECT_TRUE(contains(d[0].format(),
+                         "at /materials/w: the lobes add up to an albedo of 1.5 in the red "
+                         "channel (diffuse + glossy + refraction 1)"))
+        << d[0].format();
+}
+
 TEST(JsonLoaderErrors, PlasticAndThinDielectricErrors) {
     const std::string materials = R"json(
 "r": {"type": "rough_plastic", "int_ior": 1.3, "ext_ior": 1.3, "alpha": 0},

@@ -241,7 +241,9 @@ TEST(SmallUpbpLoader, TinySceneMapsMaterialsMediaAndLights) {
     EXPECT_TRUE(w.empty()) << allMessages(w);
     ASSERT_EQ(s->materials.size(), 3u);
     EXPECT_EQ(s->materials[0].type, MaterialType::Diffuse);
-    EXPECT_EQ(s->materials[1].type, MaterialType::Dielectric);
+    // ior >= 0: SmallUPBP's lobes with refraction (MultiLobe, every lobe kept).
+    EXPECT_EQ(s->materials[1].type, MaterialType::MultiLobe);
+    EXPECT_TRUE(s->materials[1].refract);
     EXPECT_EQ(s->materials[1].ior, 1.5f);
     ASSERT_EQ(s->shapes.size(), 3u);
     EXPECT_EQ(s->shapes[0].triangleCount, 2u);  // the quad, fanned

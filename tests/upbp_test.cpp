@@ -321,10 +321,15 @@ void expectAgreesOnSmallUpbpScene(const SmallUpbpCase& c) {
     std::snprintf(what, sizeof(what), "%s (%gx radii)", c.file, double(c.radiusScale));
     expectAgrees(*scene, opt, ref, c.iterations, what, c.reference);
     if (c.maxLength == 4) {
+        // The candle's flame is smaller than a pixel at 32x32 and seen through the wax (two
+        // delta refractions of its multi-lobe surface, each picked with probability 0.63 and
+        // weight 1.59): such samples are worth ~250 and hit a given 8x8 block in about 1.5%
+        // of the iterations, carrying most of its mean. 256 iterations see ~4 of them, too
+        // few for the block's sample variance; 4x more iterations, like the vpt reference's.
         opt = RenderOptions();
         opt.algorithm = "upbp";
         opt.maxPathLength = c.maxLength;
-        expectAgreesWithVpt(*scene, opt, 4 * c.refIterations, c.iterations, c.file);
+        expectAgreesWithVpt(*scene, opt, 4 * c.refIterations, 4 * c.iterations, c.file);
     }
 }
 

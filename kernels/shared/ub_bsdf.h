@@ -10,7 +10,11 @@
  *   RoughConductor   GGX or Beckmann (ub_microfacet.h), Walter et al. 2007 eq. 20, visible-normal
  * pdf (Heitz 2018) times the reflection Jacobian (Walter eq. 14); RoughDielectric  Walter et al.
  * 2007 eq. 20 (reflection) and eq. 21 (refraction, Jacobian eq. 17), Fresnel lobe selection;
- *   Plastic, RoughPlastic  Mitsuba 3's coated diffuse (kernels/shared/ub_plastic.h).
+ *   Plastic, RoughPlastic  Mitsuba 3's coated diffuse (kernels/shared/ub_plastic.h);
+ *   MultiLobe        SmallUPBP's sum of lobes: its Lambert and Phong lobes here, picked
+ *                    with probabilities proportional to the lobes' albedos, which depend on
+ *                    the Fresnel weight of the delta lobes seen from the fixed direction
+ *                    (ub_bsdf_multilobe_probs): the reverse pdf uses those of dirGen.
  * Delta lobes (Mirror, Dielectric, ThinDielectric, the plastic coating) have no density:
  * they are sampled on the host only and evaluate to zero here.
  *
@@ -38,12 +42,14 @@
 #define UB_MATERIAL_PLASTIC 6u
 #define UB_MATERIAL_ROUGH_PLASTIC 7u
 #define UB_MATERIAL_THIN_DIELECTRIC 8u
+#define UB_MATERIAL_MULTI_LOBE 9u
 
 #define UB_BSDF_EVALUABLE 1u       /* valid, not all-delta, not black: evaluation can be > 0 */
 #define UB_BSDF_FROM_LIGHT 2u      /* light subpath: importance transport (bsdf.h) */
 #define UB_BSDF_GEOMETRIC_GUARD 4u /* the geometric-normal guard is on (bsdf.h) */
 #define UB_BSDF_SEPARABLE 8u       /* separable Smith G2 for GGX reflection (Material) */
 #define UB_BSDF_BECKMANN 16u       /* Beckmann microfacets instead of GGX */
+#define UB_BSDF_REFRACT 32u        /* multi-lobe: has the refraction lobe */
 
 /* Smallest microfacet roughness used (alpha -> 0 is a delta lobe floats cannot represent). */
 #define UB_MIN_GGX_ALPHA 1e-4f
@@ -119,6 +125,29 @@ UB_INLINE float ub_bsdf_plastic_specular_prob(UB_PRIVATE const ub_bsdf* b,
     float ps = reflectance * b->specularWeight;
     float pd = (1.0f - reflectance) * (1.0f - b->specularWeight);
     return ps + pd > 0.0f ? ps / (ps + pd) : 0.0f;
+}
+
+/* Multi-lobe: the probabilities of picking the Lambert and the Phong lobe when sampling from
+ * a direction on the front with cos cosTheta: albedo estimates lum(Kd), lum(Ks),
+ * F lum(mirror) and, with refraction, (1 - F), normalised (SmallUPBP's Bsdf.hxx); F is the
+ * Fresnel reflectance of the interface seen from there (1 without refraction). */
+UB_INLINE void ub_bsdf_multilobe_probs(UB_PRIVATE const ub_bsdf* b, float cosTheta,
+                                       UB_PRIVATE float* probDiffuse,
+                                       UB_PRIVATE float* probGlossy) {
+    float fresnel = (b->flags & UB_BSDF_REFRACT)
+                        ? ub_fresnel_dielectric(ub_fabs(cosTheta), b->etaOther / b->etaFix)
+                        : 1.0f;
+    float d = 0.212671f * b->diffuse[0] + 0.715160f * b->diffuse[1] + 0.072169f * b->diffuse[2];
+    float p = 0.212671f * b->glossy[0] + 0.715160f * b->glossy[1] + 0.072169f * b->glossy[2];
+    float m = 0.212671f * b->specular[0] + 0.715160f * b->specular[1] + 0.072169f * b->specular[2];
+    float total = d + p + fresnel * m + ((b->flags & UB_BSDF_REFRACT) ? 1.0f - fresnel : 0.0f);
+    if (!(total >= 1e-9f)) {
+        *probDiffuse = 0.0f;
+        *probGlossy = 0.0f;
+        return;
+    }
+    *probDiffuse = d / total;
+    *probGlossy = p / total;
 }
 
 /* Diffuse + Phong, reflection above the surface only. */
@@ -221,6 +250,29 @@ UB_INLINE ub_float3 ub_bsdf_eval_rough_dielectric(UB_PRIVATE const ub_bsdf* b, u
                        transmit * d * g2 * aFix * aGen * etaO * etaO / (cFix * cGen * denom));
 }
 
+/* Multi-lobe: the Lambert and Phong lobes above the surface; the forward pdf mixes them with
+ * dirFix's lobe probabilities (b->probDiffuse, b->probGlossy), the reverse one with dirGen's. */
+UB_INLINE ub_float3 ub_bsdf_eval_multilobe(UB_PRIVATE const ub_bsdf* b, ub_float3 gen,
+                                           UB_PRIVATE float* directPdfW,
+                                           UB_PRIVATE float* reversePdfW) {
+    ub_float3 fix = ub_f3_from(b->localFix);
+    ub_float3 f = ub_make_float3(0.0f, 0.0f, 0.0f);
+    if (fix.z <= 0.0f || gen.z <= 0.0f) return f;
+    float revDiffuse, revGlossy;
+    ub_bsdf_multilobe_probs(b, gen.z, &revDiffuse, &revGlossy);
+    f = ub_f3_scale(ub_f3_from(b->diffuse), UB_INV_PI);
+    *directPdfW = b->probDiffuse * ub_lambert_pdf(gen.z);
+    *reversePdfW = revDiffuse * ub_lambert_pdf(fix.z);
+    if (b->probGlossy > 0.0f) {
+        float cosAlpha = -fix.x * gen.x - fix.y * gen.y + fix.z * gen.z;
+        float lobePdf = ub_power_cos_pdf(cosAlpha, b->exponent); /* symmetric */
+        f = ub_f3_add(f, ub_f3_scale(ub_f3_from(b->glossy), ub_phong_lobe(cosAlpha, b->exponent)));
+        *directPdfW += b->probGlossy * lobePdf;
+        *reversePdfW += revGlossy * lobePdf;
+    }
+    return f;
+}
+
 /* Plastic: the diffuse base under the smooth coating (the coating itself is a delta). */
 UB_INLINE ub_float3 ub_bsdf_eval_plastic(UB_PRIVATE const ub_bsdf* b, ub_float3 gen,
                                          UB_PRIVATE float* directPdfW,
@@ -294,6 +346,9 @@ UB_INLINE ub_float3 ub_bsdf_eval_local(UB_PRIVATE const ub_bsdf* b, UB_GLOBAL co
             break;
         case UB_MATERIAL_ROUGH_PLASTIC:
             f = ub_bsdf_eval_rough_plastic(b, coating, gen, directPdfW, reversePdfW);
+            break;
+        case UB_MATERIAL_MULTI_LOBE:
+            f = ub_bsdf_eval_multilobe(b, gen, directPdfW, reversePdfW);
             break;
         default:
             break;

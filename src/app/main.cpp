@@ -243,8 +243,9 @@ int run(int argc, char** argv) {
         ->add_option("--backend", ra.backend,
                      "upbp: where the estimate pass runs: opencl (kernels; error without a "
                      "working device), host (C++), auto (OpenCL if a device works, else the "
-                     "host; default). Kernels exist for pp3d; the other estimators run on the "
-                     "host")
+                     "host; default). Every estimator has a kernel (pp3d, pb2d, bp2d, bb1d, "
+                     "surf); in grid media with an albedo grid or trilinear filtering pb2d, "
+                     "bp2d and bb1d run on the host (docs/opencl.md)")
         ->check(CLI::IsMember({"host", "opencl", "auto"}).description(""))
         ->type_name("opencl|host|auto");
     render

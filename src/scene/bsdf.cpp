@@ -83,9 +83,10 @@ bool isDielectric(MaterialType t) {
     return t == MaterialType::Dielectric || t == MaterialType::RoughDielectric;
 }
 
-/// Materials whose normals are never flipped to dirFix's side.
-bool keepsNormalSide(MaterialType t) {
-    return isDielectric(t) || t == MaterialType::ThinDielectric;
+/// Materials whose normals are never flipped to dirFix's side (the normal tells inside).
+bool keepsNormalSide(const Material& m) {
+    return isDielectric(m.type) || m.type == MaterialType::ThinDielectric ||
+           (m.type == MaterialType::MultiLobe && m.refract);
 }
 
 }  // namespace
@@ -107,12 +108,13 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
     etaFix_ = etaOther_ = 1.0f;
     fresnelFix_ = 0.0f;
     specularWeight_ = 0.0f;
+    probReflect_ = 0.0f;
     plasticBase_ = Rgb(0.0f);
     isDelta_ = mat.type == MaterialType::Mirror || mat.type == MaterialType::Dielectric ||
                mat.type == MaterialType::ThinDielectric;
 
     Vec3 ns = shadingNormal, ng = geoNormal;
-    if (!keepsNormalSide(mat.type) && dot(dirFix, ns) < 0.0f) {
+    if (!keepsNormalSide(mat) && dot(dirFix, ns) < 0.0f) {
         if (mat.twoSided) {
             ns = -ns;
             ng = -ng;
@@ -172,6 +174,9 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
         case MaterialType::ThinDielectric:
             setupPlastic();
             break;
+        case MaterialType::MultiLobe:
+            setupMultiLobe();
+            break;
     }
     if (black_) contProb_ = 0.0f;
     contProb_ = clamp01(contProb_);
@@ -189,7 +194,8 @@ void Bsdf::packShared() {
                       uint32_t(MaterialType::RoughDielectric) == UB_MATERIAL_ROUGH_DIELECTRIC &&
                       uint32_t(MaterialType::Plastic) == UB_MATERIAL_PLASTIC &&
                       uint32_t(MaterialType::RoughPlastic) == UB_MATERIAL_ROUGH_PLASTIC &&
-                      uint32_t(MaterialType::ThinDielectric) == UB_MATERIAL_THIN_DIELECTRIC,
+                      uint32_t(MaterialType::ThinDielectric) == UB_MATERIAL_THIN_DIELECTRIC &&
+                      uint32_t(MaterialType::MultiLobe) == UB_MATERIAL_MULTI_LOBE,
                   "MaterialType values are the UB_MATERIAL_* of kernels/shared/ub_bsdf.h");
     ub_bsdf& b = shared_;
     const Material& m = *mat_;
@@ -211,6 +217,7 @@ void Bsdf::packShared() {
     put(b.plasticBase, plasticBase_);
     b.type = uint32_t(m.type);
     b.flags = (valid_ && !isDelta_ && !black_ ? UB_BSDF_EVALUABLE : 0u) |
+              (m.type == MaterialType::MultiLobe && m.refract ? UB_BSDF_REFRACT : 0u) |
               (fromLight_ ? UB_BSDF_FROM_LIGHT : 0u) |
               (geometricGuard_ ? UB_BSDF_GEOMETRIC_GUARD : 0u) |
               (m.separableMasking ? UB_BSDF_SEPARABLE : 0u) |
@@ -276,6 +283,19 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
             gen = 2.0f * dot(fix, m) * m - fix;
             break;
         }
+        case MaterialType::MultiLobe:
+            // One lobe by its probability: Lambert, Phong, then the delta mirror / refraction.
+            if (rnd.z < probDiffuse_) {
+                gen = sampleCosineHemisphere(Vec2(rnd.x, rnd.y));
+                event = kEventDiffuse;
+            } else if (rnd.z < probDiffuse_ + probGlossy_) {
+                Vec3 lobe;
+                ub_power_cos_sample(rnd.x, rnd.y, mat_->exponent, &lobe.x, &lobe.y, &lobe.z);
+                gen = Frame(Vec3(-fix.x, -fix.y, fix.z)).toWorld(lobe);
+            } else {
+                return sampleDelta(rnd, dirGen, pdfW, cosThetaGen, sampledEvent);
+            }
+            break;
         case MaterialType::Plastic:
             // Delta coating reflection with probability plasticSpecularProb, else the base.
             if (rnd.z < plasticSpecularProb(fix.z))
@@ -332,6 +352,35 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
     return f;
 }
 
+void Bsdf::setupMultiLobe() {
+    const Material& mat = *mat_;
+    if (mat.refract) {
+        // As Dielectric: the front of the (unflipped) normal is outside, IOR 1.
+        etaFix_ = localDirFix_.z > 0.0f ? 1.0f : mat.ior;
+        etaOther_ = localDirFix_.z > 0.0f ? mat.ior : 1.0f;
+        fresnelFix_ = ub_fresnel_dielectric(std::fabs(localDirFix_.z), etaOther_ / etaFix_);
+    } else {
+        fresnelFix_ = 1.0f;  // SmallUPBP: without refraction the mirror has weight 1
+    }
+    packShared();  // the lobe probabilities come from the shared function
+    ub_bsdf_multilobe_probs(&shared_, localDirFix_.z, &probDiffuse_, &probGlossy_);
+    const float d = luminance(colors_.diffuse), p = luminance(colors_.glossy);
+    const float r = fresnelFix_ * luminance(colors_.specular);
+    const float t = mat.refract ? 1.0f - fresnelFix_ : 0.0f;
+    const float total = d + p + r + t;
+    if (!(total >= 1e-9f)) {
+        black_ = true;
+        return;
+    }
+    probReflect_ = r / total;
+    isDelta_ = probDiffuse_ == 0.0f && probGlossy_ == 0.0f;
+    // Russian roulette: a bound that does not depend on dirFix (the MIS partials assume both
+    // subpaths through a vertex continue with the same probability): with refraction the
+    // transmitted albedo may be 1, so 1; else the largest channel of the summed lobes.
+    contProb_ =
+        mat.refract ? 1.0f : maxComponent(colors_.diffuse + colors_.glossy + colors_.specular);
+}
+
 bool Bsdf::hasNullLobe() const {
     return mat_ && mat_->type == MaterialType::ThinDielectric;
 }
@@ -358,6 +407,22 @@ Rgb Bsdf::sampleDelta(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThet
             gen = -fix;
             prob = 1.0f - reflectance;
             weight = colors_.transmittance * (1.0f - reflectance);
+            event = kEventRefract;
+        }
+    } else if (mat_->type == MaterialType::MultiLobe) {
+        // rnd.z in [probDiffuse + probGlossy, 1): the mirror with probReflect_, else the
+        // refraction (SmallUPBP's Bsdf.hxx): weights F mirror and (1 - F) (eta^2 for radiance).
+        const float probRefract = 1.0f - probDiffuse_ - probGlossy_ - probReflect_;
+        if (rnd.z < probDiffuse_ + probGlossy_ + probReflect_ || !(probRefract > 0.0f)) {
+            prob = probReflect_;
+            weight = colors_.specular * fresnelFix_;
+        } else {
+            const float eta = etaFix_ / etaOther_;
+            float cosT;
+            ub_fresnel_dielectric_ct(std::fabs(fix.z), etaOther_ / etaFix_, &cosT);
+            gen = Vec3(-eta * fix.x, -eta * fix.y, fix.z > 0.0f ? -cosT : cosT);
+            prob = probRefract;
+            weight = Rgb((1.0f - fresnelFix_) * (fromLight_ ? 1.0f : eta * eta));
             event = kEventRefract;
         }
     } else if (mat_->type == MaterialType::Dielectric) {

@@ -129,6 +129,7 @@ class Bsdf {
 
   private:
     void setupPlastic();
+    void setupMultiLobe();
     /// Fills shared_ from the members (end of setup()).
     void packShared();
     /// Probability of picking the specular lobe of a (rough) plastic seen from a
@@ -153,6 +154,7 @@ class Bsdf {
     float contProb_ = 0.0f;
     // Lobe selection probabilities (Phong: diffuse vs glossy).
     float probDiffuse_ = 0.0f, probGlossy_ = 0.0f;
+    float probReflect_ = 0.0f;  ///< MultiLobe: the mirror lobe (the refraction has the rest)
     // Dielectrics: IOR on dirFix's side and on the other side of the interface, and the
     // Fresnel reflectance of the smooth interface seen from dirFix.
     float etaFix_ = 1.0f, etaOther_ = 1.0f;

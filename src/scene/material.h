@@ -23,6 +23,9 @@ enum class MaterialType : uint32_t {
     RoughPlastic = 7,    ///< Mitsuba 3 `roughplastic`: GGX coating (`alpha`) over Lambert `diffuse`
     ThinDielectric = 8,  ///< Mitsuba 3 `thindielectric`: delta reflection `specular` + straight
                          ///< transmission `transmittance`; `ior` of the sheet
+    MultiLobe = 9,  ///< SmallUPBP's sum of lobes: Lambert `diffuse` + Phong `glossy`/`exponent` +
+                    ///< mirror `specular` (Fresnel-weighted with `refract`) + smooth untinted
+                    ///< refraction with `ior` when `refract` (scene/bsdf.cpp)
 };
 
 /// Textured RGB parameters of a material, in Scene::textures (-1: the constant is used).
@@ -64,6 +67,9 @@ struct Material {
     /// ThinDielectric ignores it too: the sheet is the same from both sides.
     bool twoSided = true;
     Rgb transmittance{1, 1, 1};  ///< ThinDielectric: tint of the transmitted light
+    /// MultiLobe: a refraction lobe with `ior` (SmallUPBP's ior >= 0); without it the mirror
+    /// lobe has Fresnel weight 1 (SmallUPBP's ior < 0).
+    bool refract = false;
     /// Plastic, RoughPlastic: Mitsuba's `nonlinear` (base albedo inside the internal
     /// scattering sum, darker and more saturated colours); false keeps texture colours.
     bool nonlinear = false;

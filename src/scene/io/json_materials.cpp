@@ -44,8 +44,8 @@ const MetalPreset kMetals[] = {
 };
 
 const std::vector<std::string> kMaterialTypes = {
-    "diffuse",          "phong",   "mirror",        "dielectric",     "rough_conductor",
-    "rough_dielectric", "plastic", "rough_plastic", "thin_dielectric"};
+    "diffuse",          "phong",   "mirror",        "dielectric",      "rough_conductor",
+    "rough_dielectric", "plastic", "rough_plastic", "thin_dielectric", "multi_lobe"};
 
 /// Mitsuba 3's default IORs: polypropylene (plastics), BK7 glass (thin_dielectric), air.
 constexpr float kPolypropyleneIor = 1.49f, kBk7Ior = 1.5046f, kAirIor = 1.000277f;
@@ -127,6 +127,41 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
                 break;
             }
         }
+    } else if (type == "multi_lobe") {
+        // SmallUPBP's sum of lobes (scene/bsdf.cpp): Lambert + Phong + mirror (+ refraction).
+        mat.type = MaterialType::MultiLobe;
+        keys.insert(keys.end(), {"diffuse_reflectance", "glossy_reflectance", "exponent",
+                                 "mirror_reflectance", "ior", "two_sided", "allow_energy_gain"});
+        r.checkKeys(m, ptr, keys, "multi_lobe material");
+        colour("diffuse_reflectance", Rgb(0.0f), &mat.diffuse, &mat.textures.diffuse);
+        colour("glossy_reflectance", Rgb(0.0f), &mat.glossy, &mat.textures.glossy);
+        colour("mirror_reflectance", Rgb(0.0f), &mat.specular, &mat.textures.specular);
+        mat.exponent =
+            r.getNumber(m, ptr, "exponent", Presence::Optional, NumberRange::positive(), 1.0f);
+        mat.refract = m.contains("ior");
+        if (mat.refract) {
+            mat.ior = r.getNumber(m, ptr, "ior", Presence::Required, NumberRange::positive(), 1.5f);
+            mat.twoSided = false;  // the normal tells inside from outside
+        }
+        // The lobes add: their albedos may sum above 1 (SmallUPBP allows it, e.g. its candle
+        // wax: Kd 0.588 plus index-matched refraction). That is an error unless asked for.
+        auto maxOf = [&](int texture, const Rgb& value) {
+            return texture >= 0 ? textureMax(parts.textures[size_t(texture)]) : value;
+        };
+        const Rgb sum = maxOf(mat.textures.diffuse, mat.diffuse) +
+                        maxOf(mat.textures.glossy, mat.glossy) +
+                        (mat.refract ? Rgb(1.0f) : maxOf(mat.textures.specular, mat.specular));
+        const bool allowGain = r.getBool(m, ptr, "allow_energy_gain", false);
+        for (int c = 0; c < 3 && !allowGain; ++c)
+            if (sum[c] > 1.0f + 1e-6f) {
+                r.error(ptr, std::string("the lobes add up to an albedo of ") +
+                                 formatNumber(sum[c]) + " in the " + kChannel[c] +
+                                 " channel (diffuse + glossy + " +
+                                 (mat.refract ? "refraction 1" : "mirror") +
+                                 "): the material would create energy (expected <= 1, or "
+                                 "\"allow_energy_gain\": true to keep SmallUPBP's model)");
+                break;
+            }
     } else if (type == "mirror") {
         mat.type = MaterialType::Mirror;
         keys.insert(keys.end(), {"reflectance", "two_sided"});

@@ -7,9 +7,10 @@
 //    tan(fovY / 2) = tan(fovX / 2) * height / width. Default image 256 x 256.
 //  * Materials: SmallUPBP's BSDF is a sum of lobes (Bsdf.hxx): Lambert Kd, Phong Ks
 //    with exponent Ns (off when Ns = 0), mirror (Fresnel-weighted when ior >= 0) and,
-//    when ior >= 0, smooth refraction weighted by 1 - F. unibeam materials have one
-//    type, so: ior >= 0 -> Dielectric; else mirror only -> Mirror; Ks (with Ns > 0)
-//    -> Phong; else Diffuse. Lobes that do not fit are dropped with a warning.
+//    when ior >= 0, smooth refraction weighted by 1 - F. A material with refraction, or
+//    with a mirror and a diffuse/Phong lobe, becomes a MultiLobe material (every lobe, as
+//    SmallUPBP samples them); a mirror alone a Mirror, Kd with Ks (Ns > 0) a Phong, else a
+//    Diffuse material (the same BSDFs).
 //  * Media: homogeneous; SmallUPBP's emission is the source term per unit length,
 //    unibeam's is sigma_a * Le, so Le = emission / absorption.
 //  * Shapes: one per material (SmallUPBP groups faces by material and identifies a
@@ -62,50 +63,36 @@ struct Context {
     }
 };
 
-/// SmallUPBP's lobes -> one unibeam material (see the banner).
+/// SmallUPBP's lobes -> a unibeam material (see the banner).
 Material mapMaterial(const UpbpMaterial& u, const std::string& mtlFile, Context& ctx) {
     Material m;
     m.name = u.name;
     const Rgb phong = u.shininess > 0.0f ? u.specular : Rgb(0.0f);
     const bool hasDiffuse = !isBlack(u.diffuse), hasPhong = !isBlack(phong);
     const bool hasMirror = !isBlack(u.mirror);
-    if (u.ior >= 0.0f) {
-        m.type = MaterialType::Dielectric;
-        m.ior = u.ior;
-        m.specular = Rgb(1.0f);
-        m.twoSided = false;
-        // With ior 1 the Fresnel reflectance is 0 and the mirror colour has no effect.
-        if (u.ior != 1.0f && !(u.mirror.x == 1.0f && u.mirror.y == 1.0f && u.mirror.z == 1.0f))
+    if (u.ior >= 0.0f || (hasMirror && (hasDiffuse || hasPhong))) {
+        // Every lobe, as SmallUPBP combines them (MaterialType::MultiLobe, scene/bsdf.cpp).
+        m.type = MaterialType::MultiLobe;
+        m.diffuse = u.diffuse;
+        m.glossy = phong;
+        m.exponent = u.shininess > 0.0f ? u.shininess : 1.0f;
+        m.specular = u.mirror;
+        m.refract = u.ior >= 0.0f;
+        if (m.refract) {
+            m.ior = u.ior;
+            m.twoSided = false;  // the normal tells inside from outside
+        }
+        // The lobes add: with refraction the transmitted part alone may carry albedo 1.
+        const Rgb sum = u.diffuse + phong + (m.refract ? Rgb(0.0f) : u.mirror);
+        const float most = maxComponent(sum) + (m.refract ? 1.0f : 0.0f);
+        if (most > 1.0f + 1e-6f && (hasDiffuse || hasPhong))
             ctx.materialWarning(u, mtlFile,
-                                "mirror " + rgbText(u.mirror) + " with ior " + formatNumber(u.ior) +
-                                    ": SmallUPBP tints only the Fresnel reflection by it; "
-                                    "unibeam's dielectric reflects and refracts untinted "
-                                    "(exact for mirror 1 1 1)");
-        if (hasDiffuse || hasPhong)
-            ctx.materialWarning(u, mtlFile,
-                                std::string("its ") + (hasDiffuse ? "diffuse (Kd)" : "") +
-                                    (hasDiffuse && hasPhong ? " and " : "") +
-                                    (hasPhong ? "Phong (Ks)" : "") +
-                                    " lobe is dropped: SmallUPBP adds it to the refraction, "
-                                    "a unibeam material has a single type (here: dielectric)");
+                                "its lobes add up to an albedo of up to " + formatNumber(most) +
+                                    " (> 1: the surface creates energy); kept, as SmallUPBP "
+                                    "renders it");
         return m;
     }
-    if (hasMirror && (hasDiffuse || hasPhong)) {
-        const float mirrorAlbedo = luminance(u.mirror);
-        const float otherAlbedo = luminance(u.diffuse) + luminance(phong);
-        const bool keepMirror = mirrorAlbedo >= otherAlbedo;
-        ctx.materialWarning(u, mtlFile,
-                            "SmallUPBP adds a mirror lobe (" + rgbText(u.mirror) +
-                                ") to its diffuse/Phong lobes; a unibeam material has a single "
-                                "type: the " +
-                                (keepMirror ? "mirror" : "diffuse/Phong") +
-                                " part (the larger albedo) is kept");
-        if (keepMirror) {
-            m.type = MaterialType::Mirror;
-            m.specular = u.mirror;
-            return m;
-        }
-    } else if (hasMirror) {
+    if (hasMirror) {
         m.type = MaterialType::Mirror;
         m.specular = u.mirror;
         return m;
