@@ -137,6 +137,20 @@ const std::vector<Case> kCases = {
       "cannot read bitmap 'image.png': corrupt PNG image: 30000 x 8000 pixels "
       "need 720008000 bytes of image data, more than the 74 bytes of the file can hold (expected "
       "the image data of every pixel the header announces)"}},
+    // libpng allocated what an ancillary chunk announced before reading it: 239 bytes
+    // announcing a 973 MB tEXt chunk took 1.1 GB (the memory growth of the earlier runs).
+    {"fuzz_png_image",
+     "huge-text-chunk.png",
+     2,
+     {"scene.json:3:",
+      "cannot read bitmap 'image.png': corrupt PNG image: chunk 'tEXt' at byte 106 announces "
+      "973078564 bytes, more than the 121 bytes left in the file (truncated or corrupt file?)"}},
+    // OpenEXR allocated what a header attribute announced (here 1.6 GB) before reading it.
+    {"fuzz_exr_image",
+     "huge-attribute.exr",
+     2,
+     {"scene.json:3:", "cannot read bitmap 'image.exr': corrupt OpenEXR image: header attribute",
+      "announces 1634231040 bytes, more than the 496 bytes left in the file"}},
     // Assimp's PLY importer leaks on this malformed ASCII body (suppressed as third-party in
     // scripts/lsan.supp); the loader reports the file as invalid.
     {"fuzz_mesh_ply",

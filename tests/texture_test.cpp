@@ -183,11 +183,30 @@ TEST(Texture, PngReadErrors) {
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("not a PNG"), std::string::npos) << e.what();
     }
-    // A valid signature followed by garbage: libpng's error path, not a crash.
+    // A valid signature followed by garbage: the chunk walk finds a chunk longer than the file.
     fp = std::fopen(path.c_str(), "wb");
     const unsigned char sig[8] = {137, 80, 78, 71, 13, 10, 26, 10};
     std::fwrite(sig, 1, 8, fp);
     std::fputs("garbage after the signature", fp);
+    std::fclose(fp);
+    try {
+        readPng(path);
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(
+            std::string(e.what()).find("corrupt PNG image: chunk 'age ' at byte 8 announces "),
+            std::string::npos)
+            << e.what();
+    }
+    // Chunks that fit the file but an IHDR with garbage and a wrong CRC: libpng's error path,
+    // not a crash.
+    fp = std::fopen(path.c_str(), "wb");
+    std::fwrite(sig, 1, 8, fp);
+    const unsigned char ihdr[25] = {0, 0, 0, 13, 'I', 'H', 'D', 'R', 9, 9, 9, 9, 9,
+                                    9, 9, 9, 9,  9,   9,   9,   9,   1, 2, 3, 4};
+    std::fwrite(ihdr, 1, sizeof(ihdr), fp);
+    const unsigned char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
+    std::fwrite(iend, 1, sizeof(iend), fp);
     std::fclose(fp);
     try {
         readPng(path);

@@ -87,13 +87,15 @@ ProgressiveResult renderProgressive(Integrator& integrator, int width, int heigh
     auto rejectedSoFar = [&] {
         RejectionCounts counts = integrator.rejectedContributions();
         if (resume)
-            for (const auto& [name, n] : resume->rejected) {
+            for (const auto& entry : resume->rejected) {
+                // (not a structured binding: C++17 lambdas cannot capture those; clang rejects)
+                const std::string& name = entry.first;
                 auto it = std::find_if(counts.begin(), counts.end(),
                                        [&](const auto& c) { return c.first == name; });
                 if (it == counts.end())
-                    counts.emplace_back(name, n);
+                    counts.emplace_back(name, entry.second);
                 else
-                    it->second += n;
+                    it->second += entry.second;
             }
         return counts;
     };
