@@ -69,7 +69,10 @@ Rgb PathTracer::tracePixel(int x, int y, int iteration) const {
                            uint64_t(y) * uint64_t(camera.width()) + uint64_t(x));
     const Vec2 jitter = rng.uniform2();
     const Vec2 lensU = rng.uniform2();
-    Ray ray = camera.generateRay(Vec2(float(x) + jitter.x, float(y) + jitter.y), lensU);
+    // Pixel position from the scene's reconstruction filter (box: pixel + jitter).
+    const Vec2 raster =
+        scene_.settings.pixelFilter.sampleRaster(x, y, jitter, camera.width(), camera.height());
+    Ray ray = camera.generateRay(raster, lensU);
 
     Rgb radiance(0.0f);
     Rgb throughput(1.0f);

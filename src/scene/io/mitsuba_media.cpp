@@ -35,6 +35,9 @@ bool readConstant(XmlReader& r, const XmlObject& o, const std::string& name, Rgb
     if (const XmlObject* v = r.child(o, "volume", name)) {
         if (v->type != "constvolume") return false;
         *out = r.getColor(*v, "value", Rgb(1.0f), use);
+        // A constant is the same in every frame: to_world (valid, as Mitsuba requires) changes
+        // nothing.
+        r.getTransform(*v, "to_world");
         r.checkUnused(*v);
         return true;
     }
