@@ -8,6 +8,7 @@
 #include "core/image.h"
 #include "scene/io/mitsuba_build.h"
 #include "scene/mesh_io.h"
+#include "scene/serialized_mesh.h"
 #include "scene/shapes.h"
 
 namespace ub {
@@ -16,7 +17,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kShapes = {"obj", "ply", "rectangle", "cube", "sphere"};
+const std::vector<std::string> kShapes = {"obj",       "ply",  "serialized",
+                                          "rectangle", "cube", "sphere"};
 const std::vector<std::string> kEmitters = {"area",        "point",    "spot",
                                             "directional", "constant", "envmap"};
 const std::vector<std::string> kIntegrators = {"path",   "volpath", "volpathmis",
@@ -354,17 +356,21 @@ void Builder::readShape(const XmlObject& o) {
     bool isSphere = false;
     Vec3 center;
     float radius = 1.0f;
-    if (o.type == "obj" || o.type == "ply") {
+    if (o.type == "obj" || o.type == "ply" || o.type == "serialized") {
         std::string file = r_.getString(o, "filename", "");
         bool faceNormals = r_.getBool(o, "face_normals", false);
         bool flipTex = o.type == "obj" ? r_.getBool(o, "flip_tex_coords", true) : false;
+        const int shapeIndex =
+            o.type == "serialized" ? r_.getInt(o, "shape_index", 0, 0, (1 << 30)) : 0;
         if (file.empty()) {
             r_.error(o.pos, o.label() + ": needs <string name=\"filename\">");
         } else {
             std::string path = b_.resolveFile(o, "filename", file);
             if (!path.empty()) {
                 Diagnostics meshDiags;
-                mesh = loadMeshFile(path, meshDiags, o.label());
+                mesh = o.type == "serialized"
+                           ? loadSerializedMesh(path, shapeIndex, faceNormals, meshDiags, o.label())
+                           : loadMeshFile(path, meshDiags, o.label());
                 for (const Diagnostic& d : meshDiags.all()) {
                     const XmlProperty* p = o.find("filename");
                     std::string msg = o.label() + ": " + d.format();
