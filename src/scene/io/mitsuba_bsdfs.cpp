@@ -1,6 +1,7 @@
 // Mitsuba <bsdf> plugins -> unibeam materials (docs/mitsuba.md lists the mapping).
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 
 #include "core/image.h"
 #include "scene/io/mitsuba_build.h"
@@ -47,16 +48,18 @@ int buildTexture(MitsubaBuild& b, const XmlObject& t) {
         if (file.empty()) {
             r.error(t.pos, t.label() + ": needs <string name=\"filename\">");
         } else if (std::string path = b.resolveFile(t, "filename", file); !path.empty()) {
-            std::string ext = path.size() > 4 ? path.substr(path.size() - 4) : "";
+            std::string ext = std::filesystem::path(path).extension().string();
             for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
             try {
                 if (ext == ".exr")
                     tex.image = std::make_shared<Image>(readExr(path));
                 else if (ext == ".png")
                     tex.image = std::make_shared<Image>(readPng(path, !raw));
+                else if (ext == ".jpg" || ext == ".jpeg")
+                    tex.image = std::make_shared<Image>(readJpeg(path, !raw));
                 else
                     r.error(t.find("filename")->pos,
-                            t.label() + ": '" + file + "' is not a .png or .exr file");
+                            t.label() + ": '" + file + "' is not a .png, .jpg/.jpeg or .exr file");
             } catch (const InputError& e) {
                 for (const Diagnostic& d : e.diagnostics())
                     r.error(t.find("filename")->pos, t.label() + ": " + d.format());
