@@ -4,10 +4,11 @@
 // location (line:column for text formats, the JSON path of the referencing key for meshes and
 // images, which have no lines) and what was expected. Cases cover every loader: native JSON
 // (16), Mitsuba XML with includes (12), .vol grids (5), SmallUPBP .obj/.mtl/.aux (7), OBJ (4)
-// and PLY (4) meshes, Mitsuba .serialized meshes (3), PNG (2), JPEG (2) and OpenEXR (2) images, and the CLI's
-// own scene checks (2). Earlier CLI cases (tests/cli_test.cpp, MissingOrBadSceneExitsTwo: a missing
-// scene for render and info, a JSON syntax error) are not repeated; the loaders' own tests check
-// the same kinds of errors in-process. File contents "@data:PATH" are copied from tests/data,
+// and PLY (4) meshes, Mitsuba .serialized meshes (3), PNG (2), JPEG (2) and OpenEXR (2) images, and
+// the CLI's own scene checks (2). Earlier CLI cases (tests/cli_test.cpp, MissingOrBadSceneExitsTwo:
+// a missing scene for render and info, a JSON syntax error) are not repeated; the loaders' own
+// tests check the same kinds of errors in-process. File contents "@data:PATH" are copied from
+// tests/data,
 // "@prefix:N:PATH" are the first N bytes of a repository file (a truncated image).
 #include <gtest/gtest.h>
 #include <sys/wait.h>

@@ -219,3 +219,46 @@ TEST(MitsubaInterop, NamedConductorPresets) {
     EXPECT_TRUE(contains(e, "<bsdf type=\"conductor\">: a smooth conductor with a Fresnel term"))
         << e;
 }
+
+TEST(MitsubaInterop, TopLevelSamplerAndNamedAreaEmitterAreAttachedByRef) {
+    const std::string text = R"(<scene version="3.0.0">
+<sampler type="independent" id="spp16"><integer name="sample_count" value="16"/></sampler>
+<sensor type="perspective"><ref id="spp16"/><film type="hdrfilm"><integer name="width" value="8"/>
+<integer name="height" value="8"/></film></sensor>
+<shape type="rectangle"><ref id="light"/></shape>
+<shape type="rectangle"><transform name="to_world"><translate z="1"/></transform><ref id="light"/></shape>
+<emitter type="area" id="light"><rgb name="radiance" value="2"/></emitter>
+</scene>
+)";
+    auto s = load(text);
+    ASSERT_EQ(s->lights.size(), 2u);  // one area light per shape
+    EXPECT_FLOAT_EQ(s->lights[1].radiance.x, 2.0f);
+    std::string e = errorsOf(R"(<scene version="3.0.0">
+<sensor type="perspective"/>
+<emitter type="area"><rgb name="radiance" value="2"/></emitter>
+</scene>
+)");
+    EXPECT_TRUE(contains(e,
+                         "scene.xml:3:1: error: an 'area' emitter must be nested inside a "
+                         "<shape> (or given an id and attached to shapes with <ref"))
+        << e;
+}
+
+TEST(MitsubaInterop, HasSpectralExtinctionIsAHintForGreyMedia) {
+    auto medium = [](const std::string& sigma, const std::string& flag) {
+        return "<shape type=\"cube\"><bsdf type=\"null\"/><medium type=\"homogeneous\" "
+               "name=\"interior\">" +
+               sigma + "<boolean name=\"has_spectral_extinction\" value=\"" + flag +
+               "\"/></medium></shape>\n" + kLight;
+    };
+    auto s = load(scene("", medium("<float name=\"sigma_t\" value=\"3\"/>", "false")));
+    EXPECT_EQ(s->media.size(), 1u);
+    s = load(scene("", medium("<rgb name=\"sigma_t\" value=\"1, 2, 3\"/>", "true")));
+    EXPECT_EQ(s->media.size(), 1u);
+    std::string e =
+        errorsOf(scene("", medium("<rgb name=\"sigma_t\" value=\"1, 2, 3\"/>", "false")));
+    EXPECT_TRUE(contains(e,
+                         "has_spectral_extinction = false with a sigma_t that differs between "
+                         "channels"))
+        << e;
+}

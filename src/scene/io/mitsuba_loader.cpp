@@ -79,10 +79,13 @@ void Builder::build() {
             readSensor(o);
         } else if (o.tag == "shape") {
             readShape(o);
+        } else if (o.tag == "emitter" && o.type == "area" && !o.id.empty()) {
+            // A named area emitter: attached to shapes with <ref id="..."/> (read there).
         } else if (o.tag == "emitter") {
             readEmitter(o);
         } else if (o.tag == "bsdf" || o.tag == "medium" || o.tag == "texture" ||
-                   o.tag == "volume" || o.tag == "phase") {
+                   o.tag == "volume" || o.tag == "phase" || o.tag == "sampler" ||
+                   o.tag == "rfilter" || o.tag == "film") {
             if (o.id.empty())
                 r_.error(o.pos, "top-level " + o.label() +
                                     " without an id cannot be used (give "
@@ -537,7 +540,9 @@ void Builder::readEmitter(const XmlObject& o) {
             }
         }
     } else if (o.type == "area") {
-        r_.error(o.pos, "an 'area' emitter must be nested inside a <shape>");
+        r_.error(o.pos,
+                 "an 'area' emitter must be nested inside a <shape> (or given an id and "
+                 "attached to shapes with <ref id=\"...\"/>)");
         return;
     } else {
         r_.unsupportedPlugin(o, kEmitters);
