@@ -166,6 +166,58 @@ TEST(PixelFilter, SplatWeightIsTheSampledDensity) {
     }
 }
 
+// Mitsuba's ptracer convention: the camera-path weight integral(f) / S(p) (0 outside the
+// image) times the sampled density equals splatWeight(). Weighted histograms of 400 000
+// samples in 6 x 6 cells over the unclipped footprint against the integral of splatWeight
+// over each cell, |z| < 4.5 per cell (standard error from the samples; 36 cells x 4 filters x
+// 3 pixels); the expected total weight of a corner pixel is below 1 (no renormalisation).
+TEST(PixelFilter, PartitionOfUnityWeightsMatchSplatWeight) {
+    const int w = 10, h = 8, cells = 6, n = 400000, res = 40;
+    for (const PixelFilter& base : kFilters) {
+        const PixelFilter f = base.withBorder(PixelFilterBorder::kPartitionOfUnity);
+        for (const auto& px : {std::pair<int, int>{5, 4}, {0, 0}, {9, 3}}) {
+            const double r = f.radius(), x0 = px.first + 0.5 - r, y0 = px.second + 0.5 - r;
+            const double cell = 2 * r / cells;
+            std::vector<double> sum(cells * cells, 0.0), sum2(cells * cells, 0.0);
+            Rng rng = Rng::forPath(5, uint64_t(px.first), uint64_t(px.second));
+            double total = 0;
+            for (int i = 0; i < n; ++i) {
+                float wt = -1;
+                const Vec2 p = f.sampleRaster(px.first, px.second, rng.uniform2(), w, h, &wt);
+                ASSERT_GE(wt, 0.0f);
+                total += wt;
+                const int cx = std::min(cells - 1, int((p.x - x0) / cell));
+                const int cy = std::min(cells - 1, int((p.y - y0) / cell));
+                if (cx < 0 || cy < 0) continue;
+                sum[size_t(cy * cells + cx)] += wt;
+                sum2[size_t(cy * cells + cx)] += double(wt) * wt;
+            }
+            double expectedTotal = 0;
+            for (int cy = 0; cy < cells; ++cy)
+                for (int cx = 0; cx < cells; ++cx) {
+                    double integral = 0;
+                    for (int j = 0; j < res; ++j)
+                        for (int i = 0; i < res; ++i)
+                            integral +=
+                                f.splatWeight(px.first, px.second,
+                                              Vec2(float(x0 + cell * (cx + (i + 0.5) / res)),
+                                                   float(y0 + cell * (cy + (j + 0.5) / res))),
+                                              w, h);
+                    integral *= cell * cell / (res * res);
+                    expectedTotal += integral;
+                    const size_t k = size_t(cy * cells + cx);
+                    const double mean = sum[k] / n, var = sum2[k] / n - mean * mean;
+                    const double se = std::sqrt(std::max(var, 0.0) / n) + 1e-4 * integral;
+                    EXPECT_LT(std::fabs(mean - integral), 4.5 * se + 1e-9)
+                        << f.describe() << " pixel " << px.first << "," << px.second << " cell "
+                        << cx << "," << cy << ": " << mean << " vs " << integral;
+                }
+            if (px.first == 0) EXPECT_LT(expectedTotal, 0.95) << f.describe();
+            EXPECT_NEAR(total / n, expectedTotal, 0.01) << f.describe();
+        }
+    }
+}
+
 TEST(PixelFilter, BoxIsPixelPlusJitter) {
     const PixelFilter box;
     EXPECT_TRUE(box.isBox());
@@ -203,16 +255,16 @@ TEST(PixelFilter, CdfMatchesProfile) {
     EXPECT_DOUBLE_EQ(PixelFilter::tent(1.0f).eval1(0.5), 0.5);
 }
 
-// Cornell box without spheres at 24x24 with a wide Gaussian (stddev 1 pixel, radius 4):
-// lt and bpt against pt, 4x4-pixel blocks (36 blocks x 3 channels, family-wise level 1e-3
-// with the Sidak correction) and image means (|z| < 3.9). Camera paths sample the filter,
-// light tracing spreads its splats with splatWeight(), and bpt mixes both by MIS. Power:
-// pt with the box filter differs from pt with the Gaussian at that level (the blurred
+// Cornell box without spheres at 24x24 with a wide Gaussian (stddev 1 pixel, radius 4), with
+// both border conventions: lt and bpt against pt, 4x4-pixel blocks (36 blocks x 3 channels,
+// family-wise level 1e-3 with the Sidak correction) and image means (|z| < 3.9). Camera paths
+// sample the filter, light tracing spreads its splats with splatWeight(), and bpt mixes both by
+// MIS. Power: pt with the box filter differs from pt with the Gaussian at that level (the blurred
 // edges of the light and the walls).
 TEST(PixelFilterRender, LightTracingAgreesWithCameraSampling) {
     const int res = 24, block = 4;
     auto scene = cornellWithoutSpheres(res);
-    scene->settings.pixelFilter = PixelFilter::gaussian(1.0f);
+    BlockStats refRenormalized;
     auto options = [](const char* algorithm, uint64_t seed) {
         RenderOptions o;
         o.algorithm = algorithm;
@@ -220,23 +272,29 @@ TEST(PixelFilterRender, LightTracingAgreesWithCameraSampling) {
         o.maxPathLength = 10;
         return o;
     };
-    auto pt = makeIntegrator(*scene, options("pt", 21));
-    BlockStats ref = renderBlockStats(*pt, 256, block);
-    for (const char* algorithm : {"lt", "bpt"}) {
-        auto integrator = makeIntegrator(*scene, options(algorithm, 22));
-        BlockStats s = renderBlockStats(*integrator, algorithm[0] == 'l' ? 256 : 128, block);
-        Agreement g = compare(s, ref);
-        std::printf("[ filter   ] %s vs pt, gaussian stddev 1: %s\n", algorithm, g.report.c_str());
-        EXPECT_GT(g.sidakMinP, 1e-3)
-            << algorithm << ": block " << g.worstBlock << " channel " << g.worstChannel << ": "
-            << s.mean(g.worstBlock, 0) << " vs pt " << ref.mean(g.worstBlock, 0);
-        for (int c = 0; c < 3; ++c) EXPECT_LT(std::fabs(g.meanZ[c]), 3.9) << algorithm;
+    for (PixelFilterBorder border :
+         {PixelFilterBorder::kRenormalized, PixelFilterBorder::kPartitionOfUnity}) {
+        scene->settings.pixelFilter = PixelFilter::gaussian(1.0f).withBorder(border);
+        auto pt = makeIntegrator(*scene, options("pt", 21));
+        BlockStats ref = renderBlockStats(*pt, 256, block);
+        if (border == PixelFilterBorder::kRenormalized) refRenormalized = ref;
+        for (const char* algorithm : {"lt", "bpt"}) {
+            auto integrator = makeIntegrator(*scene, options(algorithm, 22));
+            BlockStats s = renderBlockStats(*integrator, algorithm[0] == 'l' ? 256 : 128, block);
+            Agreement g = compare(s, ref);
+            std::printf("[ filter   ] %s vs pt, %s: %s\n", algorithm,
+                        scene->settings.pixelFilter.describe().c_str(), g.report.c_str());
+            EXPECT_GT(g.sidakMinP, 1e-3)
+                << algorithm << ": block " << g.worstBlock << " channel " << g.worstChannel << ": "
+                << s.mean(g.worstBlock, 0) << " vs pt " << ref.mean(g.worstBlock, 0);
+            for (int c = 0; c < 3; ++c) EXPECT_LT(std::fabs(g.meanZ[c]), 3.9) << algorithm;
+        }
     }
     // Power: the box-filtered image is distinguishable from the Gaussian one.
     scene->settings.pixelFilter = PixelFilter::box();
     auto ptBox = makeIntegrator(*scene, options("pt", 23));
     BlockStats box = renderBlockStats(*ptBox, 256, block);
-    Agreement g = compare(box, ref);
+    Agreement g = compare(box, refRenormalized);
     std::printf("[ filter   ] pt box vs pt gaussian: %s\n", g.report.c_str());
     EXPECT_LT(g.sidakMinP, 1e-3) << "the test cannot tell the filters apart";
 }

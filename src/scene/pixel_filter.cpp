@@ -43,6 +43,7 @@ std::string PixelFilter::describe() const {
             s << "gaussian (stddev " << stddev_ << ", radius " << radius_ << ")";
             break;
     }
+    if (border_ == PixelFilterBorder::kPartitionOfUnity) s << ", borders as Mitsuba's ptracer";
     return s.str();
 }
 
@@ -105,8 +106,21 @@ double PixelFilter::sample1(double lo, double hi, double u) const {
     return std::clamp(x, lo, hi);
 }
 
-Vec2 PixelFilter::sampleRaster(int x, int y, const Vec2& u, int width, int height) const {
+Vec2 PixelFilter::sampleRaster(int x, int y, const Vec2& u, int width, int height,
+                               float* weight) const {
+    if (weight) *weight = 1.0f;
     if (type_ == PixelFilterType::kBox) return Vec2(float(x) + u.x, float(y) + u.y);
+    if (border_ == PixelFilterBorder::kPartitionOfUnity) {
+        const double tx = x + 0.5 + sample1(-radius_, radius_, double(u.x));
+        const double ty = y + 0.5 + sample1(-radius_, radius_, double(u.y));
+        const Vec2 p{float(tx), float(ty)};
+        if (weight) {
+            const bool inside =
+                p.x >= 0.0f && p.x < float(width) && p.y >= 0.0f && p.y < float(height);
+            *weight = inside ? float(norm_ / coverage1(tx) * norm_ / coverage1(ty)) : 0.0f;
+        }
+        return p;
+    }
     auto axis = [&](int i, double ui, int size) {
         const double c = double(i) + 0.5;
         // The footprint restricted to the image [0, size].
@@ -118,10 +132,22 @@ Vec2 PixelFilter::sampleRaster(int x, int y, const Vec2& u, int width, int heigh
     return Vec2(axis(x, double(u.x), width), axis(y, double(u.y), height));
 }
 
+double PixelFilter::coverage1(double t) const {
+    // Pixel centres k + 1/2 within the radius of t.
+    double s = 0.0;
+    const int k0 = int(std::floor(t - 0.5 - radius_)), k1 = int(std::ceil(t - 0.5 + radius_));
+    for (int k = k0; k <= k1; ++k) s += eval1(t - (double(k) + 0.5));
+    return s;
+}
+
 double PixelFilter::weight1(int i, double t, int size) const {
     const double c = double(i) + 0.5;
     const double f = eval1(t - c);
     if (f <= 0.0) return 0.0;
+    if (border_ == PixelFilterBorder::kPartitionOfUnity) {
+        const double s = coverage1(t);
+        return s > 0.0 ? f / s : 0.0;
+    }
     const double mass = cdf1(double(size) - c) - cdf1(-c);  // part of the footprint in the image
     return mass > 0.0 ? f / (norm_ * mass) : 0.0;
 }

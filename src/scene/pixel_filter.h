@@ -17,6 +17,14 @@
 // contributes fhat_ij(p) to every pixel whose footprint contains p (splatWeight()).
 // The box filter (radius 1/2) samples exactly pixel + u, as without a filter.
 //
+// Border convention kPartitionOfUnity (Mitsuba 3's particle tracer, `ptracer`, which splats
+// each particle with weights normalised to sum to 1 over the whole footprint, pixels outside
+// the image included, and drops what falls outside): the filter of pixel ij is
+//     w_ij(p) = f(p - c_ij) / S(p),   S(p) = sum over all pixel centres c (unclipped) of f(p - c),
+// restricted to the image, so border pixels are not renormalised. Camera paths sample p from
+// the normalised f over the whole footprint with weight integral(f) / S(p), 0 outside the
+// image; splats use w_ij. For the box and for a tent of radius 1, S = integral(f) = 1.
+//
 // Profiles (Mitsuba 3's definitions, src/rfilters/*.cpp there):
 //   box:      f1(x) = 1 for |x| < 1/2
 //   tent:     f1(x) = max(0, 1 - |x| / r), default r = 1
@@ -32,6 +40,12 @@ namespace ub {
 
 enum class PixelFilterType : uint8_t { kBox, kTent, kGaussian };
 
+/// How pixels whose footprint leaves the image are normalised (see above).
+enum class PixelFilterBorder : uint8_t {
+    kRenormalized,      ///< filter normalised over the image (Mitsuba's sampling integrators)
+    kPartitionOfUnity,  ///< weights f / S over the whole footprint (Mitsuba's ptracer)
+};
+
 class PixelFilter {
   public:
     /// The box filter (unibeam's default).
@@ -42,6 +56,13 @@ class PixelFilter {
     /// Gaussian of standard deviation stddev (> 0) pixels, cut off at 4 stddev.
     static PixelFilter gaussian(float stddev);
 
+    /// The same filter with another border convention.
+    PixelFilter withBorder(PixelFilterBorder border) const {
+        PixelFilter f = *this;
+        f.border_ = border;
+        return f;
+    }
+    PixelFilterBorder border() const { return border_; }
     PixelFilterType type() const { return type_; }
     bool isBox() const { return type_ == PixelFilterType::kBox; }
     float radius() const { return float(radius_); }
@@ -54,11 +75,16 @@ class PixelFilter {
     /// Its cumulative integral from -radius, normalised: cdf1(-radius) = 0, cdf1(radius) = 1.
     double cdf1(double x) const;
 
-    /// A raster position in pixel (x, y) of a width x height image drawn from fhat_xy with
-    /// u in [0,1)^2 (box: exactly (x + u.x, y + u.y)). Always inside the image.
-    Vec2 sampleRaster(int x, int y, const Vec2& u, int width, int height) const;
-    /// fhat_xy(p): the density of sampleRaster(x, y, ...) at raster position p (per unit
-    /// raster area); 0 outside pixel (x, y)'s footprint or outside the image.
+    /// A raster position for pixel (x, y) of a width x height image, u in [0,1)^2, and the
+    /// weight of a camera path through it (*weight, may be null). kRenormalized: drawn from
+    /// fhat_xy, always inside the image, weight 1 (box: exactly (x + u.x, y + u.y)).
+    /// kPartitionOfUnity: drawn from the normalised filter over the whole footprint, weight
+    /// integral(f) / S(p), 0 when p is outside the image (then the path adds nothing).
+    Vec2 sampleRaster(int x, int y, const Vec2& u, int width, int height,
+                      float* weight = nullptr) const;
+    /// The filter of pixel (x, y) at raster position p (per unit raster area): fhat_xy(p), or
+    /// w_xy(p) with kPartitionOfUnity; 0 outside the footprint or outside the image. The
+    /// expected camera-path estimate of the pixel is its integral against the image.
     float splatWeight(int x, int y, const Vec2& p, int width, int height) const;
     /// The pixels whose footprint may contain raster position p, clipped to the image:
     /// [*x0, *x1] x [*y0, *y1] (empty when *x0 > *x1 or *y0 > *y1).
@@ -67,10 +93,13 @@ class PixelFilter {
   private:
     /// Offset in [lo, hi] (within (-r, r)) drawn from f1 restricted to [lo, hi].
     double sample1(double lo, double hi, double u) const;
-    /// fhat along one axis: f1(t - c) / (integral of f1 over the image around c).
+    /// The filter along one axis at raster coordinate t for pixel i.
     double weight1(int i, double t, int size) const;
+    /// S1(t) = sum over all integers k of f1(t - k - 1/2).
+    double coverage1(double t) const;
 
     PixelFilterType type_ = PixelFilterType::kBox;
+    PixelFilterBorder border_ = PixelFilterBorder::kRenormalized;
     double radius_ = 0.5, stddev_ = 0.0;
     double norm_ = 1.0;  ///< integral of f1 over (-radius, radius)
 };

@@ -96,6 +96,11 @@ void Builder::build() {
             r_.error(o.pos, o.label() + " cannot appear at the top level of a scene");
         }
     }
+    // Mitsuba's ptracer normalises its splats over the whole filter footprint (border pixels
+    // are not renormalised); its image is rendered with that convention whatever -a chooses.
+    if (b_.scene.settings.defaultAlgorithm == "lt")
+        b_.scene.settings.pixelFilter =
+            b_.scene.settings.pixelFilter.withBorder(PixelFilterBorder::kPartitionOfUnity);
     if (!sensor)
         r_.error(XmlPos{b_.xml.file, 0, 0},
                  "the scene has no <sensor> (expected one "
