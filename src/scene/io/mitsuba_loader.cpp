@@ -467,7 +467,13 @@ void Builder::readShape(const XmlObject& o) {
     }
     // A null BSDF on an emitter: Mitsuba lets rays pass through it; unibeam's area lights
     // are opaque, so the surface is black (documented in docs/mitsuba.md).
-    if (materialId == -1 && em) materialId = blackMaterial();
+    if (materialId == -1 && em) {
+        r_.warning(o.pos, o.label() + " '" + name +
+                              "': a null BSDF on an emitter makes an opaque black emitting "
+                              "surface (Mitsuba lets rays pass through it; unibeam's area "
+                              "lights are opaque)");
+        materialId = blackMaterial();
+    }
     const bool imaginary = materialId == -1;  // null BSDF + medium: an index-matched boundary
     if (imaginary && em)
         r_.error(em->pos, o.label() + ": a shape with a null BSDF and a medium cannot emit");
