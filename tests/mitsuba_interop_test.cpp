@@ -10,6 +10,7 @@
 
 #include "scene/io/mitsuba_loader.h"
 #include "scene/io/mitsuba_spectra.h"
+#include "scene/texture.h"
 
 using namespace ub;
 
@@ -261,4 +262,56 @@ TEST(MitsubaInterop, HasSpectralExtinctionIsAHintForGreyMedia) {
                          "has_spectral_extinction = false with a sigma_t that differs between "
                          "channels"))
         << e;
+}
+
+// Bitmap filter_type and wrap_mode against values printed by Mitsuba 3.9.1 (scalar_rgb, a raw
+// 4 x 1 bitmap of 0.1, 0.3, 0.6, 0.9, evaluated at v = 0.5 and the u below).
+TEST(MitsubaInterop, BitmapFilterAndWrapModesMatchMitsuba) {
+    Texture t;
+    t.type = TextureType::Bitmap;
+    auto img = std::make_shared<Image>(4, 1);
+    const float texels[4] = {0.1f, 0.3f, 0.6f, 0.9f};
+    for (int x = 0; x < 4; ++x) img->at(x, 0) = Rgb(texels[x]);
+    t.image = img;
+    const float us[9] = {-0.6f, -0.1f, 0.05f, 0.3f, 0.95f, 1.05f, 1.3f, 1.6f, 2.2f};
+    struct Expected {
+        TextureFilter filter;
+        TextureWrap wrap;
+        float values[9];
+    };
+    const Expected cases[] = {
+        {TextureFilter::Nearest,
+         TextureWrap::Repeat,
+         {0.3f, 0.9f, 0.1f, 0.3f, 0.9f, 0.1f, 0.3f, 0.6f, 0.1f}},
+        {TextureFilter::Nearest,
+         TextureWrap::Mirror,
+         {0.6f, 0.1f, 0.1f, 0.3f, 0.9f, 0.9f, 0.6f, 0.3f, 0.1f}},
+        {TextureFilter::Nearest,
+         TextureWrap::Clamp,
+         {0.1f, 0.1f, 0.1f, 0.3f, 0.9f, 0.9f, 0.9f, 0.9f, 0.9f}},
+        {TextureFilter::Bilinear,
+         TextureWrap::Repeat,
+         {0.33f, 0.82f, 0.34f, 0.24f, 0.66f, 0.34f, 0.24f, 0.57f, 0.16f}},
+        {TextureFilter::Bilinear,
+         TextureWrap::Mirror,
+         {0.57f, 0.1f, 0.1f, 0.24f, 0.9f, 0.9f, 0.69f, 0.33f, 0.16f}},
+        {TextureFilter::Bilinear,
+         TextureWrap::Clamp,
+         {0.1f, 0.1f, 0.1f, 0.24f, 0.9f, 0.9f, 0.9f, 0.9f, 0.9f}},
+    };
+    for (const Expected& c : cases) {
+        t.filter = c.filter;
+        t.wrap = c.wrap;
+        for (int i = 0; i < 9; ++i)
+            EXPECT_NEAR(t.eval(Vec2(us[i], 0.5f)).x, c.values[i], 1e-4f)
+                << "filter " << int(c.filter) << " wrap " << int(c.wrap) << " u " << us[i];
+    }
+    std::string e = errorsOf(scene("",
+                                   "<shape type=\"rectangle\"><bsdf type=\"diffuse\"><texture "
+                                   "type=\"bitmap\" name=\"reflectance\"><string "
+                                   "name=\"filename\" value=\"x.png\"/><string "
+                                   "name=\"wrap_mode\" value=\"border\"/></texture></bsdf>"
+                                   "</shape>\n" +
+                                       std::string(kLight)));
+    EXPECT_TRUE(contains(e, "wrap_mode 'border' is not one of repeat, mirror, clamp")) << e;
 }

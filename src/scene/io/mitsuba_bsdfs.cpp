@@ -36,13 +36,19 @@ int buildTexture(MitsubaBuild& b, const XmlObject& t) {
     } else if (t.type == "bitmap") {
         tex.type = TextureType::Bitmap;
         std::string filter = r.getString(t, "filter_type", "bilinear");
-        if (filter != "bilinear")
+        if (filter == "nearest")
+            tex.filter = TextureFilter::Nearest;
+        else if (filter != "bilinear")
             r.error(t.find("filter_type")->pos,
-                    t.label() + ": filter_type '" + filter + "' is not supported (only bilinear)");
+                    t.label() + ": filter_type '" + filter + "' is not one of bilinear, nearest");
         std::string wrap = r.getString(t, "wrap_mode", "repeat");
-        if (wrap != "repeat")
+        if (wrap == "mirror")
+            tex.wrap = TextureWrap::Mirror;
+        else if (wrap == "clamp")
+            tex.wrap = TextureWrap::Clamp;
+        else if (wrap != "repeat")
             r.error(t.find("wrap_mode")->pos,
-                    t.label() + ": wrap_mode '" + wrap + "' is not supported (only repeat)");
+                    t.label() + ": wrap_mode '" + wrap + "' is not one of repeat, mirror, clamp");
         const bool raw = r.getBool(t, "raw", false);
         std::string file = r.getString(t, "filename", "");
         if (file.empty()) {
