@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "scene/io/mitsuba_loader.h"
@@ -314,4 +316,31 @@ TEST(MitsubaInterop, BitmapFilterAndWrapModesMatchMitsuba) {
                                    "</shape>\n" +
                                        std::string(kLight)));
     EXPECT_TRUE(contains(e, "wrap_mode 'border' is not one of repeat, mirror, clamp")) << e;
+}
+
+// <path> in an included file: relative to that file's folder, else found through the search
+// path (the main scene's folder), as Mitsuba resolves it.
+TEST(MitsubaInterop, PathInAnIncludedFileFallsBackToTheSearchPath) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / "unibeam_interop_path";
+    fs::create_directories(dir / "inc");
+    fs::create_directories(dir / "common" / "meshes");
+    std::ofstream(dir / "common" / "meshes" / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    std::ofstream(dir / "inc" / "shapes.xml")
+        << "<scene version=\"3.0.0\">\n<path value=\"common\"/>\n<shape type=\"obj\"><string "
+           "name=\"filename\" value=\"meshes/tri.obj\"/></shape>\n</scene>\n";
+    std::ofstream(dir / "main.xml")
+        << scene("", std::string("<include filename=\"inc/shapes.xml\"/>\n") + kLight);
+    auto s = loadMitsubaScene((dir / "main.xml").string());
+    EXPECT_EQ(s->shapes.size(), 1u);
+    std::ofstream(dir / "inc" / "shapes.xml")
+        << "<scene version=\"3.0.0\">\n<path value=\"nowhere\"/>\n</scene>\n";
+    try {
+        loadMitsubaScene((dir / "main.xml").string());
+        ADD_FAILURE() << "expected an error";
+    } catch (const InputError& e) {
+        EXPECT_TRUE(
+            contains(e.what(), "shapes.xml:2:1: error: <path> 'nowhere' is not a directory"))
+            << e.what();
+    }
 }
