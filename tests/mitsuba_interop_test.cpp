@@ -13,6 +13,7 @@
 #include "scene/io/mitsuba_loader.h"
 #include "scene/io/mitsuba_spectra.h"
 #include "scene/texture.h"
+#include "tests/support/vol_file.h"
 
 using namespace ub;
 
@@ -343,4 +344,39 @@ TEST(MitsubaInterop, PathInAnIncludedFileFallsBackToTheSearchPath) {
             contains(e.what(), "shapes.xml:2:1: error: <path> 'nowhere' is not a directory"))
             << e.what();
     }
+}
+
+// A gridvolume's unit cube is mapped by its to_world, any affine matrix (here with shear):
+// the voxel containing local point q is found at world point to_world(q).
+TEST(MitsubaInterop, GridVolumeToWorldMapsTheUnitCube) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / "unibeam_interop_grid";
+    fs::create_directories(dir);
+    std::vector<float> values;
+    for (int i = 0; i < 8; ++i) values.push_back(1.0f + float(i));  // x fastest
+    ub::test::writeBinaryFile((dir / "g.vol").string(), ub::test::volBytes(2, 2, 2, 1, values));
+    const char* matrix = "2 0.5 0 1   0 1 0.3 -1   0.2 0 1.5 0.5   0 0 0 1";
+    const std::string body =
+        std::string(
+            "<shape type=\"cube\"><transform name=\"to_world\"><scale value=\"10\"/>"
+            "</transform><bsdf type=\"null\"/><medium type=\"heterogeneous\" "
+            "name=\"interior\"><volume type=\"gridvolume\" name=\"sigma_t\"><string "
+            "name=\"filename\" value=\"g.vol\"/><string name=\"filter_type\" "
+            "value=\"nearest\"/><transform name=\"to_world\"><matrix value=\"") +
+        matrix + "\"/></transform></volume><float name=\"scale\" value=\"3\"/></medium></shape>\n" +
+        kLight;
+    auto s = loadMitsubaSceneFromString(scene("", body), "scene.xml", dir.string());
+    ASSERT_EQ(s->media.size(), 1u);
+    auto world = [&](const Vec3& q) {
+        return Vec3(2 * q.x + 0.5f * q.y + 1, q.y + 0.3f * q.z - 1, 0.2f * q.x + 1.5f * q.z + 0.5f);
+    };
+    for (int i = 0; i < 8; ++i) {
+        const Vec3 q(0.25f + 0.5f * float(i & 1), 0.25f + 0.5f * float((i >> 1) & 1),
+                     0.25f + 0.5f * float((i >> 2) & 1));
+        const MediumCoefficients c = mediumCoefficientsAt(s->media[0], world(q));
+        EXPECT_NEAR(c.sigmaT.x, 3.0f * values[size_t(i)], 1e-4f) << "voxel " << i;
+    }
+    // Outside the mapped cube: no medium.
+    EXPECT_EQ(mediumCoefficientsAt(s->media[0], world(Vec3(1.2f, 0.5f, 0.5f))).sigmaT.x, 0.0f);
+    EXPECT_EQ(mediumCoefficientsAt(s->media[0], world(Vec3(0.5f, -0.1f, 0.5f))).sigmaT.x, 0.0f);
 }
