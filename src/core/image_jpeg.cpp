@@ -68,6 +68,10 @@ Image readJpeg(const std::string& path, bool linearize) {
         throw InputError(path, "corrupt or unsupported JPEG image (libjpeg: " + err.message + ")");
     }
     jpeg_create_decompress(&cinfo);
+    // libjpeg allocates the whole coefficient buffer of a progressive image up front: cap its
+    // memory (beyond it, an error, since no backing store is compiled in) so that a header
+    // announcing a huge image is an error rather than gigabytes.
+    cinfo.mem->max_memory_to_use = long(1) << 30;
     jpeg_mem_src(&cinfo, file.data(), static_cast<unsigned long>(file.size()));
     jpeg_read_header(&cinfo, TRUE);
     if (cinfo.jpeg_color_space == JCS_CMYK || cinfo.jpeg_color_space == JCS_YCCK) {
