@@ -5,6 +5,7 @@
 #include "ub_hash_grid.h"
 #include "ub_medium_homogeneous.h"
 #include "ub_pp3d.h"
+#include "ub_surf.h"
 
 /* Arguments: the lookup (photons, grid), then the tail every estimate kernel shares (queries,
  * their count, media, MIS constants, radius, normalisation, path lengths, results). */
@@ -50,6 +51,11 @@ __kernel void ub_layout_probe(__global uint* out) {
     out[5] = (uint)((__private char*)&ph.dVCM - (__private char*)&ph);
     out[6] = (uint)((__private char*)&q.pixel - (__private char*)&q);
     out[7] = (uint)((__private char*)&b.fwdPassBefore - (__private char*)&b);
+    ub_surface_query s;
+    out[8] = (uint)sizeof(ub_light_vertex);
+    out[9] = (uint)sizeof(ub_surface_query);
+    out[10] = (uint)((__private char*)&s.bsdf.tableIndex - (__private char*)&s);
+    out[11] = (uint)((__private char*)&s.pixel - (__private char*)&s);
 }
 
 #ifdef UB_FORCE_BUILD_ERROR

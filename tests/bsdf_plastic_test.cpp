@@ -57,6 +57,12 @@ Material roughPlastic(float alpha, float ior = 1.49f) {
     prepareMaterial(m);
     return m;
 }
+/// The same rough material with Beckmann microfacets (Mitsuba 3's default), re-prepared.
+Material beckmann(Material m) {
+    m.distribution = MicrofacetDistribution::kBeckmann;
+    prepareMaterial(m);
+    return m;
+}
 Material thinGlass(float ior) {
     Material m;
     m.type = MaterialType::ThinDielectric;
@@ -71,7 +77,8 @@ std::vector<NamedMaterial> plasticMaterials() {
             {"Plastic1.9nonlinear", plastic(1.9f, true), false},
             {"RoughPlastic0.05", roughPlastic(0.05f), true},
             {"RoughPlastic0.3", roughPlastic(0.3f), false},
-            {"RoughPlastic0.8", roughPlastic(0.8f, 1.9f), false}};
+            {"RoughPlastic0.8", roughPlastic(0.8f, 1.9f), false},
+            {"RoughPlastic0.3Beckmann", beckmann(roughPlastic(0.3f)), false}};
 }
 
 Vec3 directionAt(const Vec3& n, float thetaDeg, float side, float phiDeg = 30.0f) {

@@ -273,14 +273,32 @@ TEST(MitsubaXml, EmittersAndMaxDepth) {
     EXPECT_FLOAT_EQ(s->lights[2].radiance.x, 3.0f);
 }
 
-TEST(MitsubaXml, RoughConductorNeedsGgx) {
+// Mitsuba's default microfacet distribution is Beckmann; "ggx" selects GGX; anything else
+// is an error naming the value.
+TEST(MitsubaXml, RoughConductorDistributions) {
+    auto s =
+        load(scene(std::string(kLight) +
+                   "<shape type=\"sphere\">\n  <bsdf type=\"roughconductor\">"
+                   "<rgb name=\"eta\" value=\"0.2\"/><rgb name=\"k\" value=\"3\"/>"
+                   "</bsdf></shape>\n<shape type=\"sphere\"><point name=\"center\" x=\"3\" y=\"0\" "
+                   "z=\"0\"/><bsdf type=\"roughdielectric\"><string name=\"distribution\" "
+                   "value=\"ggx\"/></bsdf></shape>\n"));
+    bool beckmann = false, ggx = false;
+    for (const Material& m : s->materials) {
+        beckmann |= m.type == MaterialType::RoughConductor &&
+                    m.distribution == MicrofacetDistribution::kBeckmann;
+        ggx |= m.type == MaterialType::RoughDielectric &&
+               m.distribution == MicrofacetDistribution::kGgx;
+    }
+    EXPECT_TRUE(beckmann);
+    EXPECT_TRUE(ggx);
     std::string e = errorsOf(scene(std::string(kLight) +
                                    "<shape type=\"sphere\">\n  <bsdf type=\"roughconductor\">"
-                                   "<rgb name=\"eta\" value=\"0.2\"/><rgb name=\"k\" value=\"3\"/>"
+                                   "<string name=\"distribution\" value=\"phong\"/>"
                                    "</bsdf></shape>\n"));
     EXPECT_TRUE(contains(e,
-                         "scene.xml:10:3: error: <bsdf type=\"roughconductor\">: microfacet "
-                         "distribution 'beckmann' (Mitsuba's default) is not supported"))
+                         "scene.xml:10:31: error: <bsdf type=\"roughconductor\">: unknown "
+                         "microfacet distribution 'phong' (expected 'beckmann' or 'ggx')"))
         << e;
 }
 

@@ -208,7 +208,7 @@ TEST(OpenClEstimate, WholeRenderAgreesBetweenBackendsInAGridMedium) {
     auto cl = makeIntegrator(*scene, opt);
     EXPECT_NE(cl->setupNote().find("on OpenCL device"), std::string::npos) << cl->setupNote();
     EXPECT_EQ(cl->setupNote().find("on the host"), std::string::npos) << cl->setupNote();
-    expectBackendsAgree(*host, *cl, 1e-4f, {"pb2d", "bp2d", "bb1d"});
+    expectBackendsAgree(*host, *cl, 1e-4f, {"surf", "pb2d", "bp2d", "bb1d"});
 }
 
 // The program cache: the first runtime builds and caches, the second loads the entry; a

@@ -31,6 +31,8 @@ typedef uint ub_uint;
 #define ub_acos(x) acos(x)
 #define ub_log(x) log(x)
 #define ub_floor(x) floor(x)
+#define ub_erf(x) erf(x)
+#define ub_erfc(x) erfc(x)
 #else
 #include <cmath>
 #include <cstdint>
@@ -50,6 +52,8 @@ typedef uint32_t ub_uint;
 #define ub_acos(x) std::acos(x)
 #define ub_log(x) std::log(x)
 #define ub_floor(x) std::floor(x)
+#define ub_erf(x) std::erf(x)
+#define ub_erfc(x) std::erfc(x)
 #endif
 
 #define UB_PI 3.14159265358979323846f

@@ -1,5 +1,5 @@
-/* GGX (Trowbridge-Reitz) microfacet distribution, isotropic roughness alpha
- * (host C++ and OpenCL C). Local frame: z is the macro-surface normal, and
+/* GGX (Trowbridge-Reitz) and Beckmann microfacet distributions, isotropic roughness
+ * alpha (host C++ and OpenCL C). Local frame: z is the macro-surface normal, and
  * every function here assumes the directions were mirrored to z >= 0 by the
  * caller (GGX is symmetric under z -> -z).
  *
@@ -13,6 +13,12 @@
  *  Sampling of visible normals: Heitz 2018, "Sampling the GGX distribution of
  *         visible normals" (JCGT 7(4)), whose density is
  *         D_v(m) = G1(v) max(0, v.m) D(m) / v.z   (Heitz 2014, eq. 38).
+ *  Beckmann: D = exp(-tan^2 / alpha^2) / (pi alpha^2 cos^4) (Walter et al. 2007, eq. 25;
+ *         Beckmann & Spizzichino 1963); Lambda(v) = (erf(a) - 1) / 2 + exp(-a^2) /
+ *         (2 a sqrt(pi)), a = 1 / (alpha tan theta_v) (Walter et al. 2007, eq. 27 as
+ *         Lambda; Heitz 2014, eq. 80). Its visible normals are sampled on the host
+ *         (src/scene/microfacet_sampling.cpp); the density is D_v above with Beckmann D, G1.
+ *  ub_mf_*: the same quantities for either distribution (UB_MF_GGX, UB_MF_BECKMANN).
  *  Jacobians from the microfacet normal to the generated direction:
  *         reflection 1 / (4 |o.m|) (Walter et al. 2007, eq. 14),
  *         refraction eta_o^2 |o.m| / (eta_i (i.m) + eta_o (o.m))^2 (eq. 17).
@@ -102,6 +108,53 @@ UB_INLINE void ub_ggx_sample_visible(float vx, float vy, float vz, float alpha, 
     *mx = ex * ie;
     *my = ey * ie;
     *mz = ez * ie;
+}
+
+/* Beckmann D(m), m.z = cosThetaM; zero below the surface. */
+UB_INLINE float ub_beckmann_d(float cosThetaM, float alpha) {
+    if (cosThetaM <= 0.0f) return 0.0f;
+    float c2 = cosThetaM * cosThetaM, a2 = alpha * alpha;
+    float tan2 = ub_fmax(0.0f, 1.0f - c2) / c2;
+    return ub_exp(-tan2 / a2) / (UB_PI * a2 * c2 * c2);
+}
+
+/* Beckmann Lambda(v), cosTheta = v.z > 0 (written with erfc: (erf(a) - 1) / 2 = -erfc(a) / 2,
+ * exact for large a where erf(a) rounds to 1). */
+UB_INLINE float ub_beckmann_lambda(float cosTheta, float alpha) {
+    float c2 = cosTheta * cosTheta;
+    if (c2 <= 0.0f) return 1e30f;
+    float s2 = ub_fmax(0.0f, 1.0f - c2);
+    if (s2 <= 0.0f) return 0.0f;
+    float a = cosTheta / (alpha * ub_sqrt(s2)); /* 1 / (alpha tan theta) */
+    if (a > 9.0f) return 0.0f;                  /* exp(-81): below float resolution of 1 + Lambda */
+    return 0.5f * (ub_exp(-a * a) / (a * 1.7724538509055160273f) - ub_erfc(a));
+}
+
+#define UB_MF_GGX 0u
+#define UB_MF_BECKMANN 1u
+
+UB_INLINE float ub_mf_d(ub_uint dist, float cosThetaM, float alpha) {
+    return dist == UB_MF_BECKMANN ? ub_beckmann_d(cosThetaM, alpha) : ub_ggx_d(cosThetaM, alpha);
+}
+UB_INLINE float ub_mf_lambda(ub_uint dist, float cosTheta, float alpha) {
+    return dist == UB_MF_BECKMANN ? ub_beckmann_lambda(cosTheta, alpha)
+                                  : ub_ggx_lambda(cosTheta, alpha);
+}
+UB_INLINE float ub_mf_g1(ub_uint dist, float cosTheta, float alpha) {
+    return 1.0f / (1.0f + ub_mf_lambda(dist, cosTheta, alpha));
+}
+UB_INLINE float ub_mf_g2_correlated(ub_uint dist, float cosThetaI, float cosThetaO, float alpha) {
+    return 1.0f /
+           (1.0f + ub_mf_lambda(dist, cosThetaI, alpha) + ub_mf_lambda(dist, cosThetaO, alpha));
+}
+UB_INLINE float ub_mf_g2_separable(ub_uint dist, float cosThetaI, float cosThetaO, float alpha) {
+    return ub_mf_g1(dist, cosThetaI, alpha) * ub_mf_g1(dist, cosThetaO, alpha);
+}
+/* D_v(m) = G1(v) max(0, v.m) D(m) / v.z (Heitz 2014, eq. 38) for either distribution. */
+UB_INLINE float ub_mf_visible_pdf(ub_uint dist, float cosThetaV, float vDotM, float cosThetaM,
+                                  float alpha) {
+    if (cosThetaV <= 0.0f || vDotM <= 0.0f) return 0.0f;
+    return ub_mf_g1(dist, cosThetaV, alpha) * vDotM * ub_mf_d(dist, cosThetaM, alpha) / cosThetaV;
 }
 
 /* |d omega_o / d omega_m| for reflection (Walter et al. 2007, eq. 14). */

@@ -152,10 +152,6 @@ UB_INLINE float ub_medium_cont_prob(float sigmaS0, float sigmaS1, float sigmaS2,
     return ub_fmin(a, 1.0f);
 }
 
-UB_INLINE ub_float3 ub_f3_from(const float v[3]) {
-    return ub_make_float3(v[0], v[1], v[2]);
-}
-
 #ifndef __OPENCL_C_VERSION__
 #include <cstddef>
 static_assert(sizeof(ub_photon_point) == 80, "ub_photon_point layout");

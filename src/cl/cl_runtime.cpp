@@ -156,11 +156,14 @@ void expandIncludes(const std::string& name, std::set<std::string>& done, std::s
 }
 
 /// A device buffer copied from host data (at least one element, so empty inputs work).
-cl_mem upload(cl_context ctx, const void* data, size_t bytes) {
+/// A read-only buffer with a copy of data, or (useHost: a CPU device, data alive until the
+/// kernel has run) over the host memory itself, which saves the copy on a CPU device.
+cl_mem upload(cl_context ctx, const void* data, size_t bytes, bool useHost = false) {
     cl_int err = CL_SUCCESS;
     static const uint32_t dummy = 0;
-    cl_mem m = clCreateBuffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                              bytes > 0 ? bytes : sizeof(dummy),
+    const cl_mem_flags flags =
+        CL_MEM_READ_ONLY | (useHost && bytes > 0 ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR);
+    cl_mem m = clCreateBuffer(ctx, flags, bytes > 0 ? bytes : sizeof(dummy),
                               const_cast<void*>(bytes > 0 ? data : &dummy), &err);
     check(err, "clCreateBuffer");
     return m;
@@ -257,7 +260,7 @@ ClRuntime::ClRuntime(int platform, int device, const std::string& cacheDir,
     check(err, "clCreateContext");
     queue_ = clCreateCommandQueue(context_, dev, 0, &err);
     check(err, "clCreateCommandQueue");
-    const std::string src = clProgramSource({"pp3d.cl", "beams.cl"});
+    const std::string src = clProgramSource({"pp3d.cl", "beams.cl", "surf.cl"});
     const std::string options =
         std::string("-cl-std=CL1.2") + (extraOptions.empty() ? "" : " " + extraOptions);
     // Program cache: key = source, options, device, driver.
@@ -302,7 +305,7 @@ ClRuntime::ClRuntime(int platform, int device, const std::string& cacheDir,
             clGetProgramBuildInfo(program_, dev, CL_PROGRAM_BUILD_LOG, 0, nullptr, &n);
             std::string log(n, '\0');
             clGetProgramBuildInfo(program_, dev, CL_PROGRAM_BUILD_LOG, n, &log[0], nullptr);
-            throw ClError("OpenCL: building kernels/pp3d.cl and kernels/beams.cl for " +
+            throw ClError("OpenCL: building kernels/pp3d.cl, beams.cl and surf.cl for " +
                           desc_.device + " with options '" + options + "' failed:\n" + log);
         }
         if (!cachePath.empty()) {
@@ -328,17 +331,24 @@ ClRuntime::ClRuntime(int platform, int device, const std::string& cacheDir,
     check(err, "clCreateKernel(ub_bp2d_estimate)");
     bb1d_ = clCreateKernel(program_, "ub_bb1d_estimate", &err);
     check(err, "clCreateKernel(ub_bb1d_estimate)");
+    surf_ = clCreateKernel(program_, "ub_surf_estimate", &err);
+    check(err, "clCreateKernel(ub_surf_estimate)");
     checkLayout();
 }
+
+namespace {
+constexpr int kProbeEntries = 12;  // what kernels/pp3d.cl's ub_layout_probe writes
+}  // namespace
 
 void ClRuntime::checkLayout() {
     cl_int err = CL_SUCCESS;
     cl_kernel probe = clCreateKernel(program_, "ub_layout_probe", &err);
     check(err, "clCreateKernel(ub_layout_probe)");
-    cl_mem out = clCreateBuffer(context_, CL_MEM_WRITE_ONLY, 8 * sizeof(cl_uint), nullptr, &err);
+    cl_mem out =
+        clCreateBuffer(context_, CL_MEM_WRITE_ONLY, kProbeEntries * sizeof(cl_uint), nullptr, &err);
     if (err != CL_SUCCESS) clReleaseKernel(probe);
     check(err, "clCreateBuffer(layout probe)");
-    cl_uint device[8] = {};
+    cl_uint device[kProbeEntries] = {};
     const size_t one = 1;
     err = clSetKernelArg(probe, 0, sizeof(cl_mem), &out);
     if (err == CL_SUCCESS)
@@ -349,23 +359,31 @@ void ClRuntime::checkLayout() {
     clReleaseMemObject(out);
     clReleaseKernel(probe);
     check(err, "running the layout probe");
-    const cl_uint host[8] = {cl_uint(sizeof(ub_photon_point)),
-                             cl_uint(sizeof(ub_query_point)),
-                             cl_uint(sizeof(ub_beam)),
-                             cl_uint(sizeof(ub_hash_grid)),
-                             cl_uint(sizeof(ub_mis_constants)),
-                             cl_uint(offsetof(ub_photon_point, dVCM)),
-                             cl_uint(offsetof(ub_query_point, pixel)),
-                             cl_uint(offsetof(ub_beam, fwdPassBefore))};
-    const char* what[8] = {"sizeof(ub_photon_point)",
-                           "sizeof(ub_query_point)",
-                           "sizeof(ub_beam)",
-                           "sizeof(ub_hash_grid)",
-                           "sizeof(ub_mis_constants)",
-                           "offsetof(ub_photon_point, dVCM)",
-                           "offsetof(ub_query_point, pixel)",
-                           "offsetof(ub_beam, fwdPassBefore)"};
-    for (int i = 0; i < 8; ++i)
+    const cl_uint host[kProbeEntries] = {cl_uint(sizeof(ub_photon_point)),
+                                         cl_uint(sizeof(ub_query_point)),
+                                         cl_uint(sizeof(ub_beam)),
+                                         cl_uint(sizeof(ub_hash_grid)),
+                                         cl_uint(sizeof(ub_mis_constants)),
+                                         cl_uint(offsetof(ub_photon_point, dVCM)),
+                                         cl_uint(offsetof(ub_query_point, pixel)),
+                                         cl_uint(offsetof(ub_beam, fwdPassBefore)),
+                                         cl_uint(sizeof(ub_light_vertex)),
+                                         cl_uint(sizeof(ub_surface_query)),
+                                         cl_uint(offsetof(ub_surface_query, bsdf.tableIndex)),
+                                         cl_uint(offsetof(ub_surface_query, pixel))};
+    const char* what[kProbeEntries] = {"sizeof(ub_photon_point)",
+                                       "sizeof(ub_query_point)",
+                                       "sizeof(ub_beam)",
+                                       "sizeof(ub_hash_grid)",
+                                       "sizeof(ub_mis_constants)",
+                                       "offsetof(ub_photon_point, dVCM)",
+                                       "offsetof(ub_query_point, pixel)",
+                                       "offsetof(ub_beam, fwdPassBefore)",
+                                       "sizeof(ub_light_vertex)",
+                                       "sizeof(ub_surface_query)",
+                                       "offsetof(ub_surface_query, bsdf.tableIndex)",
+                                       "offsetof(ub_surface_query, pixel)"};
+    for (int i = 0; i < kProbeEntries; ++i)
         if (device[i] != host[i])
             throw ClError("OpenCL: device '" + desc_.device +
                           "' lays out the shared records "
@@ -375,8 +393,10 @@ void ClRuntime::checkLayout() {
 }
 
 ClRuntime::~ClRuntime() {
-    for (cl_kernel k : {pp3d_, pb2d_, bp2d_, bb1d_})
+    for (cl_kernel k : {pp3d_, pb2d_, bp2d_, bb1d_, surf_})
         if (k) clReleaseKernel(k);
+    for (cl_mem m : {gridInfoMem_, gridDataMem_})
+        if (m) clReleaseMemObject(m);
     if (program_) clReleaseProgram(program_);
     if (queue_) clReleaseCommandQueue(queue_);
     if (context_) clReleaseContext(context_);
@@ -424,7 +444,7 @@ void ClRuntime::runEstimate(cl_kernel kernel, const char* name, const std::vecto
     std::vector<Arg> fixed = lookup;
     size_t lookupBytes = 0;
     for (const Arg& x : lookup) {
-        if (!x.buffer) continue;
+        if (!x.buffer || x.mem) continue;
         lookupBytes += x.bytes;
         if (desc_.maxAllocBytes > 0 && x.bytes > desc_.maxAllocBytes)
             throw ClError(std::string("OpenCL: ") + name + ": a lookup buffer needs " +
@@ -442,8 +462,11 @@ void ClRuntime::runEstimate(cl_kernel kernel, const char* name, const std::vecto
     MemList fixedMems;
     cl_uint index = 0;
     for (const Arg& x : fixed) {
-        if (x.buffer) {
-            cl_mem m = upload(context_, x.data, x.bytes);
+        if (x.mem) {
+            check(clSetKernelArg(kernel, index++, sizeof(cl_mem), &x.mem), "clSetKernelArg");
+        } else if (x.buffer) {
+            // On a CPU device the kernel reads the lookups in place (they outlive this call).
+            cl_mem m = upload(context_, x.data, x.bytes, desc_.type == "CPU");
             fixedMems.mems.push_back(m);
             check(clSetKernelArg(kernel, index++, sizeof(cl_mem), &m), "clSetKernelArg");
         } else {
@@ -474,7 +497,9 @@ void ClRuntime::runEstimate(cl_kernel kernel, const char* name, const std::vecto
         MemList batchMems;
         cl_int err = CL_SUCCESS;
         const char* step = "clCreateBuffer(queries)";
-        cl_mem q = clCreateBuffer(context_, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, n * querySize,
+        const cl_mem_flags queryFlags =
+            CL_MEM_READ_ONLY | (desc_.type == "CPU" ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR);
+        cl_mem q = clCreateBuffer(context_, queryFlags, n * querySize,
                                   const_cast<char*>(base + begin * querySize), &err);
         if (err == CL_SUCCESS) {
             batchMems.mems.push_back(q);
@@ -517,7 +542,52 @@ void ClRuntime::runEstimate(cl_kernel kernel, const char* name, const std::vecto
 namespace {
 const std::vector<ub_grid_info> kNoGrids;
 const std::vector<uint8_t> kNoGridData;
+
+std::vector<ClRuntime::Arg> withGrids(std::vector<ClRuntime::Arg> lookup,
+                                      const std::vector<ClRuntime::Arg>& grids) {
+    lookup.insert(lookup.end(), grids.begin(), grids.end());
+    return lookup;
+}
 }  // namespace
+
+std::vector<ClRuntime::Arg> ClRuntime::gridArgs(const EstimateArgs& a) const {
+    if (a.grids || !gridInfoMem_)
+        return {bufferArg(a.grids ? *a.grids : kNoGrids),
+                bufferArg(a.gridData ? *a.gridData : kNoGridData)};
+    Arg info{nullptr, 0, true, gridInfoMem_}, data{nullptr, 0, true, gridDataMem_};
+    return {info, data};
+}
+
+void ClRuntime::setGridMedia(const std::vector<ub_grid_info>& grids,
+                             const std::vector<uint8_t>& gridData) {
+    for (cl_mem* m : {&gridInfoMem_, &gridDataMem_})
+        if (*m) {
+            clReleaseMemObject(*m);
+            *m = nullptr;
+        }
+    const size_t bytes = grids.size() * sizeof(ub_grid_info) + gridData.size();
+    if (desc_.maxAllocBytes > 0 && gridData.size() > desc_.maxAllocBytes)
+        throw ClError("OpenCL: the grid media need " + std::to_string(gridData.size() >> 20) +
+                      " MB, more than the device's largest allocation (" +
+                      std::to_string(desc_.maxAllocBytes >> 20) +
+                      " MB): use --backend host for this scene");
+    const Arg info = bufferArg(grids.empty() ? kNoGrids : grids);
+    const Arg data = bufferArg(gridData.empty() ? kNoGridData : gridData);
+    gridInfoMem_ = upload(context_, info.data, info.bytes);
+    gridDataMem_ = upload(context_, data.data, data.bytes);
+    gridMediaBytes_ = bytes;
+}
+
+void ClRuntime::estimateSurf(const std::vector<LightVertex>& photons, const HashGrid& grid,
+                             const std::vector<float>& tables,
+                             const std::vector<ub_surface_query>& queries, const EstimateArgs& a,
+                             std::vector<Rgb>* out) {
+    if (photons.empty()) return out->assign(queries.size(), Rgb(0.0f));
+    runEstimate(surf_, "clEnqueueNDRangeKernel(ub_surf_estimate)",
+                {bufferArg(photons), bufferArg(grid.cellEnds()), bufferArg(grid.indices()),
+                 scalarArg(grid.params()), bufferArg(tables)},
+                bufferArg(queries), queries.size(), a, out);
+}
 
 void ClRuntime::estimatePP3D(const std::vector<ub_photon_point>& photons, const HashGrid& grid,
                              const std::vector<ub_query_point>& queries, const EstimateArgs& a,
@@ -533,11 +603,11 @@ void ClRuntime::estimatePB2D(const std::vector<ub_photon_point>& photons, const 
                              const std::vector<ub_beam>& queries, const EstimateArgs& a,
                              std::vector<Rgb>* out) {
     if (photons.empty() || spheres.empty()) return out->assign(queries.size(), Rgb(0.0f));
-    runEstimate(pb2d_, "clEnqueueNDRangeKernel(ub_pb2d_estimate)",
-                {bufferArg(photons), bufferArg(spheres.nodes()), bufferArg(spheres.prims()),
-                 bufferArg(a.grids ? *a.grids : kNoGrids),
-                 bufferArg(a.gridData ? *a.gridData : kNoGridData)},
-                bufferArg(queries), queries.size(), a, out);
+    runEstimate(
+        pb2d_, "clEnqueueNDRangeKernel(ub_pb2d_estimate)",
+        withGrids({bufferArg(photons), bufferArg(spheres.nodes()), bufferArg(spheres.prims())},
+                  gridArgs(a)),
+        bufferArg(queries), queries.size(), a, out);
 }
 
 void ClRuntime::estimateBP2D(const std::vector<ub_beam>& beams,
@@ -546,9 +616,9 @@ void ClRuntime::estimateBP2D(const std::vector<ub_beam>& beams,
                              std::vector<Rgb>* out) {
     if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
     runEstimate(bp2d_, "clEnqueueNDRangeKernel(ub_bp2d_estimate)",
-                {bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()), bufferArg(bvh.prims()),
-                 bufferArg(a.grids ? *a.grids : kNoGrids),
-                 bufferArg(a.gridData ? *a.gridData : kNoGridData)},
+                withGrids({bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()),
+                           bufferArg(bvh.prims())},
+                          gridArgs(a)),
                 bufferArg(queries), queries.size(), a, out);
 }
 
@@ -558,9 +628,9 @@ void ClRuntime::estimateBB1D(const std::vector<ub_beam>& beams,
                              std::vector<Rgb>* out) {
     if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
     runEstimate(bb1d_, "clEnqueueNDRangeKernel(ub_bb1d_estimate)",
-                {bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()), bufferArg(bvh.prims()),
-                 bufferArg(a.grids ? *a.grids : kNoGrids),
-                 bufferArg(a.gridData ? *a.gridData : kNoGridData)},
+                withGrids({bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()),
+                           bufferArg(bvh.prims())},
+                          gridArgs(a)),
                 bufferArg(queries), queries.size(), a, out);
 }
 

@@ -6,9 +6,9 @@
 // Queries go to the device in batches that fit its largest allocation and global memory;
 // running out of resources halves the batch and retries (runEstimate).
 //
-// pp3d runs as a kernel (kernels/pp3d.cl) in every medium; pb2d, bp2d and bb1d
-// (kernels/beams.cl) in homogeneous media and in nearest-filtered NanoVDB grids without an
-// albedo grid (regular tracking through the grid read with CNanoVDB.h,
+// pp3d and surface merging run as kernels (kernels/pp3d.cl, kernels/surf.cl) in every scene; pb2d,
+// bp2d and bb1d (kernels/beams.cl) in homogeneous media and in nearest-filtered NanoVDB grids
+// without an albedo grid (regular tracking through the grid read with CNanoVDB.h,
 // kernels/shared/ub_grid_medium.h); scenes with other grid media run them on the host.
 // Results come back one per query and are added to pixels on the host in query order, so
 // no float atomics are needed and images are deterministic.
@@ -28,7 +28,9 @@
 #include "estimators/grid_access.h"
 #include "kernels/shared/ub_bvh.h"
 #include "kernels/shared/ub_medium_homogeneous.h"
+#include "kernels/shared/ub_surf.h"
 #include "kernels/shared/ub_upbp_records.h"
+#include "render/light_vertex.h"
 
 namespace ub {
 
@@ -102,6 +104,19 @@ class ClRuntime {
     void estimateBB1D(const std::vector<ub_beam>& beams, const std::vector<ub_beam_part>& parts,
                       const Bvh& bvh, const std::vector<ub_beam>& queries, const EstimateArgs& a,
                       std::vector<Rgb>* out);
+    /// Surface merging (kernels/surf.cl) over surface photons and surface queries; tables:
+    /// the materials' rough-plastic coating tables (estimators/surface_merging.h).
+    void estimateSurf(const std::vector<LightVertex>& photons, const HashGrid& grid,
+                      const std::vector<float>& tables,
+                      const std::vector<ub_surface_query>& queries, const EstimateArgs& a,
+                      std::vector<Rgb>* out);
+
+    /// Uploads the grid media for the beam kernels once per render (grids[m] describes
+    /// medium m inside gridData); later estimates with EstimateArgs::grids == nullptr use
+    /// these device buffers instead of uploading them each time. Throws ClError.
+    void setGridMedia(const std::vector<ub_grid_info>& grids, const std::vector<uint8_t>& gridData);
+    /// Bytes of the resident grid-media buffers.
+    size_t gridMediaBytes() const { return gridMediaBytes_; }
 
     /// Batches launched so far, and retries with a smaller batch after the device ran out of
     /// resources (runEstimate).
@@ -111,11 +126,13 @@ class ClRuntime {
     /// k launches fail with CL_OUT_OF_RESOURCES.
     void setMaxBatchForTest(size_t n) { maxBatchForTest_ = n; }
     void failLaunchesForTest(int k) { failLaunchesForTest_ = k; }
-    /// A kernel argument: host data uploaded as a buffer, or a scalar/struct by value.
+    /// A kernel argument: host data uploaded as a buffer, a scalar/struct by value, or a
+    /// buffer already on the device (mem).
     struct Arg {
         const void* data;
         size_t bytes;
         bool buffer;
+        cl_mem mem = nullptr;
     };
 
   private:
@@ -127,7 +144,11 @@ class ClRuntime {
     cl_context context_ = nullptr;
     cl_command_queue queue_ = nullptr;
     cl_program program_ = nullptr;
-    cl_kernel pp3d_ = nullptr, pb2d_ = nullptr, bp2d_ = nullptr, bb1d_ = nullptr;
+    cl_kernel pp3d_ = nullptr, pb2d_ = nullptr, bp2d_ = nullptr, bb1d_ = nullptr, surf_ = nullptr;
+    cl_mem gridInfoMem_ = nullptr, gridDataMem_ = nullptr;  ///< setGridMedia()
+    size_t gridMediaBytes_ = 0;
+    /// The grid-media arguments of a beam kernel: a's own vectors, else the resident buffers.
+    std::vector<Arg> gridArgs(const EstimateArgs& a) const;
     size_t batches_ = 0, batchRetries_ = 0, maxBatchForTest_ = 0;
     int failLaunchesForTest_ = 0;
     /// Runs estimate kernel `kernel` over `count` queries: its arguments are `lookup`, then

@@ -132,35 +132,14 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
 
     t0 = std::chrono::steady_clock::now();
     std::vector<Rgb> perPoint[4], perBeam[4];
-    // The beam kernels evaluate homogeneous media in closed form and nearest-filtered grids
-    // without an albedo grid by regular tracking through the grid (kernels/beams.cl); the
-    // grids go to the device concatenated, each at a 32-byte aligned offset (NanoVDB's
-    // alignment). Other grid media keep these estimators on the host.
-    std::vector<ub_medium_info> media;
-    std::vector<ub_grid_info> grids(in.scene->media.size());
-    std::vector<uint8_t> gridData;
-    bool beamsOnDevice = true;
-    for (size_t i = 0; i < in.scene->media.size(); ++i) {
-        const Medium& m = in.scene->media[i];
-        media.push_back(mediumInfo(m));
-        if (m.type == MediumType::kHomogeneous || !in.cl || !t.photonBeams() && !t.pb2d) continue;
-        if (!gridMediumOnDevice(m)) {
-            beamsOnDevice = false;
-            continue;
-        }
-        const size_t offset = (gridData.size() + 31) & ~size_t(31);
-        const nanovdb::FloatGrid& g = m.grid->grid();
-        const uint8_t* bytes = reinterpret_cast<const uint8_t*>(&g);
-        gridData.resize(offset);
-        gridData.insert(gridData.end(), bytes, bytes + g.gridSize());
-        grids[i] = gridInfo(m, uint32_t(offset));
-    }
-    ClRuntime* beamCl = beamsOnDevice ? in.cl : nullptr;
+    // The media as the kernels see them and the grid media on the device were prepared once
+    // for the render (prepareDeviceMedia).
+    static const std::vector<ub_medium_info> kNoMedia(1, ub_medium_info{});
+    const std::vector<ub_medium_info>& media = in.deviceMedia ? *in.deviceMedia : kNoMedia;
+    ClRuntime* beamCl = in.beamKernels ? in.cl : nullptr;
     auto clArgs = [&](int tech, float normalization) {
         ClRuntime::EstimateArgs a;
-        a.media = &media;
-        a.grids = &grids;
-        a.gridData = &gridData;
+        a.media = &media;  // grids: resident on the device (ClRuntime::setGridMedia)
         a.mis = in.mis;
         a.radius = in.radius[tech];
         a.normalization = normalization;
@@ -237,6 +216,36 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
             for (size_t i = 0; i < nBeams; ++i)
                 add((*in.queryBeams)[i].pixel, tech, perBeam[tech][i]);
     }
+}
+
+bool prepareDeviceMedia(const Scene& scene, ClRuntime* cl, bool needGrids,
+                        std::vector<ub_medium_info>* media) {
+    // The beam kernels evaluate homogeneous media in closed form and nearest-filtered grids
+    // without an albedo grid by regular tracking through the grid (kernels/beams.cl); the
+    // grids go to the device concatenated, each at a 32-byte aligned offset (NanoVDB's
+    // alignment), once per render. Other grid media keep the beam estimators on the host.
+    media->clear();
+    std::vector<ub_grid_info> grids(scene.media.size());
+    std::vector<uint8_t> gridData;
+    bool beamKernels = true;
+    for (size_t i = 0; i < scene.media.size(); ++i) {
+        const Medium& m = scene.media[i];
+        media->push_back(mediumInfo(m));
+        if (m.type == MediumType::kHomogeneous || !needGrids) continue;
+        if (!gridMediumOnDevice(m)) {
+            beamKernels = false;
+            continue;
+        }
+        const size_t offset = (gridData.size() + 31) & ~size_t(31);
+        const nanovdb::FloatGrid& g = m.grid->grid();
+        const uint8_t* bytes = reinterpret_cast<const uint8_t*>(&g);
+        gridData.resize(offset);
+        gridData.insert(gridData.end(), bytes, bytes + g.gridSize());
+        grids[i] = gridInfo(m, uint32_t(offset));
+    }
+    if (media->empty()) media->push_back(ub_medium_info{});  // never an empty buffer
+    if (cl && beamKernels) cl->setGridMedia(grids, gridData);
+    return beamKernels;
 }
 
 }  // namespace ub

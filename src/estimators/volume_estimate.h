@@ -32,6 +32,7 @@
 
 #include "core/image.h"
 #include "kernels/shared/ub_bvh.h"
+#include "kernels/shared/ub_medium_homogeneous.h"
 #include "kernels/shared/ub_upbp_records.h"
 #include "render/contribution_guard.h"
 #include "render/upbp_techniques.h"
@@ -55,7 +56,11 @@ struct VolumeEstimateInput {
     const std::vector<ub_beam>* photonBeams = nullptr;
     const std::vector<ub_query_point>* queryPoints = nullptr;
     const std::vector<ub_beam>* queryBeams = nullptr;
-    ClRuntime* cl = nullptr;         ///< the OpenCL backend (kernels for what it has), or host only
+    ClRuntime* cl = nullptr;  ///< the OpenCL backend (kernels for what it has), or host only
+    /// With cl: the media as the kernels see them, and whether the beam kernels can run in
+    /// every medium (prepareDeviceMedia, once per render).
+    const std::vector<ub_medium_info>* deviceMedia = nullptr;
+    bool beamKernels = false;
     MemoryBudget* budget = nullptr;  ///< lookups reserve here while they live (--max-memory)
     /// Contribution guards per technique (UB_TECH_*; render/contribution_guard.h): each
     /// query's estimate passes its technique's guard before it is added to its pixel.
@@ -73,6 +78,13 @@ struct VolumeEstimateStats {
     /// Query estimates dropped by the guard (NaN, infinite or negative), per technique.
     uint64_t rejected[4] = {0, 0, 0, 0};
 };
+
+/// The media as the kernels see them (one ub_medium_info per medium, at least one entry), and
+/// with needGrids (pb2d or photon beams) the grid media uploaded to cl's device
+/// (ClRuntime::setGridMedia). Returns false if a grid medium has no beam kernel (an albedo
+/// grid, trilinear filtering): pb2d, bp2d and bb1d then run on the host.
+bool prepareDeviceMedia(const Scene& scene, ClRuntime* cl, bool needGrids,
+                        std::vector<ub_medium_info>* media);
 
 /// Adds every enabled volumetric technique's estimate to its query's pixel of `image` (and
 /// of layers[UB_TECH_*] if layers is given; each layer the size of the image).

@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/rng.h"
 #include "estimators/grid_access.h"
+#include "estimators/surface_merging.h"
 #include "estimators/volume_estimate.h"
 #include "render/chain_beams.h"
 #include "render/medium_walk.h"
@@ -92,6 +93,8 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
             useVM_ = upbp_.surf;
             break;
     }
+    surfBatch_ = algorithm_ == Algorithm::Upbp && upbp_.surf;
+    if (surfBatch_) coatingTables_ = coatingTables(scene);
     if (algorithm_ == Algorithm::Upbp) {
         const float radii[4] = {options.radiusPP3D, options.radiusPB2D, options.radiusBP2D,
                                 options.radiusBB1D};
@@ -180,21 +183,23 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
     if (algorithm_ == Algorithm::Upbp) {
         // The estimate pass: OpenCL kernels for what has one (pp3d), the host for the rest.
         backendNote_ = "estimate pass on the host";
-        if (options.backend != "host" && upbp_.anyVolume()) {
+        if (options.backend != "host" && (upbp_.anyVolume() || upbp_.surf)) {
             try {
                 cl_ = std::make_unique<ClRuntime>(options.clPlatform, options.clDevice,
                                                   options.clCache);
-                bool beamKernels = true;
-                for (const Medium& m : scene.media)
-                    beamKernels &= m.type == MediumType::kHomogeneous || gridMediumOnDevice(m);
+                beamKernels_ = prepareDeviceMedia(scene, cl_.get(),
+                                                  upbp_.pb2d || upbp_.photonBeams(), &deviceMedia_);
+                const bool beamKernels = beamKernels_ || !upbp_.pb2d && !upbp_.photonBeams();
                 backendNote_ = "estimate pass on OpenCL device '" + cl_->device().device + "' (" +
                                cl_->device().platform + ")" +
                                (beamKernels ? ""
-                                            : ": pp3d; pb2d, bp2d, bb1d on the host (a grid "
-                                              "medium with an albedo grid or trilinear filtering "
-                                              "has no beam kernel)") +
+                                            : ": pp3d and surf; pb2d, bp2d, bb1d on the host (a "
+                                              "grid medium with an albedo grid or trilinear "
+                                              "filtering has no beam kernel)") +
                                "; " + cl_->programNote();
             } catch (const ClError& e) {
+                cl_.reset();
+                beamKernels_ = false;
                 if (options.backend == "opencl") throw InputError("", e.what());
                 backendNote_ =
                     std::string("estimate pass on the host (backend auto: ") + e.what() + ")";
@@ -308,8 +313,19 @@ void VertexCM::renderIteration(int iteration, Image& out) {
         photonBeams_.insert(photonBeams_.end(), chunk.beams.begin(), chunk.beams.end());
     }
 
-    // (2) Hashed grid over the light vertices for merging.
-    if (useVM_) grid_.build(lightVertices_, &LightVertex::position, radius);
+    // (2) Hashed grid over the light vertices for merging (upbp: over the surface ones).
+    if (surfBatch_) {
+        surfacePhotons_.clear();
+        size_t n = 0;
+        for (const LightVertex& lv : lightVertices_) n += lv.inMedium() ? 0 : 1;
+        reserveFor(surfacePhotons_, n, budget_.get(), "surface photons",
+                   "a smaller --resolution (fewer light subpaths) or --max-length needs less");
+        for (const LightVertex& lv : lightVertices_)
+            if (!lv.inMedium()) surfacePhotons_.push_back(lv);
+        grid_.build(surfacePhotons_, &LightVertex::position, radius);
+    } else if (useVM_) {
+        grid_.build(lightVertices_, &LightVertex::position, radius);
+    }
 
     // (3) Camera pass: one subpath per pixel (lt traces only the primary ray, for
     // directly visible emitters). Each pixel has its own random stream.
@@ -321,7 +337,7 @@ void VertexCM::renderIteration(int iteration, Image& out) {
             rec.points.clear();
             rec.beams.clear();
             rec.rejected = 0;
-            if (layered && useVM_) rec.surf.assign(size_t(width), Rgb(0.0f));
+            rec.surf.clear();
             for (int x = 0; x < width; ++x) {
                 Rgb c = traceCameraPath(x, y, iteration, &rec);
                 guards_[0].filter(uint32_t(y) * uint32_t(width) + uint32_t(x), &c, &rec.rejected);
@@ -348,18 +364,7 @@ void VertexCM::renderIteration(int iteration, Image& out) {
         const bool on[4] = {upbp_.pp3d, upbp_.pb2d, upbp_.bp2d, upbp_.bb1d};
         for (int t = 0; t < 4; ++t)
             if (on[t]) volumeLayers[t] = &layers_[next++];
-        if (surf) {
-            const ContributionGuard& guard = guards_[size_t(surfTechnique_)];
-            uint64_t& rejected = rejected_[size_t(surfTechnique_)];
-            for (int y = 0; y < height; ++y)
-                for (int x = 0; x < width; ++x) {
-                    Rgb m = cameraRows_[size_t(y)].surf[size_t(x)];
-                    if (!guard.filter(uint32_t(y) * uint32_t(width) + uint32_t(x), &m, &rejected))
-                        continue;
-                    surf->at(x, y) = m;
-                    out.at(x, y) += m;
-                }
-        }
+        if (surf) estimateSurfaceQueries(out, surf);
     } else {
         splats_.resolve(out);
     }
@@ -396,6 +401,8 @@ void VertexCM::renderIteration(int iteration, Image& out) {
         in.queryPoints = &queryPoints_;
         in.queryBeams = &queryBeams_;
         in.cl = cl_.get();
+        in.deviceMedia = &deviceMedia_;
+        in.beamKernels = beamKernels_;
         in.budget = budget_.get();
         for (int t = 0; t < 4; ++t)
             if (volumeTechnique_[t] >= 0) in.guards[t] = guards_[size_t(volumeTechnique_[t])];
@@ -548,6 +555,14 @@ std::string VertexCM::iterationSummary() const {
                      ? std::string("(OpenCL, not counted)")
                      : std::to_string(lastPairs_[t]);
     }
+    std::string surf;
+    if (surfBatch_)
+        surf = "; surf: " + std::to_string(surfacePhotons_.size()) + " surface photons, " +
+               std::to_string(surfaceQueries_.size()) + " surface queries, pairs " +
+               (lastSurfPairs_ == VolumeEstimateStats::kNotCounted
+                    ? std::string("(OpenCL, not counted)")
+                    : std::to_string(lastSurfPairs_)) +
+               ", " + std::to_string(lastSurfSeconds_).substr(0, 5) + " s";
     char buf[512];
     std::snprintf(buf, sizeof(buf),
                   "upbp (%s), last iteration: %zu light vertices, %zu photon points, %zu photon "
@@ -556,7 +571,7 @@ std::string VertexCM::iterationSummary() const {
                   upbp_.describe().c_str(), lightVertices_.size(), photonPoints_.size(),
                   photonBeams_.size(), beamPaths_, queryPoints_.size(), queryBeams_.size(),
                   pairs.c_str(), lastBuildSeconds_, lastEstimateSeconds_);
-    return buf;
+    return buf + surf;
 }
 
 float VertexCM::ratioIn(const SubPath& state, const PathVertex& v) const {

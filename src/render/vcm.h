@@ -57,7 +57,9 @@
 
 #include "core/memory_budget.h"
 #include "estimators/hash_grid.h"
+#include "kernels/shared/ub_medium_homogeneous.h"
 #include "kernels/shared/ub_mis_volume.h"
+#include "kernels/shared/ub_surf.h"
 #include "kernels/shared/ub_upbp_records.h"
 #include "render/film.h"
 #include "render/integrator.h"
@@ -178,8 +180,8 @@ class VertexCM : public Integrator {
     struct CameraRecords {
         std::vector<ub_query_point> points;
         std::vector<ub_beam> beams;
-        std::vector<Rgb> surf;  ///< UPBP layers: surface merging per pixel of the row
-        uint64_t rejected = 0;  ///< camera-pass pixel estimates dropped by the guard
+        std::vector<ub_surface_query> surf;  ///< upbp: surface queries (surface merging)
+        uint64_t rejected = 0;               ///< camera-pass pixel estimates dropped by the guard
     };
 
     // Light pass (vcm_light.cpp): traces light subpaths [begin, end) of an iteration.
@@ -198,6 +200,9 @@ class VertexCM : public Integrator {
     Rgb connectVertices(const LightVertex& lv, const SubPath& state, const PathVertex& v,
                         const VertexScatter& scatter) const;
     Rgb mergeVertices(const SubPath& state, const Hit& hit, const Bsdf& bsdf) const;
+    /// upbp's surface-merging pass (estimators/surface_merging.cpp) over the recorded surface
+    /// queries: adds each query's estimate to its pixel of out and of layer, in query order.
+    void estimateSurfaceQueries(Image& out, Image* layer);
 
     // Shared: samples the next direction (Russian roulette, MIS update [TR (34)-(36)],
     // [TR (53)-(55)]), updates the medium stack and spawns the ray. Returns false if the
@@ -211,11 +216,13 @@ class VertexCM : public Integrator {
     RenderOptions options_;
     Algorithm algorithm_;
     bool useVC_ = false, useVM_ = false, lightTraceOnly_ = false, ppm_ = false;
-    bool useMedia_ = false;          ///< vlt/vbpt/upbp on a scene with media
-    UpbpTechniques upbp_;            ///< UPBP techniques (Algorithm::Upbp)
-    int beamPaths_ = 0;              ///< N_B
-    float mediaRadius_ = 1;          ///< what relative UPBP radii are fractions of
-    std::unique_ptr<ClRuntime> cl_;  ///< OpenCL backend of the estimate pass, or null
+    bool useMedia_ = false;                    ///< vlt/vbpt/upbp on a scene with media
+    UpbpTechniques upbp_;                      ///< UPBP techniques (Algorithm::Upbp)
+    int beamPaths_ = 0;                        ///< N_B
+    float mediaRadius_ = 1;                    ///< what relative UPBP radii are fractions of
+    std::unique_ptr<ClRuntime> cl_;            ///< OpenCL backend of the estimate pass, or null
+    std::vector<ub_medium_info> deviceMedia_;  ///< with cl_: prepareDeviceMedia()
+    bool beamKernels_ = false;                 ///< with cl_: pb2d, bp2d, bb1d as kernels
     std::string backendNote_;
     /// DepthCounting::kNonNullVertices: null-lobe vertices do not count towards the length.
     bool nullNotCounted_ = false;
@@ -238,6 +245,14 @@ class VertexCM : public Integrator {
     std::vector<ub_beam> photonBeams_;
     std::vector<ub_query_point> queryPoints_;
     std::vector<ub_beam> queryBeams_;
+    /// upbp with surf: surface merging runs as a batch pass (surfBatch_) over the surface
+    /// light vertices (surfacePhotons_, which grid_ indexes) and the recorded queries.
+    bool surfBatch_ = false;
+    std::vector<LightVertex> surfacePhotons_;
+    std::vector<ub_surface_query> surfaceQueries_;
+    std::vector<float> coatingTables_;  ///< estimators/surface_merging.h coatingTables()
+    size_t lastSurfPairs_ = 0;
+    double lastSurfSeconds_ = 0;
     float volumeRadius_[4] = {0, 0, 0, 0};  ///< this iteration's radii (UB_TECH_*), 0: off
     std::vector<std::string> layerNames_;   ///< UPBP technique layers
     std::vector<Image> layers_;             ///< the last iteration's layers

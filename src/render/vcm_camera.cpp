@@ -8,6 +8,7 @@
 
 #include "core/memory_budget.h"
 #include "core/rng.h"
+#include "estimators/surface_merging.h"
 #include "render/vcm.h"
 #include "render/vertex_scatter.h"
 
@@ -121,11 +122,19 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
             }
         }
         if (!atLimit && !scatter.isDelta() && useVM_ && !v.inMedium) {
-            const Rgb merged = state.throughput * mergeVertices(state, v.hit, scatter.bsdf());
-            if (!records->surf.empty())  // UPBP layers: kept apart, added by the caller
-                records->surf[size_t(x)] += merged;
-            else
-                color += merged;
+            if (surfBatch_) {
+                // upbp: a surface query, estimated in batch after the camera pass
+                // (estimators/surface_merging.h), on the OpenCL device when there is one.
+                pushBudgeted(
+                    records->surf,
+                    makeSurfaceQuery(scatter.bsdf(), v.hit.pos, state.pathLength, state.throughput,
+                                     uint32_t(pixelIndex), state.mis.dVCM, state.mis.dVM,
+                                     scatter.continuationProb(), v.hit.materialId),
+                    budget_.get(), "surface queries",
+                    "a smaller --resolution or --max-length needs less");
+            } else {
+                color += state.throughput * mergeVertices(state, v.hit, scatter.bsdf());
+            }
             if (ppm_) break;  // PPM merges at the first non-specular camera vertex only
         }
         if (!sampleScattering(rng, scatter, v, state, atLimit)) break;

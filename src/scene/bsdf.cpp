@@ -55,6 +55,7 @@
 #include "kernels/shared/ub_fresnel.h"
 #include "kernels/shared/ub_microfacet.h"
 #include "kernels/shared/ub_phong.h"
+#include "scene/microfacet_sampling.h"
 
 namespace ub {
 
@@ -123,7 +124,10 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
     geoNormal_ = ng;
     localDirFix_ = frame_.toLocal(dirFix);
     cosGeoFix_ = dot(dirFix, ng);
-    if (std::fabs(localDirFix_.z) < kEpsCosine || std::fabs(cosGeoFix_) < kEpsCosine) return false;
+    if (std::fabs(localDirFix_.z) < kEpsCosine || std::fabs(cosGeoFix_) < kEpsCosine) {
+        packShared();  // not evaluable
+        return false;
+    }
 
     switch (mat.type) {
         case MaterialType::Diffuse:
@@ -172,157 +176,75 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
     if (black_) contProb_ = 0.0f;
     contProb_ = clamp01(contProb_);
     valid_ = true;
+    packShared();
     return true;
 }
 
-float Bsdf::shadingFactor(float cosShadingGen, float cosGeoGen) const {
-    if (!fromLight_) return 1.0f;
-    return std::fabs(localDirFix_.z) * std::fabs(cosGeoGen) /
-           (std::fabs(cosGeoFix_) * cosShadingGen);
-}
-
-bool Bsdf::geometricSideOk(float localGenZ, float cosGeoGen) const {
-    if (cosGeoGen == 0.0f) return false;
-    if (!geometricGuard_) return true;  // Mitsuba 3: the shading-frame lobe decides alone
-    bool shadingReflect = localGenZ * localDirFix_.z > 0.0f;
-    bool geometricReflect = cosGeoGen * cosGeoFix_ > 0.0f;
-    return shadingReflect == geometricReflect;
+void Bsdf::packShared() {
+    static_assert(uint32_t(MaterialType::Diffuse) == UB_MATERIAL_DIFFUSE &&
+                      uint32_t(MaterialType::Phong) == UB_MATERIAL_PHONG &&
+                      uint32_t(MaterialType::Mirror) == UB_MATERIAL_MIRROR &&
+                      uint32_t(MaterialType::Dielectric) == UB_MATERIAL_DIELECTRIC &&
+                      uint32_t(MaterialType::RoughConductor) == UB_MATERIAL_ROUGH_CONDUCTOR &&
+                      uint32_t(MaterialType::RoughDielectric) == UB_MATERIAL_ROUGH_DIELECTRIC &&
+                      uint32_t(MaterialType::Plastic) == UB_MATERIAL_PLASTIC &&
+                      uint32_t(MaterialType::RoughPlastic) == UB_MATERIAL_ROUGH_PLASTIC &&
+                      uint32_t(MaterialType::ThinDielectric) == UB_MATERIAL_THIN_DIELECTRIC,
+                  "MaterialType values are the UB_MATERIAL_* of kernels/shared/ub_bsdf.h");
+    ub_bsdf& b = shared_;
+    const Material& m = *mat_;
+    auto put = [](float dst[3], const Vec3& v) {
+        dst[0] = v.x;
+        dst[1] = v.y;
+        dst[2] = v.z;
+    };
+    put(b.frameS, frame_.s);
+    put(b.frameT, frame_.t);
+    put(b.frameN, frame_.n);
+    put(b.geoNormal, geoNormal_);
+    put(b.localFix, localDirFix_);
+    put(b.diffuse, colors_.diffuse);
+    put(b.glossy, colors_.glossy);
+    put(b.specular, colors_.specular);
+    put(b.eta, m.eta);
+    put(b.k, m.k);
+    put(b.plasticBase, plasticBase_);
+    b.type = uint32_t(m.type);
+    b.flags = (valid_ && !isDelta_ && !black_ ? UB_BSDF_EVALUABLE : 0u) |
+              (fromLight_ ? UB_BSDF_FROM_LIGHT : 0u) |
+              (geometricGuard_ ? UB_BSDF_GEOMETRIC_GUARD : 0u) |
+              (m.separableMasking ? UB_BSDF_SEPARABLE : 0u) |
+              (m.distribution == MicrofacetDistribution::kBeckmann ? UB_BSDF_BECKMANN : 0u);
+    b.cosGeoFix = cosGeoFix_;
+    b.exponent = m.exponent;
+    b.alpha = m.alpha;
+    b.ior = m.ior;
+    b.etaFix = etaFix_;
+    b.etaOther = etaOther_;
+    b.probDiffuse = probDiffuse_;
+    b.probGlossy = probGlossy_;
+    b.fresnelFix = fresnelFix_;
+    b.specularWeight = specularWeight_;
+    b.tableIndex = 0;  // the surface-merging pass sets the material's index
+    b.pad0 = b.pad1 = 0.0f;
+    coating_ = m.type == MaterialType::RoughPlastic ? m.coatingTransmittance.data() : nullptr;
 }
 
 Rgb Bsdf::evaluate(const Vec3& dirGen, float* cosThetaGen, float* directPdfW,
                    float* reversePdfW) const {
-    Vec3 localGen = frame_.toLocal(dirGen);
-    if (cosThetaGen) *cosThetaGen = std::fabs(localGen.z);
-    float pd = 0.0f, pr = 0.0f;
-    Rgb f(0.0f);
-    if (valid_ && !isDelta_ && !black_) f = evalLocal(localGen, dot(dirGen, geoNormal_), &pd, &pr);
+    float cosGen = 0.0f, pd = 0.0f, pr = 0.0f;
+    const ub_float3 f = ub_bsdf_evaluate(
+        &shared_, coating_, ub_make_float3(dirGen.x, dirGen.y, dirGen.z), &cosGen, &pd, &pr);
+    if (cosThetaGen) *cosThetaGen = cosGen;
     if (directPdfW) *directPdfW = pd;
     if (reversePdfW) *reversePdfW = pr;
-    return f;
+    return Rgb(f.x, f.y, f.z);
 }
 
 float Bsdf::pdf(const Vec3& dirGen, bool reverse) const {
     float pd = 0.0f, pr = 0.0f;
     evaluate(dirGen, nullptr, &pd, &pr);
     return reverse ? pr : pd;
-}
-
-Rgb Bsdf::evalLocal(const Vec3& localGen, float cosGeoGen, float* directPdfW,
-                    float* reversePdfW) const {
-    *directPdfW = *reversePdfW = 0.0f;
-    if (std::fabs(localGen.z) < kEpsCosine || !geometricSideOk(localGen.z, cosGeoGen))
-        return Rgb(0.0f);
-    Rgb f(0.0f);
-    switch (mat_->type) {
-        case MaterialType::Diffuse:
-        case MaterialType::Phong:
-            f = evalPhong(localGen, directPdfW, reversePdfW);
-            break;
-        case MaterialType::RoughConductor:
-            f = evalRoughConductor(localGen, directPdfW, reversePdfW);
-            break;
-        case MaterialType::RoughDielectric:
-            f = evalRoughDielectric(localGen, directPdfW, reversePdfW);
-            break;
-        case MaterialType::Plastic:
-            f = evalPlastic(localGen, directPdfW, reversePdfW);
-            break;
-        case MaterialType::RoughPlastic:
-            f = evalRoughPlastic(localGen, directPdfW, reversePdfW);
-            break;
-        default:
-            break;
-    }
-    return f * shadingFactor(std::fabs(localGen.z), cosGeoGen);
-}
-
-Rgb Bsdf::evalPhong(const Vec3& gen, float* directPdfW, float* reversePdfW) const {
-    const Vec3& fix = localDirFix_;
-    if (fix.z <= 0.0f || gen.z <= 0.0f) return Rgb(0.0f);  // reflection above the surface only
-    Rgb f(0.0f);
-    if (probDiffuse_ > 0.0f) {
-        f += colors_.diffuse * kInvPi;
-        *directPdfW += probDiffuse_ * ub_lambert_pdf(gen.z);
-        *reversePdfW += probDiffuse_ * ub_lambert_pdf(fix.z);
-    }
-    if (probGlossy_ > 0.0f) {
-        // cos(alpha) between dirGen and the mirror direction of dirFix; symmetric in
-        // the two directions, so the reverse pdf is the same value.
-        const Vec3 mirrorFix(-fix.x, -fix.y, fix.z);
-        float cosAlpha = dot(mirrorFix, gen);
-        float lobePdf = probGlossy_ * ub_power_cos_pdf(cosAlpha, mat_->exponent);
-        f += colors_.glossy * ub_phong_lobe(cosAlpha, mat_->exponent);
-        *directPdfW += lobePdf;
-        *reversePdfW += lobePdf;
-    }
-    return f;
-}
-
-Rgb Bsdf::evalRoughConductor(const Vec3& gen, float* directPdfW, float* reversePdfW) const {
-    const Vec3& fix = localDirFix_;
-    if (fix.z <= 0.0f || gen.z <= 0.0f) return Rgb(0.0f);
-    const float alpha = ggxAlpha(*mat_);
-    const Vec3 h = normalize(fix + gen);  // h.z > 0 and fix.h = gen.h > 0 here
-    const float cosFixH = dot(fix, h), cosGenH = dot(gen, h);
-    const float d = ub_ggx_d(h.z, alpha);
-    const float g2 = mat_->separableMasking ? ub_ggx_g2_separable(fix.z, gen.z, alpha)
-                                            : ub_ggx_g2_correlated(fix.z, gen.z, alpha);
-    // Visible-normal density times the reflection Jacobian (Walter eq. 14).
-    *directPdfW = ub_ggx_visible_pdf(fix.z, cosFixH, h.z, alpha) * ub_jacobian_reflect(cosGenH);
-    *reversePdfW = ub_ggx_visible_pdf(gen.z, cosGenH, h.z, alpha) * ub_jacobian_reflect(cosFixH);
-    // Walter eq. 20: F D G / (4 |i.n| |o.n|).
-    return colors_.specular * fresnelConductor(cosFixH, mat_->eta, mat_->k) *
-           (d * g2 / (4.0f * fix.z * gen.z));
-}
-
-Rgb Bsdf::evalRoughDielectric(const Vec3& gen, float* directPdfW, float* reversePdfW) const {
-    const Vec3& fix = localDirFix_;
-    const float alpha = ggxAlpha(*mat_);
-    const bool reflect = fix.z * gen.z > 0.0f;
-    const float etaGen = reflect ? etaFix_ : etaOther_;
-    // Half vector: Walter eq. 13 (reflection), eq. 16 (refraction), oriented to +z.
-    Vec3 h = reflect ? fix + gen : etaFix_ * fix + etaGen * gen;
-    float len2 = lengthSqr(h);
-    if (!(len2 > 1e-12f)) return Rgb(0.0f);
-    h = h / std::sqrt(len2);
-    if (h.z < 0.0f) h = -h;
-    const float cosFixH = dot(fix, h), cosGenH = dot(gen, h);
-    // Both directions must see the microfacet from their side of the macro-surface
-    // (the chi+ factors of Walter eq. 20/21).
-    if (cosFixH * fix.z <= 0.0f || cosGenH * gen.z <= 0.0f) return Rgb(0.0f);
-    const float cFix = std::fabs(fix.z), cGen = std::fabs(gen.z);
-    const float aFix = std::fabs(cosFixH), aGen = std::fabs(cosGenH);
-    const float d = ub_ggx_d(h.z, alpha);
-    const float visFix = ub_ggx_visible_pdf(cFix, aFix, h.z, alpha);
-    const float visGen = ub_ggx_visible_pdf(cGen, aGen, h.z, alpha);
-    if (reflect) {
-        const float fresnelFix = ub_fresnel_dielectric(aFix, etaOther_ / etaFix_);
-        const float fresnelGen = ub_fresnel_dielectric(aGen, etaOther_ / etaFix_);
-        *directPdfW = fresnelFix * visFix * ub_jacobian_reflect(aGen);
-        *reversePdfW = fresnelGen * visGen * ub_jacobian_reflect(aFix);
-        const float g2 = mat_->separableMasking ? ub_ggx_g2_separable(cFix, cGen, alpha)
-                                                : ub_ggx_g2_correlated(cFix, cGen, alpha);
-        // fix.h = gen.h in exact arithmetic; in floats they differ by ~1e-7, which near the
-        // critical angle (inside the glass) moves F by ~1e-4 relative. The value uses F at
-        // their mean so that f(fix, gen) = f(gen, fix) exactly (reciprocity); the pdfs above
-        // keep F(fix.h), the probability the sampler used.
-        const float fresnelSym = ub_fresnel_dielectric(0.5f * (aFix + aGen), etaOther_ / etaFix_);
-        return colors_.specular * (fresnelSym * d * g2 / (4.0f * cFix * cGen));
-    }
-    // Refraction: gen is on the side of IOR etaGen = etaOther_. F(cos_i, eta) equals
-    // F(cos_t, 1/eta); it is computed from the outside direction whichever of the two is
-    // dirFix, so f and the pdfs are bitwise symmetric under swapping dirFix and dirGen.
-    const float transmit = 1.0f - (fix.z > 0.0f ? ub_fresnel_dielectric(aFix, etaGen / etaFix_)
-                                                : ub_fresnel_dielectric(aGen, etaFix_ / etaGen));
-    *directPdfW = transmit * visFix * ub_jacobian_refract(etaFix_, cosFixH, etaGen, cosGenH);
-    *reversePdfW = transmit * visGen * ub_jacobian_refract(etaGen, cosGenH, etaFix_, cosFixH);
-    const float denom = ub_sqr(etaFix_ * cosFixH + etaGen * cosGenH);
-    // Walter eq. 21 with o = the camera-side direction: eta_o^2 is etaFix for radiance
-    // (dirFix towards the camera) and etaGen for importance (the adjoint BTDF).
-    const float etaO = fromLight_ ? etaGen : etaFix_;
-    const float g2 = ub_ggx_g2_separable(cFix, cGen, alpha);
-    return colors_.specular *
-           (transmit * d * g2 * aFix * aGen * etaO * etaO / (cFix * cGen * denom));
 }
 
 Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
@@ -349,9 +271,8 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
             }
             break;
         case MaterialType::RoughConductor: {
-            Vec3 m;
-            ub_ggx_sample_visible(fix.x, fix.y, fix.z, ggxAlpha(*mat_), rnd.x, rnd.y, &m.x, &m.y,
-                                  &m.z);
+            const Vec3 m = sampleVisibleNormal(uint32_t(mat_->distribution), fix, ggxAlpha(*mat_),
+                                               rnd.x, rnd.y);
             gen = 2.0f * dot(fix, m) * m - fix;
             break;
         }
@@ -364,9 +285,8 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
             break;
         case MaterialType::RoughPlastic:
             if (rnd.z < plasticSpecularProb(fix.z)) {
-                Vec3 m;
-                ub_ggx_sample_visible(fix.x, fix.y, fix.z, ggxAlpha(*mat_), rnd.x, rnd.y, &m.x,
-                                      &m.y, &m.z);
+                const Vec3 m = sampleVisibleNormal(uint32_t(mat_->distribution), fix,
+                                                   ggxAlpha(*mat_), rnd.x, rnd.y);
                 gen = 2.0f * dot(fix, m) * m - fix;
             } else {
                 gen = sampleCosineHemisphere(Vec2(rnd.x, rnd.y));
@@ -377,9 +297,8 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
             // Work mirrored to dirFix's side (GGX is symmetric under z -> -z).
             const float side = fix.z < 0.0f ? -1.0f : 1.0f;
             const Vec3 fixUp(fix.x, fix.y, side * fix.z);
-            Vec3 m;
-            ub_ggx_sample_visible(fixUp.x, fixUp.y, fixUp.z, ggxAlpha(*mat_), rnd.x, rnd.y, &m.x,
-                                  &m.y, &m.z);
+            const Vec3 m = sampleVisibleNormal(uint32_t(mat_->distribution), fixUp, ggxAlpha(*mat_),
+                                               rnd.x, rnd.y);
             const float cosI = dot(fixUp, m);
             float cosT;
             const float fresnel = ub_fresnel_dielectric_ct(cosI, etaOther_ / etaFix_, &cosT);
@@ -460,14 +379,15 @@ Rgb Bsdf::sampleDelta(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThet
     const Vec3 world = frame_.toWorld(gen);
     const float cosGen = std::fabs(gen.z);
     const float cosGeoGen = dot(world, geoNormal_);
-    if (!(prob > 0.0f) || cosGen < kEpsCosine || !geometricSideOk(gen.z, cosGeoGen))
+    if (!(prob > 0.0f) || cosGen < kEpsCosine ||
+        !ub_bsdf_geometric_side_ok(&shared_, gen.z, cosGeoGen))
         return Rgb(0.0f);
     *dirGen = world;
     *pdfW = prob;
     if (cosThetaGen) *cosThetaGen = cosGen;
     if (sampledEvent) *sampledEvent = event;
     // Pre-divided by the cosine the caller multiplies with (SmallVCM convention).
-    return weight * (shadingFactor(cosGen, cosGeoGen) / cosGen);
+    return weight * (ub_bsdf_shading_factor(&shared_, cosGen, cosGeoGen) / cosGen);
 }
 
 }  // namespace ub

@@ -35,6 +35,7 @@
 #include <cstdint>
 
 #include "core/vec.h"
+#include "kernels/shared/ub_bsdf.h"
 #include "scene/material.h"
 
 namespace ub {
@@ -113,31 +114,28 @@ class Bsdf {
     const Vec3& shadingNormal() const { return frame_.n; }
     const Material* material() const { return mat_; }
     /// Geometric-normal guard on (default) or off (Mitsuba 3); kept across setup() calls.
-    void setGeometricGuard(bool on) { geometricGuard_ = on; }
+    void setGeometricGuard(bool on) {
+        geometricGuard_ = on;
+        shared_.flags = on ? (shared_.flags | UB_BSDF_GEOMETRIC_GUARD)
+                           : (shared_.flags & ~UB_BSDF_GEOMETRIC_GUARD);
+    }
     bool geometricGuard() const { return geometricGuard_; }
 
+    /// The evaluation state shared with the kernels (kernels/shared/ub_bsdf.h), filled by
+    /// setup(); the surface-merging pass records it. coatingTable(): the rough plastic's
+    /// coating transmittance table that evaluation reads (null for other materials).
+    const ub_bsdf& shared() const { return shared_; }
+    const float* coatingTable() const { return coating_; }
+
   private:
-    /// f_s and both pdfs (lobe selection included) for dirGen given in frame_;
-    /// cosGeoGen = dot(dirGen, geoNormal_). Applies the geometric guard and the
-    /// fromLight shading-normal factor. Non-delta materials only.
-    Rgb evalLocal(const Vec3& localGen, float cosGeoGen, float* directPdfW,
-                  float* reversePdfW) const;
-    Rgb evalPhong(const Vec3& localGen, float* directPdfW, float* reversePdfW) const;
-    Rgb evalRoughConductor(const Vec3& localGen, float* directPdfW, float* reversePdfW) const;
-    Rgb evalRoughDielectric(const Vec3& localGen, float* directPdfW, float* reversePdfW) const;
-    // Plastic, RoughPlastic, ThinDielectric (bsdf_plastic.cpp).
     void setupPlastic();
-    Rgb evalPlastic(const Vec3& localGen, float* directPdfW, float* reversePdfW) const;
-    Rgb evalRoughPlastic(const Vec3& localGen, float* directPdfW, float* reversePdfW) const;
+    /// Fills shared_ from the members (end of setup()).
+    void packShared();
     /// Probability of picking the specular lobe of a (rough) plastic seen from a
     /// direction with |cos| = cosTheta (Mitsuba 3's weighting, see bsdf_plastic.cpp).
     float plasticSpecularProb(float cosTheta) const;
     /// Coating transmittance of a (rough) plastic for |cos| = cosTheta.
     float plasticTransmittance(float cosTheta) const;
-    /// Veach's adjoint factor for shading normals (1 for radiance transport).
-    float shadingFactor(float cosShadingGen, float cosGeoGen) const;
-    /// True if a dirGen with these cosines is on the allowed geometric side.
-    bool geometricSideOk(float localGenZ, float cosGeoGen) const;
     Rgb sampleDelta(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
                     uint32_t* sampledEvent) const;
 
@@ -163,6 +161,9 @@ class Bsdf {
     // s_mean)), and the diffuse-base factor rho / (1 - Fint) per channel.
     float specularWeight_ = 0.0f;
     Rgb plasticBase_{0.0f};
+    // What evaluate() reads (ub_bsdf_evaluate): the fields above in the shared layout.
+    ub_bsdf shared_{};
+    const float* coating_ = nullptr;
 };
 
 }  // namespace ub

@@ -42,6 +42,8 @@
 // The visible-normal integrals use a tensor Gauss-Legendre rule on the sampler's unit
 // square (32 x 32 nodes when the relative IOR > 1, 128 x 128 otherwise: the total
 // internal reflection edge needs more), like Mitsuba.
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -52,6 +54,7 @@
 #include "kernels/shared/ub_phong.h"
 #include "kernels/shared/ub_plastic.h"
 #include "scene/bsdf.h"
+#include "scene/microfacet_sampling.h"
 
 namespace ub {
 
@@ -102,7 +105,7 @@ void gaussLegendre(int n, std::vector<double>* nodes, std::vector<double>* weigh
 /// wi's side) reflects (transmit = false) or transmits (true) for wi = (sin, 0, mu),
 /// single scattering: E over visible normals of F or 1 - F, times G1 of the outgoing
 /// direction, zero where it leaves on the wrong side.
-double roughInterfaceEnergy(float mu, float eta, float alpha, bool transmit) {
+double roughInterfaceEnergy(float mu, float eta, float alpha, uint32_t dist, bool transmit) {
     std::vector<double> nodes, weights;
     gaussLegendre(eta > 1.0f ? 32 : 128, &nodes, &weights);
     const Vec3 wi(std::sqrt(std::max(0.0f, 1.0f - mu * mu)), 0.0f, mu);
@@ -110,8 +113,7 @@ double roughInterfaceEnergy(float mu, float eta, float alpha, bool transmit) {
     for (size_t a = 0; a < nodes.size(); ++a)
         for (size_t b = 0; b < nodes.size(); ++b) {
             const float u1 = float(0.5 * nodes[a] + 0.5), u2 = float(0.5 * nodes[b] + 0.5);
-            Vec3 m;
-            ub_ggx_sample_visible(wi.x, wi.y, wi.z, alpha, u1, u2, &m.x, &m.y, &m.z);
+            const Vec3 m = sampleVisibleNormal(dist, wi, alpha, u1, u2);
             const float cosI = dot(wi, m);
             if (!(cosI > 0.0f)) continue;
             float cosT;
@@ -122,11 +124,11 @@ double roughInterfaceEnergy(float mu, float eta, float alpha, bool transmit) {
                 // Snell with relative IOR eta: t = -wi / eta + (cosI / eta - cosT) m.
                 const Vec3 wo = -wi / eta + (cosI / eta - cosT) * m;
                 if (!(wo.z < 0.0f)) continue;
-                value = (1.0 - fresnel) * ub_ggx_g1(-wo.z, alpha);
+                value = (1.0 - fresnel) * ub_mf_g1(dist, -wo.z, alpha);
             } else {
                 const Vec3 wo = 2.0f * cosI * m - wi;
                 if (!(wo.z > 0.0f)) continue;
-                value = fresnel * ub_ggx_g1(wo.z, alpha);
+                value = fresnel * ub_mf_g1(dist, wo.z, alpha);
             }
             sum += value * weights[a] * weights[b] * 0.25;
         }
@@ -142,14 +144,19 @@ void prepareMaterial(Material& m) {
             break;
         case MaterialType::RoughPlastic: {
             const float alpha = plasticAlpha(m);
+            const uint32_t dist = uint32_t(m.distribution);
             const int n = UB_ROUGH_PLASTIC_TABLE_SIZE;
-            double internal = 0.0;
-            for (int k = 0; k < n; ++k) {
+            // The 64 table entries in parallel (each independent), summed in order.
+            std::vector<double> internalAt(size_t(n), 0.0);
+            tbb::parallel_for(0, n, [&](int k) {
                 const float mu = std::max(1e-6f, float(k) / float(n - 1));
                 m.coatingTransmittance[size_t(k)] =
-                    float(roughInterfaceEnergy(mu, m.ior, alpha, true));
-                internal += roughInterfaceEnergy(mu, 1.0f / m.ior, alpha, false) * mu;
-            }
+                    float(roughInterfaceEnergy(mu, m.ior, alpha, dist, true));
+                internalAt[size_t(k)] =
+                    roughInterfaceEnergy(mu, 1.0f / m.ior, alpha, dist, false) * mu;
+            });
+            double internal = 0.0;
+            for (double v : internalAt) internal += v;
             m.internalReflectance = float(2.0 * internal / n);
             break;
         }
@@ -158,6 +165,7 @@ void prepareMaterial(Material& m) {
     }
     m.preparedIor = m.ior;
     m.preparedAlpha = m.alpha;
+    m.preparedDistribution = m.distribution;
 }
 
 // ---- Bsdf members ------------------------------------------------------------------
@@ -171,7 +179,8 @@ void Bsdf::setupPlastic() {
                                  colors_.transmittance * (1.0f - fresnelFix_));
         return;
     }
-    if (mat.preparedIor != mat.ior || mat.preparedAlpha != mat.alpha)
+    if (mat.preparedIor != mat.ior || mat.preparedAlpha != mat.alpha ||
+        mat.preparedDistribution != mat.distribution)
         throw std::logic_error("Bsdf::setup: plastic material '" + mat.name +
                                "' was not prepared (call prepareMaterial after setting ior/alpha)");
     const float meanDiffuse = mean3(colors_.diffuse), meanSpecular = mean3(colors_.specular);
@@ -202,47 +211,7 @@ float Bsdf::plasticTransmittance(float cosTheta) const {
 }
 
 float Bsdf::plasticSpecularProb(float cosTheta) const {
-    const float reflectance = mat_->type == MaterialType::Plastic
-                                  ? ub_fresnel_dielectric(cosTheta, mat_->ior)
-                                  : 1.0f - plasticTransmittance(cosTheta);
-    const float ps = reflectance * specularWeight_;
-    const float pd = (1.0f - reflectance) * (1.0f - specularWeight_);
-    return ps + pd > 0.0f ? ps / (ps + pd) : 0.0f;
-}
-
-Rgb Bsdf::evalPlastic(const Vec3& gen, float* directPdfW, float* reversePdfW) const {
-    const Vec3& fix = localDirFix_;
-    if (fix.z <= 0.0f || gen.z <= 0.0f) return Rgb(0.0f);
-    const float eta = mat_->ior;
-    const float fresnelGen = ub_fresnel_dielectric(gen.z, eta);
-    *directPdfW = (1.0f - plasticSpecularProb(fix.z)) * ub_lambert_pdf(gen.z);
-    *reversePdfW = (1.0f - plasticSpecularProb(gen.z)) * ub_lambert_pdf(fix.z);
-    return plasticBase_ * ((1.0f - fresnelFix_) * (1.0f - fresnelGen) * kInvPi / (eta * eta));
-}
-
-Rgb Bsdf::evalRoughPlastic(const Vec3& gen, float* directPdfW, float* reversePdfW) const {
-    const Vec3& fix = localDirFix_;
-    if (fix.z <= 0.0f || gen.z <= 0.0f) return Rgb(0.0f);
-    const float eta = mat_->ior, alpha = plasticAlpha(*mat_);
-    // Both directions above the surface: h = normalize(fix + gen) has h.z > 0 and
-    // fix.h = gen.h > 0.
-    const Vec3 h = normalize(fix + gen);
-    const float cosFixH = dot(fix, h), cosGenH = dot(gen, h);
-    const float d = ub_ggx_d(h.z, alpha);
-    const float g = ub_ggx_g2_separable(fix.z, gen.z, alpha);
-    const float fresnel = ub_fresnel_dielectric(cosFixH, eta);
-    const float probSpecFix = plasticSpecularProb(fix.z), probSpecGen = plasticSpecularProb(gen.z);
-    // Visible-normal density times the reflection Jacobian (Walter eq. 14), mixed with the
-    // cosine lobe by the selection probabilities.
-    *directPdfW = probSpecFix * ub_ggx_visible_pdf(fix.z, cosFixH, h.z, alpha) *
-                      ub_jacobian_reflect(cosGenH) +
-                  (1.0f - probSpecFix) * ub_lambert_pdf(gen.z);
-    *reversePdfW = probSpecGen * ub_ggx_visible_pdf(gen.z, cosGenH, h.z, alpha) *
-                       ub_jacobian_reflect(cosFixH) +
-                   (1.0f - probSpecGen) * ub_lambert_pdf(fix.z);
-    const Rgb glossy = colors_.specular * (fresnel * d * g / (4.0f * fix.z * gen.z));
-    const float transmit = plasticTransmittance(fix.z) * plasticTransmittance(gen.z);
-    return glossy + plasticBase_ * (transmit * kInvPi / (eta * eta));
+    return ub_bsdf_plastic_specular_prob(&shared_, coating_, cosTheta);
 }
 
 }  // namespace ub

@@ -33,6 +33,12 @@ struct MaterialTextures {
     int transmittance = -1;  ///< replaces Material::transmittance
 };
 
+/// Microfacet normal distribution of the rough materials (kernels/shared/ub_microfacet.h).
+enum class MicrofacetDistribution : uint32_t {
+    kGgx = 0,       ///< GGX / Trowbridge-Reitz (unibeam's default)
+    kBeckmann = 1,  ///< Beckmann (Mitsuba 3's default)
+};
+
 struct Material {
     MaterialType type = MaterialType::Diffuse;
     std::string name;
@@ -50,6 +56,9 @@ struct Material {
     /// height-correlated 1 / (1 + Lambda(i) + Lambda(o)) (Heitz 2014 eq. 99). Refraction
     /// and RoughPlastic always use the separable form.
     bool separableMasking = false;
+    /// RoughConductor, RoughDielectric, RoughPlastic: the microfacet distribution (`alpha` is
+    /// its roughness: the RMS slope for Beckmann, as in Mitsuba).
+    MicrofacetDistribution distribution = MicrofacetDistribution::kGgx;
     /// Two-sided: if true (default for opaque materials), the back side of a surface
     /// behaves like the front. Dielectrics ignore it: their inside is defined by the normal.
     /// ThinDielectric ignores it too: the sheet is the same from both sides.
@@ -70,6 +79,7 @@ struct Material {
     /// `ior` and `alpha` that prepareMaterial() used (-1: not prepared). Bsdf::setup throws
     /// std::logic_error for a plastic whose current ior/alpha differ from these.
     float preparedIor = -1.0f, preparedAlpha = -1.0f;
+    MicrofacetDistribution preparedDistribution = MicrofacetDistribution::kGgx;
 };
 
 }  // namespace ub

@@ -19,6 +19,16 @@ bool readMasking(JsonReader& r, const Json& m, const std::string& ptr) {
     return false;
 }
 
+/// Optional "distribution" of the rough materials: "ggx" (default) or "beckmann".
+MicrofacetDistribution readDistribution(JsonReader& r, const Json& m, const std::string& ptr) {
+    const std::string v = r.getString(m, ptr, "distribution", Presence::Optional);
+    if (v.empty() || v == "ggx") return MicrofacetDistribution::kGgx;
+    if (v == "beckmann") return MicrofacetDistribution::kBeckmann;
+    r.error(jsonPointerChild(ptr, "distribution"),
+            "unknown microfacet distribution '" + v + "' (expected \"ggx\" or \"beckmann\")");
+    return MicrofacetDistribution::kGgx;
+}
+
 /// Named metals for rough_conductor "metal": complex IOR n + ik sampled at
 /// 650 nm (R), 550 nm (G) and 450 nm (B) from measured tables (refractiveindex.info).
 /// The same numbers are listed in docs/scene-format.md.
@@ -126,10 +136,11 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         bool rough = type == "rough_dielectric";
         mat.type = rough ? MaterialType::RoughDielectric : MaterialType::Dielectric;
         keys.insert(keys.end(), {"ior", "tint"});
-        if (rough) keys.insert(keys.end(), {"alpha", "masking"});
+        if (rough) keys.insert(keys.end(), {"alpha", "masking", "distribution"});
         r.checkKeys(m, ptr, keys, type + " material");
         mat.ior = r.getNumber(m, ptr, "ior", Presence::Required, NumberRange::positive(), 1.5f);
         if (rough) mat.separableMasking = readMasking(r, m, ptr);
+        if (rough) mat.distribution = readDistribution(r, m, ptr);
         colour("tint", Rgb(1.0f), &mat.specular, &mat.textures.specular);
         if (rough)
             mat.alpha = r.getNumber(m, ptr, "alpha", Presence::Required,
@@ -137,9 +148,11 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         mat.twoSided = false;  // the inside of a dielectric is defined by its normal
     } else if (type == "rough_conductor") {
         mat.type = MaterialType::RoughConductor;
-        keys.insert(keys.end(), {"metal", "eta", "k", "alpha", "masking", "tint", "two_sided"});
+        keys.insert(keys.end(),
+                    {"metal", "eta", "k", "alpha", "masking", "distribution", "tint", "two_sided"});
         r.checkKeys(m, ptr, keys, "rough_conductor material");
         mat.separableMasking = readMasking(r, m, ptr);
+        mat.distribution = readDistribution(r, m, ptr);
         const Json* metal = r.member(m, ptr, "metal", Presence::Optional, "");
         bool hasEta = m.contains("eta"), hasK = m.contains("k");
         if (metal) {
@@ -173,8 +186,9 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         mat.type = rough ? MaterialType::RoughPlastic : MaterialType::Plastic;
         keys.insert(keys.end(), {"diffuse_reflectance", "specular_reflectance", "int_ior",
                                  "ext_ior", "nonlinear", "two_sided"});
-        if (rough) keys.push_back("alpha");
+        if (rough) keys.insert(keys.end(), {"alpha", "distribution"});
         r.checkKeys(m, ptr, keys, type + " material");
+        if (rough) mat.distribution = readDistribution(r, m, ptr);
         colour("diffuse_reflectance", Rgb(0.5f), &mat.diffuse, &mat.textures.diffuse);
         colour("specular_reflectance", Rgb(1.0f), &mat.specular, &mat.textures.specular);
         const float intIor = r.getNumber(m, ptr, "int_ior", Presence::Optional,

@@ -101,17 +101,18 @@ void readReflectance(MitsubaBuild& b, const XmlObject& o, const std::string& nam
     *value = b.r.getColor(o, name, def, ColorUse::Reflectance);
 }
 
-/// Reads a GGX roughness: `alpha`, or `alpha_u` = `alpha_v` (anisotropy is not supported),
-/// and insists on distribution="ggx" (Mitsuba's default is Beckmann, which unibeam lacks).
-float readGgxAlpha(XmlReader& r, const XmlObject& o) {
+/// Reads a microfacet roughness: `alpha`, or `alpha_u` = `alpha_v` (anisotropy is not
+/// supported), and the `distribution` (beckmann, Mitsuba's default, or ggx) into *dist.
+float readMicrofacetAlpha(XmlReader& r, const XmlObject& o, MicrofacetDistribution* dist) {
     const XmlProperty* d = o.find("distribution");
-    std::string dist = r.getString(o, "distribution", "beckmann");
-    if (dist != "ggx") {
-        r.error(d ? d->pos : o.pos,
-                o.label() + ": microfacet distribution '" + dist + "'" +
-                    (d ? "" : " (Mitsuba's default)") +
-                    " is not supported; unibeam has GGX only (set <string name=\"distribution\" "
-                    "value=\"ggx\"/>)");
+    const std::string name = r.getString(o, "distribution", "beckmann");
+    if (name == "beckmann") {
+        *dist = MicrofacetDistribution::kBeckmann;
+    } else if (name == "ggx") {
+        *dist = MicrofacetDistribution::kGgx;
+    } else {
+        r.error(d ? d->pos : o.pos, o.label() + ": unknown microfacet distribution '" + name +
+                                        "' (expected 'beckmann' or 'ggx')");
     }
     r.getBool(o, "sample_visible", true);  // sampling strategy only: same expectation
     if (o.find("alpha_u") || o.find("alpha_v")) {
@@ -231,7 +232,7 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
         m.type = MaterialType::Mirror;
     } else if (o.type == "roughconductor") {
         m.type = MaterialType::RoughConductor;
-        m.alpha = readGgxAlpha(r, o);
+        m.alpha = readMicrofacetAlpha(r, o, &m.distribution);
         m.separableMasking = true;  // Mitsuba's MicrofacetDistribution::G = G1(i) G1(o)
         readConductorIor(b, o, m);  // "none" (the default): eta 0, k 1
         m.specular = r.getColor(o, "specular_reflectance", Rgb(1.0f), ColorUse::Reflectance);
@@ -258,11 +259,11 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
         readReflectance(b, o, "diffuse_reflectance", Rgb(0.5f), &m.diffuse, &m.textures.diffuse);
         readReflectance(b, o, "specular_reflectance", Rgb(1.0f), &m.specular, &m.textures.specular);
         m.nonlinear = r.getBool(o, "nonlinear", false);
-        if (rough) m.alpha = readGgxAlpha(r, o);
+        if (rough) m.alpha = readMicrofacetAlpha(r, o, &m.distribution);
     } else if (o.type == "roughdielectric") {
         m.type = MaterialType::RoughDielectric;
         m.ior = readRelativeIor(r, o);
-        m.alpha = readGgxAlpha(r, o);
+        m.alpha = readMicrofacetAlpha(r, o, &m.distribution);
         m.separableMasking = true;  // Mitsuba's MicrofacetDistribution::G = G1(i) G1(o)
         m.specular = readDielectricTint(r, o);
     } else {

@@ -1,0 +1,329 @@
+/* Evaluation of unibeam's BSDFs at a surface point (host C++ and OpenCL C): the non-delta
+ * lobes of every material type, their value f_s and both solid-angle pdfs. The host's
+ * Bsdf (src/scene/bsdf.h, conventions there) sets a ub_bsdf up at a hit and evaluates it
+ * with these functions; the surface-merging kernel (kernels/surf.cl) evaluates the same
+ * record, recorded by the camera pass, for each photon it gathers.
+ *
+ * Lobes and references (details in src/scene/bsdf.cpp and bsdf_plastic.cpp):
+ *   Diffuse, Phong   Lambert rho/pi plus the modified Phong lobe (Lafortune & Willems
+ *                    1994), mixture pdf by lobe-selection probabilities (SmallVCM);
+ *   RoughConductor   GGX or Beckmann (ub_microfacet.h), Walter et al. 2007 eq. 20, visible-normal
+ * pdf (Heitz 2018) times the reflection Jacobian (Walter eq. 14); RoughDielectric  Walter et al.
+ * 2007 eq. 20 (reflection) and eq. 21 (refraction, Jacobian eq. 17), Fresnel lobe selection;
+ *   Plastic, RoughPlastic  Mitsuba 3's coated diffuse (kernels/shared/ub_plastic.h).
+ * Delta lobes (Mirror, Dielectric, ThinDielectric, the plastic coating) have no density:
+ * they are sampled on the host only and evaluate to zero here.
+ *
+ * Measures: pdfs per unit solid angle (suffix W). directPdfW = p(dirGen | dirFix),
+ * reversePdfW = p(dirFix | dirGen); neither includes Russian roulette.
+ *
+ * Fixed-size scalars only; 192 bytes, checked below and by the layout probe.
+ */
+#ifndef UB_BSDF_H
+#define UB_BSDF_H
+
+#include "ub_fresnel.h"
+#include "ub_microfacet.h"
+#include "ub_phong.h"
+#include "ub_plastic.h"
+#include "ub_vec3.h"
+
+/* Material types (the values of ub::MaterialType, src/scene/material.h). */
+#define UB_MATERIAL_DIFFUSE 0u
+#define UB_MATERIAL_PHONG 1u
+#define UB_MATERIAL_MIRROR 2u
+#define UB_MATERIAL_DIELECTRIC 3u
+#define UB_MATERIAL_ROUGH_CONDUCTOR 4u
+#define UB_MATERIAL_ROUGH_DIELECTRIC 5u
+#define UB_MATERIAL_PLASTIC 6u
+#define UB_MATERIAL_ROUGH_PLASTIC 7u
+#define UB_MATERIAL_THIN_DIELECTRIC 8u
+
+#define UB_BSDF_EVALUABLE 1u       /* valid, not all-delta, not black: evaluation can be > 0 */
+#define UB_BSDF_FROM_LIGHT 2u      /* light subpath: importance transport (bsdf.h) */
+#define UB_BSDF_GEOMETRIC_GUARD 4u /* the geometric-normal guard is on (bsdf.h) */
+#define UB_BSDF_SEPARABLE 8u       /* separable Smith G2 for GGX reflection (Material) */
+#define UB_BSDF_BECKMANN 16u       /* Beckmann microfacets instead of GGX */
+
+/* Smallest microfacet roughness used (alpha -> 0 is a delta lobe floats cannot represent). */
+#define UB_MIN_GGX_ALPHA 1e-4f
+/* |cos| below which a direction counts as grazing (no evaluation). */
+#define UB_EPS_COSINE 1e-6f
+
+typedef struct {
+    float frameS[3]; /* shading frame (s, t, n); n possibly flipped to dirFix's side */
+    ub_uint type;    /* UB_MATERIAL_* */
+    float frameT[3];
+    ub_uint flags; /* UB_BSDF_* */
+    float frameN[3];
+    float cosGeoFix;    /* dot(dirFix, geoNormal) */
+    float geoNormal[3]; /* same side convention as frameN */
+    float exponent;     /* Phong exponent */
+    float localFix[3];  /* dirFix in the shading frame */
+    float alpha;        /* GGX roughness as given (clamped to UB_MIN_GGX_ALPHA when used) */
+    float diffuse[3];   /* RGB parameters at the point (textures resolved) */
+    float ior;          /* interior / exterior IOR (dielectrics, plastics) */
+    float glossy[3];
+    float etaFix; /* dielectrics: IOR on dirFix's side */
+    float specular[3];
+    float etaOther; /* dielectrics: IOR on the other side */
+    float eta[3];   /* conductor: complex IOR */
+    float probDiffuse;
+    float k[3];
+    float probGlossy;
+    float plasticBase[3]; /* plastics: rho / (1 - Fint) per channel (ub_plastic.h) */
+    float fresnelFix;     /* smooth interface's Fresnel reflectance seen from dirFix */
+    float specularWeight; /* plastics: mean(specular) / (mean(diffuse) + mean(specular)) */
+    ub_uint tableIndex;   /* rough plastic: the material whose coating table applies */
+    float pad0, pad1;
+} ub_bsdf;
+
+/* The microfacet distribution of b (UB_MF_*). */
+UB_INLINE ub_uint ub_bsdf_distribution(UB_PRIVATE const ub_bsdf* b) {
+    return (b->flags & UB_BSDF_BECKMANN) ? UB_MF_BECKMANN : UB_MF_GGX;
+}
+
+UB_INLINE ub_float3 ub_bsdf_to_local(UB_PRIVATE const ub_bsdf* b, ub_float3 v) {
+    return ub_make_float3(v.x * b->frameS[0] + v.y * b->frameS[1] + v.z * b->frameS[2],
+                          v.x * b->frameT[0] + v.y * b->frameT[1] + v.z * b->frameT[2],
+                          v.x * b->frameN[0] + v.y * b->frameN[1] + v.z * b->frameN[2]);
+}
+
+/* Veach 1997, Sec. 5.3: the adjoint factor |dirFix.Ns| |dirGen.Ng| / (|dirFix.Ng| |dirGen.Ns|)
+ * for importance transport, 1 for radiance. */
+UB_INLINE float ub_bsdf_shading_factor(UB_PRIVATE const ub_bsdf* b, float cosShadingGen,
+                                       float cosGeoGen) {
+    if (!(b->flags & UB_BSDF_FROM_LIGHT)) return 1.0f;
+    return ub_fabs(b->localFix[2]) * ub_fabs(cosGeoGen) / (ub_fabs(b->cosGeoFix) * cosShadingGen);
+}
+
+/* The geometric-normal guard: a reflected dirGen on dirFix's side of the geometric surface,
+ * a transmitted one on the other side (bsdf.cpp's banner). */
+UB_INLINE int ub_bsdf_geometric_side_ok(UB_PRIVATE const ub_bsdf* b, float localGenZ,
+                                        float cosGeoGen) {
+    if (cosGeoGen == 0.0f) return 0;
+    if (!(b->flags & UB_BSDF_GEOMETRIC_GUARD)) return 1; /* Mitsuba 3: shading frame decides */
+    int shadingReflect = localGenZ * b->localFix[2] > 0.0f;
+    int geometricReflect = cosGeoGen * b->cosGeoFix > 0.0f;
+    return shadingReflect == geometricReflect;
+}
+
+/* Probability of picking a plastic's specular lobe seen from a direction with |cos| =
+ * cosTheta (Mitsuba 3: R w / (R w + (1 - R)(1 - w)), bsdf_plastic.cpp). coating: the rough
+ * plastic's transmittance table (unused for the smooth one). */
+UB_INLINE float ub_bsdf_plastic_specular_prob(UB_PRIVATE const ub_bsdf* b,
+                                              UB_GLOBAL const float* coating, float cosTheta) {
+    float reflectance = b->type == UB_MATERIAL_PLASTIC
+                            ? ub_fresnel_dielectric(cosTheta, b->ior)
+                            : 1.0f - ub_plastic_table_lookup(coating, cosTheta);
+    float ps = reflectance * b->specularWeight;
+    float pd = (1.0f - reflectance) * (1.0f - b->specularWeight);
+    return ps + pd > 0.0f ? ps / (ps + pd) : 0.0f;
+}
+
+/* Diffuse + Phong, reflection above the surface only. */
+UB_INLINE ub_float3 ub_bsdf_eval_phong(UB_PRIVATE const ub_bsdf* b, ub_float3 gen,
+                                       UB_PRIVATE float* directPdfW,
+                                       UB_PRIVATE float* reversePdfW) {
+    ub_float3 fix = ub_f3_from(b->localFix);
+    ub_float3 f = ub_make_float3(0.0f, 0.0f, 0.0f);
+    if (fix.z <= 0.0f || gen.z <= 0.0f) return f;
+    if (b->probDiffuse > 0.0f) {
+        f = ub_f3_scale(ub_f3_from(b->diffuse), UB_INV_PI);
+        *directPdfW += b->probDiffuse * ub_lambert_pdf(gen.z);
+        *reversePdfW += b->probDiffuse * ub_lambert_pdf(fix.z);
+    }
+    if (b->probGlossy > 0.0f) {
+        /* cos between dirGen and the mirror direction of dirFix: symmetric in the two
+         * directions, so the reverse pdf is the same value */
+        float cosAlpha = -fix.x * gen.x - fix.y * gen.y + fix.z * gen.z;
+        float lobePdf = b->probGlossy * ub_power_cos_pdf(cosAlpha, b->exponent);
+        f = ub_f3_add(f, ub_f3_scale(ub_f3_from(b->glossy), ub_phong_lobe(cosAlpha, b->exponent)));
+        *directPdfW += lobePdf;
+        *reversePdfW += lobePdf;
+    }
+    return f;
+}
+
+UB_INLINE ub_float3 ub_bsdf_eval_rough_conductor(UB_PRIVATE const ub_bsdf* b, ub_float3 gen,
+                                                 UB_PRIVATE float* directPdfW,
+                                                 UB_PRIVATE float* reversePdfW) {
+    ub_uint dist = ub_bsdf_distribution(b);
+    ub_float3 fix = ub_f3_from(b->localFix);
+    if (fix.z <= 0.0f || gen.z <= 0.0f) return ub_make_float3(0.0f, 0.0f, 0.0f);
+    float alpha = ub_fmax(b->alpha, UB_MIN_GGX_ALPHA);
+    ub_float3 h = ub_f3_normalize(ub_f3_add(fix, gen)); /* h.z > 0, fix.h = gen.h > 0 */
+    float cosFixH = ub_f3_dot(fix, h), cosGenH = ub_f3_dot(gen, h);
+    float d = ub_mf_d(dist, h.z, alpha);
+    float g2 = (b->flags & UB_BSDF_SEPARABLE) ? ub_mf_g2_separable(dist, fix.z, gen.z, alpha)
+                                              : ub_mf_g2_correlated(dist, fix.z, gen.z, alpha);
+    /* visible-normal density times the reflection Jacobian (Walter et al. 2007, eq. 14) */
+    *directPdfW =
+        ub_mf_visible_pdf(dist, fix.z, cosFixH, h.z, alpha) * ub_jacobian_reflect(cosGenH);
+    *reversePdfW =
+        ub_mf_visible_pdf(dist, gen.z, cosGenH, h.z, alpha) * ub_jacobian_reflect(cosFixH);
+    /* Walter et al. 2007, eq. 20: F D G / (4 |i.n| |o.n|) */
+    float s = d * g2 / (4.0f * fix.z * gen.z);
+    return ub_make_float3(b->specular[0] * ub_fresnel_conductor(cosFixH, b->eta[0], b->k[0]) * s,
+                          b->specular[1] * ub_fresnel_conductor(cosFixH, b->eta[1], b->k[1]) * s,
+                          b->specular[2] * ub_fresnel_conductor(cosFixH, b->eta[2], b->k[2]) * s);
+}
+
+UB_INLINE ub_float3 ub_bsdf_eval_rough_dielectric(UB_PRIVATE const ub_bsdf* b, ub_float3 gen,
+                                                  UB_PRIVATE float* directPdfW,
+                                                  UB_PRIVATE float* reversePdfW) {
+    ub_uint dist = ub_bsdf_distribution(b);
+    ub_float3 fix = ub_f3_from(b->localFix);
+    ub_float3 zero = ub_make_float3(0.0f, 0.0f, 0.0f);
+    float alpha = ub_fmax(b->alpha, UB_MIN_GGX_ALPHA);
+    int reflect = fix.z * gen.z > 0.0f;
+    float etaGen = reflect ? b->etaFix : b->etaOther;
+    /* half vector: Walter et al. 2007 eq. 13 (reflection), eq. 16 (refraction), to +z */
+    ub_float3 h = reflect ? ub_f3_add(fix, gen)
+                          : ub_f3_add(ub_f3_scale(fix, b->etaFix), ub_f3_scale(gen, etaGen));
+    float len2 = ub_f3_dot(h, h);
+    if (!(len2 > 1e-12f)) return zero;
+    h = ub_f3_scale(h, 1.0f / ub_sqrt(len2));
+    if (h.z < 0.0f) h = ub_f3_neg(h);
+    float cosFixH = ub_f3_dot(fix, h), cosGenH = ub_f3_dot(gen, h);
+    /* both directions see the microfacet from their side (chi+ of Walter eq. 20/21) */
+    if (cosFixH * fix.z <= 0.0f || cosGenH * gen.z <= 0.0f) return zero;
+    float cFix = ub_fabs(fix.z), cGen = ub_fabs(gen.z);
+    float aFix = ub_fabs(cosFixH), aGen = ub_fabs(cosGenH);
+    float d = ub_mf_d(dist, h.z, alpha);
+    float visFix = ub_mf_visible_pdf(dist, cFix, aFix, h.z, alpha);
+    float visGen = ub_mf_visible_pdf(dist, cGen, aGen, h.z, alpha);
+    float etaRel = b->etaOther / b->etaFix;
+    if (reflect) {
+        float fresnelFix = ub_fresnel_dielectric(aFix, etaRel);
+        float fresnelGen = ub_fresnel_dielectric(aGen, etaRel);
+        *directPdfW = fresnelFix * visFix * ub_jacobian_reflect(aGen);
+        *reversePdfW = fresnelGen * visGen * ub_jacobian_reflect(aFix);
+        float g2 = (b->flags & UB_BSDF_SEPARABLE) ? ub_mf_g2_separable(dist, cFix, cGen, alpha)
+                                                  : ub_mf_g2_correlated(dist, cFix, cGen, alpha);
+        /* F at the mean of fix.h and gen.h (equal in exact arithmetic) keeps f(fix, gen) =
+         * f(gen, fix) bit for bit; the pdfs keep F(fix.h), what the sampler used */
+        float fresnelSym = ub_fresnel_dielectric(0.5f * (aFix + aGen), etaRel);
+        return ub_f3_scale(ub_f3_from(b->specular), fresnelSym * d * g2 / (4.0f * cFix * cGen));
+    }
+    /* refraction: F computed from the outside direction whichever is dirFix, so f and the
+     * pdfs are symmetric under swapping the two */
+    float transmit = 1.0f - (fix.z > 0.0f ? ub_fresnel_dielectric(aFix, etaGen / b->etaFix)
+                                          : ub_fresnel_dielectric(aGen, b->etaFix / etaGen));
+    *directPdfW = transmit * visFix * ub_jacobian_refract(b->etaFix, cosFixH, etaGen, cosGenH);
+    *reversePdfW = transmit * visGen * ub_jacobian_refract(etaGen, cosGenH, b->etaFix, cosFixH);
+    float denom = ub_sqr(b->etaFix * cosFixH + etaGen * cosGenH);
+    /* Walter eq. 21 with o the camera side: eta_o = etaFix for radiance, etaGen for
+     * importance (the adjoint BTDF) */
+    float etaO = (b->flags & UB_BSDF_FROM_LIGHT) ? etaGen : b->etaFix;
+    float g2 = ub_mf_g2_separable(dist, cFix, cGen, alpha);
+    return ub_f3_scale(ub_f3_from(b->specular),
+                       transmit * d * g2 * aFix * aGen * etaO * etaO / (cFix * cGen * denom));
+}
+
+/* Plastic: the diffuse base under the smooth coating (the coating itself is a delta). */
+UB_INLINE ub_float3 ub_bsdf_eval_plastic(UB_PRIVATE const ub_bsdf* b, ub_float3 gen,
+                                         UB_PRIVATE float* directPdfW,
+                                         UB_PRIVATE float* reversePdfW) {
+    ub_float3 fix = ub_f3_from(b->localFix);
+    if (fix.z <= 0.0f || gen.z <= 0.0f) return ub_make_float3(0.0f, 0.0f, 0.0f);
+    float eta = b->ior;
+    float fresnelGen = ub_fresnel_dielectric(gen.z, eta);
+    *directPdfW = (1.0f - ub_bsdf_plastic_specular_prob(b, 0, fix.z)) * ub_lambert_pdf(gen.z);
+    *reversePdfW = (1.0f - ub_bsdf_plastic_specular_prob(b, 0, gen.z)) * ub_lambert_pdf(fix.z);
+    return ub_f3_scale(ub_f3_from(b->plasticBase),
+                       (1.0f - b->fresnelFix) * (1.0f - fresnelGen) * UB_INV_PI / (eta * eta));
+}
+
+/* RoughPlastic: GGX coating reflection plus the diffuse base, mixed by the selection
+ * probabilities of each direction. */
+UB_INLINE ub_float3 ub_bsdf_eval_rough_plastic(UB_PRIVATE const ub_bsdf* b,
+                                               UB_GLOBAL const float* coating, ub_float3 gen,
+                                               UB_PRIVATE float* directPdfW,
+                                               UB_PRIVATE float* reversePdfW) {
+    ub_uint dist = ub_bsdf_distribution(b);
+    ub_float3 fix = ub_f3_from(b->localFix);
+    if (fix.z <= 0.0f || gen.z <= 0.0f) return ub_make_float3(0.0f, 0.0f, 0.0f);
+    float eta = b->ior, alpha = ub_fmax(b->alpha, UB_MIN_GGX_ALPHA);
+    ub_float3 h = ub_f3_normalize(ub_f3_add(fix, gen));
+    float cosFixH = ub_f3_dot(fix, h), cosGenH = ub_f3_dot(gen, h);
+    float d = ub_mf_d(dist, h.z, alpha);
+    float g = ub_mf_g2_separable(dist, fix.z, gen.z, alpha);
+    float fresnel = ub_fresnel_dielectric(cosFixH, eta);
+    float probSpecFix = ub_bsdf_plastic_specular_prob(b, coating, fix.z);
+    float probSpecGen = ub_bsdf_plastic_specular_prob(b, coating, gen.z);
+    /* Walter et al. 2007 eq. 14 for the coating, mixed with the cosine lobe */
+    *directPdfW = probSpecFix * ub_mf_visible_pdf(dist, fix.z, cosFixH, h.z, alpha) *
+                      ub_jacobian_reflect(cosGenH) +
+                  (1.0f - probSpecFix) * ub_lambert_pdf(gen.z);
+    *reversePdfW = probSpecGen * ub_mf_visible_pdf(dist, gen.z, cosGenH, h.z, alpha) *
+                       ub_jacobian_reflect(cosFixH) +
+                   (1.0f - probSpecGen) * ub_lambert_pdf(fix.z);
+    float glossy = fresnel * d * g / (4.0f * fix.z * gen.z);
+    float transmit =
+        ub_plastic_table_lookup(coating, fix.z) * ub_plastic_table_lookup(coating, gen.z);
+    float base = transmit * UB_INV_PI / (eta * eta);
+    return ub_make_float3(b->specular[0] * glossy + b->plasticBase[0] * base,
+                          b->specular[1] * glossy + b->plasticBase[1] * base,
+                          b->specular[2] * glossy + b->plasticBase[2] * base);
+}
+
+/* f_s(dirFix, dirGen) and both pdfs for dirGen given in the shading frame; cosGeoGen =
+ * dot(dirGen, geoNormal). Applies the geometric guard and, for light subpaths, the
+ * shading-normal factor. coating: the rough plastic's coating table (else unused). */
+UB_INLINE ub_float3 ub_bsdf_eval_local(UB_PRIVATE const ub_bsdf* b, UB_GLOBAL const float* coating,
+                                       ub_float3 gen, float cosGeoGen, UB_PRIVATE float* directPdfW,
+                                       UB_PRIVATE float* reversePdfW) {
+    ub_float3 f = ub_make_float3(0.0f, 0.0f, 0.0f);
+    *directPdfW = 0.0f;
+    *reversePdfW = 0.0f;
+    if (ub_fabs(gen.z) < UB_EPS_COSINE || !ub_bsdf_geometric_side_ok(b, gen.z, cosGeoGen)) return f;
+    switch (b->type) {
+        case UB_MATERIAL_DIFFUSE:
+        case UB_MATERIAL_PHONG:
+            f = ub_bsdf_eval_phong(b, gen, directPdfW, reversePdfW);
+            break;
+        case UB_MATERIAL_ROUGH_CONDUCTOR:
+            f = ub_bsdf_eval_rough_conductor(b, gen, directPdfW, reversePdfW);
+            break;
+        case UB_MATERIAL_ROUGH_DIELECTRIC:
+            f = ub_bsdf_eval_rough_dielectric(b, gen, directPdfW, reversePdfW);
+            break;
+        case UB_MATERIAL_PLASTIC:
+            f = ub_bsdf_eval_plastic(b, gen, directPdfW, reversePdfW);
+            break;
+        case UB_MATERIAL_ROUGH_PLASTIC:
+            f = ub_bsdf_eval_rough_plastic(b, coating, gen, directPdfW, reversePdfW);
+            break;
+        default:
+            break;
+    }
+    return ub_f3_scale(f, ub_bsdf_shading_factor(b, ub_fabs(gen.z), cosGeoGen));
+}
+
+/* The same for a world-space unit dirGen; *cosThetaGen = |cos| to the shading normal. */
+UB_INLINE ub_float3 ub_bsdf_evaluate(UB_PRIVATE const ub_bsdf* b, UB_GLOBAL const float* coating,
+                                     ub_float3 dirGen, UB_PRIVATE float* cosThetaGen,
+                                     UB_PRIVATE float* directPdfW, UB_PRIVATE float* reversePdfW) {
+    ub_float3 gen = ub_bsdf_to_local(b, dirGen);
+    *cosThetaGen = ub_fabs(gen.z);
+    if (!(b->flags & UB_BSDF_EVALUABLE)) {
+        *directPdfW = 0.0f;
+        *reversePdfW = 0.0f;
+        return ub_make_float3(0.0f, 0.0f, 0.0f);
+    }
+    float cosGeoGen =
+        dirGen.x * b->geoNormal[0] + dirGen.y * b->geoNormal[1] + dirGen.z * b->geoNormal[2];
+    return ub_bsdf_eval_local(b, coating, gen, cosGeoGen, directPdfW, reversePdfW);
+}
+
+#ifndef __OPENCL_C_VERSION__
+#include <cstddef>
+static_assert(sizeof(ub_bsdf) == 192, "ub_bsdf layout");
+static_assert(offsetof(ub_bsdf, flags) == 28, "ub_bsdf layout");
+static_assert(offsetof(ub_bsdf, localFix) == 64, "ub_bsdf layout");
+static_assert(offsetof(ub_bsdf, plasticBase) == 160, "ub_bsdf layout");
+static_assert(offsetof(ub_bsdf, tableIndex) == 180, "ub_bsdf layout");
+#endif
+
+#endif /* UB_BSDF_H */
