@@ -58,14 +58,22 @@ std::string caseName(const ::testing::TestParamInfo<HandCase>& info) {
 // renormalised filter lt is 15-20% brighter than the reference along the left and right
 // edges, |z| up to 8); pt samples the same convention.
 const HandCase kCases[] = {
-    {"surfaces", "pt", 512},         {"surfaces", "bpt", 256},
-    {"lights", "pt", 512},           {"media", "vpt", 256},
-    {"media", "vbpt", 128},          {"beckmann", "pt", 512},
-    {"beckmann", "bpt", 256},        {"interop", "pt", 512},
-    {"interop", "bpt", 256},         {"interop", "vpt", 512},
-    {"interop", "vbpt", 256},        {"interop_lens", "pt", 512},
-    {"interop_lens", "vpt", 512},    {"interop_ptracer", "lt", 512},
-    {"interop_ptracer", "pt", 512},  {"interop_ptracer", "bpt", 256},
+    {"surfaces", "pt", 512},
+    {"surfaces", "bpt", 256},
+    {"lights", "pt", 512},
+    {"media", "vpt", 256},
+    {"media", "vbpt", 128},
+    {"beckmann", "pt", 512},
+    {"beckmann", "bpt", 256},
+    {"interop", "pt", 512},
+    {"interop", "bpt", 256},
+    {"interop", "vpt", 512},
+    {"interop", "vbpt", 256},
+    {"interop_lens", "pt", 512},
+    {"interop_lens", "vpt", 512},
+    {"interop_ptracer", "lt", 512},
+    {"interop_ptracer", "pt", 512},
+    {"interop_ptracer", "bpt", 256},
     {"interop_ptracer", "vbpt", 256},
 };
 

@@ -35,8 +35,9 @@ double solveIncreasing(F f, DF df, double target, double lo, double hi, double x
         const double d = df(x);
         if (v == 0.0) return x;
         double next = d > 0.0 ? x - v / d : 0.5 * (lo + hi);
-        if (std::fabs(next - x) < 1e-11) return next;  // converged (before the bracket test:
-                                                       // a last step may touch its ends)
+        if (std::fabs(next - x) < 1e-11)
+            return next;  // converged (before the bracket test:
+                          // a last step may touch its ends)
         if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
         if (hi - lo < 1e-11) return next;
         x = next;
