@@ -20,6 +20,12 @@ ub_require(OpenEXR_FOUND "OpenEXR" libopenexr-dev)
 find_package(PNG QUIET)
 ub_require(PNG_FOUND "libpng" libpng-dev)
 
+find_package(ZLIB QUIET)
+ub_require(ZLIB_FOUND "zlib" zlib1g-dev)
+
+find_package(JPEG QUIET)
+ub_require(JPEG_FOUND "libjpeg (libjpeg-turbo)" libjpeg62-turbo-dev)
+
 find_package(nlohmann_json 3 CONFIG QUIET)
 ub_require(nlohmann_json_FOUND "nlohmann-json" nlohmann-json3-dev)
 

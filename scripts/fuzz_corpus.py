@@ -121,6 +121,10 @@ def main():
         put(out, "fuzz_mesh_obj", p.parent.name + "_" + p.name, p.read_bytes())
     for p in files(["tests/data"], {".ply"}):
         put(out, "fuzz_mesh_ply", p.parent.name + "_" + p.name, p.read_bytes())
+    for p in files(["tests/data"], {".serialized"}):
+        put(out, "fuzz_serialized_mesh", p.name, p.read_bytes())
+    for p in files(["tests/data"], {".jpg", ".jpeg"}):
+        put(out, "fuzz_jpeg_image", p.parent.name + "_" + p.name, p.read_bytes())
     for p in files(["scenes", "tests/data"], {".exr"}):
         put(out, "fuzz_exr_image", p.parent.name + "_" + p.name, p.read_bytes())
     for p in files(["scenes", "tests/data"], {".png"}):

@@ -177,6 +177,25 @@ TEST(Cli, TimeLimitAndDefaultOutputName) {
     fs::remove_all(dir);
 }
 
+// A Mitsuba scene whose integrator is ptracer renders with lt when -a is not given; -a
+// chooses another algorithm.
+TEST(Cli, PtracerSceneRendersWithLightTracingUnlessAIsGiven) {
+    const std::string scene =
+        std::string(UNIBEAM_SOURCE_DIR) + "/tests/data/mitsuba/interop_ptracer.xml";
+    fs::path dir = tempDir();
+    RunResult r = runUnibeam({"render", scene, "-i", "1", "-o", (dir / "a.exr").string()}, dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("the scene's integrator renders with lt"), std::string::npos) << r.err;
+    ImageMetadata meta;
+    readExr((dir / "a.exr").string(), &meta);
+    EXPECT_EQ(meta["technique"], "lt");
+    r = runUnibeam({"render", scene, "-a", "pt", "-i", "1", "-o", (dir / "b.exr").string()}, dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    readExr((dir / "b.exr").string(), &meta);
+    EXPECT_EQ(meta["technique"], "pt");
+    fs::remove_all(dir);
+}
+
 TEST(Cli, BadFlagsExitTwoWithMessage) {
     ASSERT_TRUE(fs::exists(kScene)) << kScene;
     fs::path dir = tempDir();

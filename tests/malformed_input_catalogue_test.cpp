@@ -4,11 +4,12 @@
 // location (line:column for text formats, the JSON path of the referencing key for meshes and
 // images, which have no lines) and what was expected. Cases cover every loader: native JSON
 // (16), Mitsuba XML with includes (12), .vol grids (5), SmallUPBP .obj/.mtl/.aux (7), OBJ (4)
-// and PLY (4) meshes, PNG (2) and OpenEXR (2) images, and the CLI's own scene checks (2).
-// Earlier CLI cases (tests/cli_test.cpp, MissingOrBadSceneExitsTwo: a missing scene for render
-// and info, a JSON syntax error) are not repeated; the loaders' own tests check the same kinds
-// of errors in-process. File contents "@data:PATH" are copied from tests/data, "@prefix:N:PATH"
-// are the first N bytes of a repository file (a truncated image).
+// and PLY (4) meshes, Mitsuba .serialized meshes (3), PNG (2), JPEG (2) and OpenEXR (2) images, and
+// the CLI's own scene checks (2). Earlier CLI cases (tests/cli_test.cpp, MissingOrBadSceneExitsTwo:
+// a missing scene for render and info, a JSON syntax error) are not repeated; the loaders' own
+// tests check the same kinds of errors in-process. File contents "@data:PATH" are copied from
+// tests/data,
+// "@prefix:N:PATH" are the first N bytes of a repository file (a truncated image).
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -780,6 +781,66 @@ const std::vector<Case> kCases = {
      "s.json",
      {},
      "m.ply: error: at /shapes/0: vertex index 168430083 out of range (mesh has 4 vertices)"},
+    {"serialized_bad_magic",
+     {{"s.xml", "<scene version=\"3.0.0\">\n"
+            "    <sensor type=\"perspective\">\n"
+            "        <film type=\"hdrfilm\"><integer name=\"width\" value=\"8\"/><integer name=\"height\" value=\"8\"/></film>\n"
+            "    </sensor>\n"
+            "    <emitter type=\"constant\"/>\n"
+            "    <shape type=\"serialized\"><string name=\"filename\" value=\"m.serialized\"/></shape>\n"
+            "</scene>\n"},
+      {"m.serialized", "PLY not a mesh"}},
+     "s.xml",
+     {},
+     "s.xml:6:30: error: <shape type=\"serialized\">: m.serialized: error: at <shape type=\"serialized\">: invalid .serialized file: not a Mitsuba .serialized file (the first two bytes are 0x4c50, expected the identifier 0x41c)"},
+    {"serialized_truncated",
+     {{"s.xml", "<scene version=\"3.0.0\">\n"
+            "    <sensor type=\"perspective\">\n"
+            "        <film type=\"hdrfilm\"><integer name=\"width\" value=\"8\"/><integer name=\"height\" value=\"8\"/></film>\n"
+            "    </sensor>\n"
+            "    <emitter type=\"constant\"/>\n"
+            "    <shape type=\"serialized\"><string name=\"filename\" value=\"m.serialized\"/></shape>\n"
+            "</scene>\n"},
+      {"m.serialized", "@prefix:30:tests/data/mitsuba/meshes/quads.serialized"}},
+     "s.xml",
+     {},
+     "s.xml:6:30: error: <shape type=\"serialized\">: m.serialized: error: at <shape type=\"serialized\">: invalid .serialized file: shape 0: the file ends inside the compressed data, in the texture coordinates (truncated file)"},
+    {"serialized_shape_index_out_of_range",
+     {{"s.xml", "<scene version=\"3.0.0\">\n"
+            "    <sensor type=\"perspective\">\n"
+            "        <film type=\"hdrfilm\"><integer name=\"width\" value=\"8\"/><integer name=\"height\" value=\"8\"/></film>\n"
+            "    </sensor>\n"
+            "    <emitter type=\"constant\"/>\n"
+            "    <shape type=\"serialized\"><string name=\"filename\" value=\"m.serialized\"/><integer name=\"shape_index\" value=\"2\"/></shape>\n"
+            "</scene>\n"},
+      {"m.serialized", "@data:mitsuba/meshes/quads.serialized"}},
+     "s.xml",
+     {},
+     "s.xml:6:30: error: <shape type=\"serialized\">: m.serialized: error: at <shape type=\"serialized\">: invalid .serialized file: shape_index 2 is out of range: the file holds 2 shapes (0..1)"},
+    {"jpeg_not_jpeg",
+     {{"s.xml", "<scene version=\"3.0.0\">\n"
+            "    <sensor type=\"perspective\">\n"
+            "        <film type=\"hdrfilm\"><integer name=\"width\" value=\"8\"/><integer name=\"height\" value=\"8\"/></film>\n"
+            "    </sensor>\n"
+            "    <emitter type=\"constant\"/>\n"
+            "    <shape type=\"cube\"><bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"t.jpg\"/></texture></bsdf></shape>\n"
+            "</scene>\n"},
+      {"t.jpg", "nope"}},
+     "s.xml",
+     {},
+     "s.xml:6:87: error: <texture type=\"bitmap\">: t.jpg: error: not a JPEG file (missing the start-of-image marker FF D8 FF)"},
+    {"jpeg_truncated",
+     {{"s.xml", "<scene version=\"3.0.0\">\n"
+            "    <sensor type=\"perspective\">\n"
+            "        <film type=\"hdrfilm\"><integer name=\"width\" value=\"8\"/><integer name=\"height\" value=\"8\"/></film>\n"
+            "    </sensor>\n"
+            "    <emitter type=\"constant\"/>\n"
+            "    <shape type=\"cube\"><bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"t.jpg\"/></texture></bsdf></shape>\n"
+            "</scene>\n"},
+      {"t.jpg", "@prefix:400:tests/data/mitsuba/textures/stripes.jpg"}},
+     "s.xml",
+     {},
+     "s.xml:6:87: error: <texture type=\"bitmap\">: t.jpg: error: corrupt or unsupported JPEG image (libjpeg: Premature end of JPEG file)"},
     {"png_bad_signature",
      {{"s.json", "{\n"
             "\"camera\": {\"position\": [0, 0, 5], \"target\": [0, 0, 0], \"up\": [0, 1, 0], \"fov\": 40, \"resolution\": [8, 8]},\n"

@@ -155,7 +155,7 @@ TEST(JsonLoaderErrors, TextureErrors) {
     std::ofstream(dir.path / "broken.png") << "not a png";
     const std::string materials = R"json(
 "a": {"type": "diffuse", "reflectance": {"type": "bitmap", "file": "missing.png"}},
-"b": {"type": "diffuse", "reflectance": {"type": "bitmap", "file": "tiles.jpg"}},
+"b": {"type": "diffuse", "reflectance": {"type": "bitmap", "file": "tiles.gif"}},
 "c": {"type": "diffuse", "reflectance": {"type": "bitmap", "file": "broken.png"}},
 "d": {"type": "diffuse", "reflectance": {"type": "bitmap", "file": "bright.exr"}},
 "e": {"type": "diffuse", "reflectance": {"type": "checkerbord"}},
@@ -174,8 +174,8 @@ TEST(JsonLoaderErrors, TextureErrors) {
         << all;
     EXPECT_TRUE(contains(all,
                          "scene.json:5:68: error: at /materials/b/reflectance/file: "
-                         "unsupported bitmap file 'tiles.jpg' (expected a .png (sRGB, 8 or "
-                         "16 bit) or .exr (linear) file)"))
+                         "unsupported bitmap file 'tiles.gif' (expected a .png (sRGB, 8 or "
+                         "16 bit), .jpg/.jpeg (sRGB) or .exr (linear) file)"))
         << all;
     EXPECT_TRUE(contains(all,
                          "error: at /materials/c/reflectance/file: cannot read bitmap "

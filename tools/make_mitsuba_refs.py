@@ -41,6 +41,16 @@ def render_reference(path, spp, res):
     return mean, var_sample, time.time() - start
 
 
+def make_jpeg(folder):
+    """A 16x16 JPEG texture (baseline, Mitsuba's own writer, quality 95)."""
+    x = np.linspace(0, 1, 16)
+    X, Y = np.meshgrid(x, x)
+    img = np.stack([0.9 - 0.7 * Y, 0.2 + 0.7 * X, 0.3 + 0.3 * X * Y], -1)
+    img[:, ::4, :] *= 0.25
+    mi.Bitmap((img * 255).astype(np.uint8), pixel_format=mi.Bitmap.PixelFormat.RGB).write(
+        str(folder / "textures" / "stripes.jpg"), quality=95)
+
+
 def make_inputs(folder):
     """A 16x16 sRGB texture and a 12^3 density grid with a 3-channel albedo grid."""
     (folder / "textures").mkdir(exist_ok=True)
@@ -51,6 +61,7 @@ def make_inputs(folder):
     img[::4, :, :] *= 0.3
     mi.Bitmap((img * 255).astype(np.uint8), pixel_format=mi.Bitmap.PixelFormat.RGB).write(
         str(folder / "textures" / "tiles.png"))
+    make_jpeg(folder)
     n = 12
     c = (np.arange(n) + 0.5) / n
     Z, Yv, Xv = np.meshgrid(c, c, c, indexing="ij")  # VolumeGrid data is [z][y][x][channel]

@@ -24,6 +24,9 @@ struct UsageError : std::runtime_error {
 struct RenderArgs {
     std::string scene;
     std::string algorithm = "pt";
+    /// -a was given; otherwise a scene's default algorithm (RenderSettings::defaultAlgorithm,
+    /// e.g. lt for Mitsuba's ptracer) replaces pt.
+    bool algorithmGiven = false;
     double timeLimit = 0;    ///< -t, 0 if not given
     int iterations = 0;      ///< -i, 0 if not given
     std::string exrPath;     ///< -o

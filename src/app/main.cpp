@@ -117,16 +117,18 @@ int run(int argc, char** argv) {
             "Scene file: unibeam .json, Mitsuba 3 .xml, or SmallUPBP .obj (with its .obj.aux)")
         ->required()
         ->type_name("SCENE");
-    render
-        ->add_option("-a,--algorithm", ra.algorithm,
-                     "Rendering algorithm: one of " + algorithmList() +
-                         " (default pt). UPBP: 'upbp' runs all six techniques, "
-                         "'upbp:T1+T2+...' any subset of bpt (connections, NEE, light "
-                         "tracing), surf (surface merging), pp3d, pb2d, bp2d, bb1d (volumetric "
-                         "points and beams), with MIS over exactly those; without bpt only "
-                         "paths the chosen estimators can merge are rendered (docs/"
-                         "algorithms.md). 'vcm' on a scene with media is upbp:bpt+surf")
-        ->type_name("ALGO");
+    CLI::Option* algorithmOpt =
+        render
+            ->add_option("-a,--algorithm", ra.algorithm,
+                         "Rendering algorithm: one of " + algorithmList() +
+                             " (default pt, or lt for a Mitsuba scene whose integrator is "
+                             "ptracer). UPBP: 'upbp' runs all six techniques, "
+                             "'upbp:T1+T2+...' any subset of bpt (connections, NEE, light "
+                             "tracing), surf (surface merging), pp3d, pb2d, bp2d, bb1d (volumetric "
+                             "points and beams), with MIS over exactly those; without bpt only "
+                             "paths the chosen estimators can merge are rendered (docs/"
+                             "algorithms.md). 'vcm' on a scene with media is upbp:bpt+surf")
+            ->type_name("ALGO");
     CLI::Option* timeOpt =
         render
             ->add_option("-t,--time", ra.timeLimit,
@@ -462,6 +464,7 @@ int run(int argc, char** argv) {
                                               maxLengthText + "'");
                 ra.maxLength = v;
             }
+            ra.algorithmGiven = algorithmOpt->count() > 0;
             if (radiusOpt->count() > 0) ra.radius = radius;
             if (alphaOpt->count() > 0) ra.alpha = alpha;
             for (int t = 0; t < 4; ++t) {

@@ -110,6 +110,9 @@ std::string join(const std::vector<std::string>& v) {
 RenderOptions makeRenderOptions(const RenderArgs& args, const Scene& scene) {
     RenderOptions options;
     options.algorithm = args.algorithm;
+    // A scene may name its algorithm (Mitsuba's ptracer: lt); -a overrides it.
+    if (!args.algorithmGiven && !scene.settings.defaultAlgorithm.empty())
+        options.algorithm = scene.settings.defaultAlgorithm;
     options.maxPathLength = args.maxLength ? *args.maxLength : scene.settings.maxPathLength;
     options.minPathLength = scene.settings.minPathLength;
     options.seed = args.seed ? *args.seed : scene.settings.seed;
@@ -187,6 +190,10 @@ int runRender(const RenderArgs& args) {
     if (width > 0)
         scene->camera = scene->camera.resized(width, height, scene->settings.keepHorizontalFov);
     RenderOptions options = makeRenderOptions(args, *scene);
+    if (options.algorithm != args.algorithm)
+        std::fprintf(stderr,
+                     "unibeam: the scene's integrator renders with %s (-a chooses another)\n",
+                     options.algorithm.c_str());
     std::unique_ptr<Integrator> integrator = makeIntegrator(*scene, options);
     if (!integrator->setupNote().empty())
         std::fprintf(stderr, "unibeam: %s\n", integrator->setupNote().c_str());

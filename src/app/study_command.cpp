@@ -323,6 +323,7 @@ int runStudy(const StudyArgs& args) {
     }
     RenderArgs ra = args.render;
     ra.algorithm = "upbp";
+    ra.algorithmGiven = true;
     const RenderOptions base = makeRenderOptions(ra, *scene);
     installStopSignalHandlers();
 

@@ -35,6 +35,10 @@ Image readExr(const std::string& path, ImageMetadata* metadata = nullptr);
 /// sRGB transfer function (IEC 61966-2-1), otherwise it is returned as value / max.
 /// Throws InputError if the file is missing or not a readable PNG.
 Image readPng(const std::string& path, bool linearize = true);
+/// Reads a baseline or progressive JPEG (grey or YCbCr; CMYK is an error), 8-bit values
+/// decoded like readPng (sRGB unless linearize = false). Corrupt or truncated data is an
+/// error (libjpeg's warnings are not ignored). Throws InputError naming the file.
+Image readJpeg(const std::string& path, bool linearize = true);
 /// The sRGB transfer function (IEC 61966-2-1): encoded value in [0,1] -> linear.
 float srgbToLinear(float encoded);
 /// Writes 32-bit float RGB with the given string attributes. Throws std::runtime_error on I/O

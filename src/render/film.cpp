@@ -51,20 +51,24 @@ Image Film::average() const {
     return img;
 }
 
-void SplatBuffer::reset(int width, int height, const ContributionGuard& guard) {
+void SplatBuffer::reset(int width, int height, const ContributionGuard& guard,
+                        const PixelFilter& filter) {
     width_ = width;
     height_ = height;
+    filter_ = filter;
     chunks_.assign(kChunkCount, Chunk());
     for (auto& c : chunks_) {
         c.width_ = width;
         c.height_ = height;
         c.guard_ = guard;
+        c.filter_ = filter;
     }
 }
 
 void SplatBuffer::clear() {
     for (auto& c : chunks_) {
         c.splats_.clear();
+        c.filtered_.clear();
         c.rejected_ = 0;
     }
 }
@@ -88,13 +92,24 @@ void SplatBuffer::forEachChunk(size_t pathCount,
 void SplatBuffer::resolve(Image& image) const {
     if (image.width != width_ || image.height != height_)
         throw std::logic_error("SplatBuffer::resolve: image size differs from the buffer size");
-    for (const auto& c : chunks_)
+    for (const auto& c : chunks_) {
         for (const Splat& s : c.splats_) image.pixels[s.pixel] += s.value;
+        for (const FilteredSplat& s : c.filtered_) {
+            int x0, x1, y0, y1;
+            filter_.footprint(s.raster, width_, height_, &x0, &x1, &y0, &y1);
+            for (int y = y0; y <= y1; ++y)
+                for (int x = x0; x <= x1; ++x) {
+                    const float w = filter_.splatWeight(x, y, s.raster, width_, height_);
+                    if (w > 0.0f)
+                        image.pixels[size_t(y) * size_t(width_) + size_t(x)] += s.value * w;
+                }
+        }
+    }
 }
 
 size_t SplatBuffer::splatCount() const {
     size_t n = 0;
-    for (const auto& c : chunks_) n += c.splats_.size();
+    for (const auto& c : chunks_) n += c.size();
     return n;
 }
 

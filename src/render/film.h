@@ -29,6 +29,10 @@
 //     });
 //     splats.resolve(image);   // image += splats, in a fixed order
 //
+// With a reconstruction filter other than the box (scene/pixel_filter.h), a splat is recorded
+// with its raster position and resolve() spreads it over the pixels of the filter's footprint,
+// each weighted by the normalised filter fhat of that pixel (PixelFilter::splatWeight).
+//
 // Both are guarded (render/contribution_guard.h): a splat that is NaN, infinite or negative is
 // dropped and counted by its chunk (rejectedCount(), the chunks' counts summed), and
 // Film::addIteration drops and counts every such pixel of an iteration (rejected()).
@@ -43,6 +47,7 @@
 
 #include "core/image.h"
 #include "render/contribution_guard.h"
+#include "scene/pixel_filter.h"
 
 namespace ub {
 
@@ -90,24 +95,35 @@ class SplatBuffer {
         uint32_t pixel;  ///< y * width + x
         Rgb value;
     };
+    /// A splat of a filtered film: its raster position, spread over the footprint in resolve().
+    struct FilteredSplat {
+        Vec2 raster;
+        Rgb value;
+    };
 
     class Chunk {
       public:
-        /// Adds value to the pixel containing raster position (x right, y down); positions
-        /// outside the image are ignored. A NaN, infinite or negative value is dropped and
-        /// counted (rejected()).
+        /// Adds value to the pixel containing raster position (x right, y down), or with a
+        /// filter to the pixels of its footprint; positions outside the image are ignored. A
+        /// NaN, infinite or negative value is dropped and counted (rejected()).
         void add(const Vec2& raster, const Rgb& value) {
             if (!(raster.x >= 0 && raster.y >= 0)) return;  // also rejects NaN
             int x = int(raster.x), y = int(raster.y);
             if (x >= width_ || y >= height_) return;
-            addPixel(x, y, value);
+            if (filter_.isBox()) {
+                addPixel(x, y, value);
+                return;
+            }
+            Rgb v = value;
+            const uint32_t pixel = uint32_t(y) * uint32_t(width_) + uint32_t(x);
+            if (guard_.filter(pixel, &v, &rejected_)) filtered_.push_back({raster, v});
         }
         /// Adds value to pixel (x, y) (must be inside the image); guarded like add().
         void addPixel(int x, int y, Rgb value) {
             const uint32_t pixel = uint32_t(y) * uint32_t(width_) + uint32_t(x);
             if (guard_.filter(pixel, &value, &rejected_)) splats_.push_back({pixel, value});
         }
-        size_t size() const { return splats_.size(); }
+        size_t size() const { return splats_.size() + filtered_.size(); }
         /// Splats rejected by the guard since the last clear().
         uint64_t rejected() const { return rejected_; }
 
@@ -116,13 +132,17 @@ class SplatBuffer {
         int width_ = 0, height_ = 0;
         uint64_t rejected_ = 0;
         ContributionGuard guard_;
+        PixelFilter filter_;
         std::vector<Splat> splats_;
+        std::vector<FilteredSplat> filtered_;
     };
 
     SplatBuffer() = default;
     SplatBuffer(int width, int height) { reset(width, height); }
-    /// guard: the technique's guard (fault injection in tests; default: none).
-    void reset(int width, int height, const ContributionGuard& guard = ContributionGuard());
+    /// guard: the technique's guard (fault injection in tests; default: none); filter: the
+    /// scene's reconstruction filter.
+    void reset(int width, int height, const ContributionGuard& guard = ContributionGuard(),
+               const PixelFilter& filter = PixelFilter());
     /// Empties every chunk (keeps the allocations) and zeroes the rejection counts.
     void clear();
 
@@ -142,6 +162,7 @@ class SplatBuffer {
 
   private:
     int width_ = 0, height_ = 0;
+    PixelFilter filter_;
     std::vector<Chunk> chunks_;
 };
 

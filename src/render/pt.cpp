@@ -69,10 +69,16 @@ Rgb PathTracer::tracePixel(int x, int y, int iteration) const {
                            uint64_t(y) * uint64_t(camera.width()) + uint64_t(x));
     const Vec2 jitter = rng.uniform2();
     const Vec2 lensU = rng.uniform2();
-    Ray ray = camera.generateRay(Vec2(float(x) + jitter.x, float(y) + jitter.y), lensU);
+    // Pixel position from the scene's reconstruction filter (box: pixel + jitter), and the
+    // path's weight (1, or Mitsuba's ptracer convention at the borders: scene/pixel_filter.h).
+    float pixelWeight = 1.0f;
+    const Vec2 raster = scene_.settings.pixelFilter.sampleRaster(x, y, jitter, camera.width(),
+                                                                 camera.height(), &pixelWeight);
+    Ray ray = camera.generateRay(raster, lensU);
 
     Rgb radiance(0.0f);
-    Rgb throughput(1.0f);
+    if (pixelWeight <= 0.0f) return radiance;  // outside the image (ptracer convention)
+    Rgb throughput(pixelWeight);
     float lastPdfW = 1.0f;  // pdf (solid angle, incl. roulette) of the last sampled direction
     bool lastDelta = true;  // the last direction came from the camera or a delta lobe
 

@@ -217,7 +217,8 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
         for (int t = 0; t < 4; ++t)
             if (layerNames_[i] == volumeNames[t]) volumeTechnique_[t] = int(i);
     }
-    splats_.reset(scene.camera.width(), scene.camera.height(), guards_[0]);
+    splats_.reset(scene.camera.width(), scene.camera.height(), guards_[0],
+                  scene.settings.pixelFilter);
 }
 
 RejectionCounts VertexCM::rejectedContributions() const {

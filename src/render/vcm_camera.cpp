@@ -27,7 +27,14 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
     SubPath state;
     const Vec2 jitter = rng.uniform2();
     const Vec2 lensU = rng.uniform2();
-    state.ray = camera.generateRay(Vec2(float(x) + jitter.x, float(y) + jitter.y), lensU);
+    // Pixel position from the scene's reconstruction filter (box: pixel + jitter), and the
+    // path's weight (1, or Mitsuba's ptracer convention at the borders: scene/pixel_filter.h).
+    float pixelWeight = 1.0f;
+    const Vec2 raster = scene_.settings.pixelFilter.sampleRaster(x, y, jitter, camera.width(),
+                                                                 camera.height(), &pixelWeight);
+    state.ray = camera.generateRay(raster, lensU);
+    if (pixelWeight <= 0.0f) return Rgb(0.0f);  // outside the image (ptracer convention)
+    state.throughput = Rgb(pixelWeight);
     // Camera subpath partials [TR (31)-(33)], completed at the first hit. Thin lenses (ppm and
     // bpm only) never use dVCM of the camera vertex: it is multiplied by bptFactor = 0.
     const float cameraPdfW = camera.isPinhole() ? camera.pdfW(state.ray.dir) : 1.0f;

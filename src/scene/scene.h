@@ -15,6 +15,7 @@
 #include "scene/medium.h"
 #include "scene/medium_stack.h"
 #include "scene/medium_trace.h"
+#include "scene/pixel_filter.h"
 #include "scene/texture.h"
 
 namespace ub {
@@ -90,6 +91,12 @@ struct RenderSettings {
     MediumTransitions mediumTransitions = MediumTransitions::kPriorityStack;
     DepthCounting depthCounting = DepthCounting::kAllVertices;
     ShadingNormals shadingNormals = ShadingNormals::kGeometricGuard;
+    /// Reconstruction filter, sampled per camera path and spread over by light-tracing splats
+    /// (scene/pixel_filter.h). Box for JSON and SmallUPBP scenes; Mitsuba's `rfilter`.
+    PixelFilter pixelFilter;
+    /// Algorithm `unibeam render` uses when -a is not given (empty: pt). Mitsuba's `ptracer`
+    /// integrator sets lt.
+    std::string defaultAlgorithm;
 };
 
 struct ShapeInfo {

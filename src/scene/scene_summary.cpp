@@ -189,7 +189,10 @@ std::string describeScene(const Scene& scene) {
 
     const RenderSettings& st = scene.settings;
     os << "settings: max_path_length " << st.maxPathLength << ", min_path_length "
-       << st.minPathLength << ", seed " << st.seed << "\n";
+       << st.minPathLength << ", seed " << st.seed;
+    if (!st.pixelFilter.isBox()) os << ", pixel filter " << st.pixelFilter.describe();
+    if (!st.defaultAlgorithm.empty()) os << ", default algorithm " << st.defaultAlgorithm;
+    os << "\n";
     return os.str();
 }
 

@@ -1,6 +1,7 @@
 // Texture lookups (conventions: texture.h).
 #include "scene/texture.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
@@ -32,6 +33,40 @@ Rgb bilinear(const Image& img, float u, float v) {
            (img.at(x0, y1) * (1.0f - wx) + img.at(x1, y1) * wx) * wy;
 }
 
+int wrapIndexMode(int i, int n, TextureWrap wrap) {
+    switch (wrap) {
+        case TextureWrap::Repeat:
+            return wrapIndex(i, n);
+        case TextureWrap::Clamp:
+            return i < 0 ? 0 : (i >= n ? n - 1 : i);
+        case TextureWrap::Mirror: {
+            const int m = wrapIndex(i, 2 * n);
+            return m < n ? m : 2 * n - 1 - m;
+        }
+    }
+    return 0;
+}
+
+/// Lookup at unwrapped uv' for any filter and wrap mode. Coordinates are clamped to
+/// +-2^24 texels first (beyond that float has no fraction and int would overflow).
+Rgb lookup(const Image& img, float u, float v, TextureFilter filter, TextureWrap wrap) {
+    const float kLimit = 16777216.0f;
+    const float px = std::clamp(u * float(img.width), -kLimit, kLimit);
+    const float py = std::clamp(v * float(img.height), -kLimit, kLimit);
+    if (filter == TextureFilter::Nearest)
+        return img.at(wrapIndexMode(int(std::floor(px)), img.width, wrap),
+                      wrapIndexMode(int(std::floor(py)), img.height, wrap));
+    const float qx = px - 0.5f, qy = py - 0.5f;
+    const float fx = std::floor(qx), fy = std::floor(qy);
+    const float wx = qx - fx, wy = qy - fy;
+    const int x0 = wrapIndexMode(int(fx), img.width, wrap);
+    const int y0 = wrapIndexMode(int(fy), img.height, wrap);
+    const int x1 = wrapIndexMode(int(fx) + 1, img.width, wrap);
+    const int y1 = wrapIndexMode(int(fy) + 1, img.height, wrap);
+    return (img.at(x0, y0) * (1.0f - wx) + img.at(x1, y0) * wx) * (1.0f - wy) +
+           (img.at(x0, y1) * (1.0f - wx) + img.at(x1, y1) * wx) * wy;
+}
+
 [[noreturn]] void throwTextureError(const Texture& t, const std::string& message) {
     Diagnostic d;
     d.where = "texture '" + t.name + "'";
@@ -59,6 +94,9 @@ Rgb Texture::eval(const Vec2& uvSurface) const {
     if (type == TextureType::Constant) return color0;
     const Vec2 uv = toUv.apply(uvSurface);
     if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return Rgb(0.0f);
+    if (type == TextureType::Bitmap &&
+        (filter != TextureFilter::Bilinear || wrap != TextureWrap::Repeat))
+        return lookup(*image, uv.x, uv.y, filter, wrap);
     const float u = frac(uv.x), v = frac(uv.y);
     if (type == TextureType::Checkerboard) return (u > 0.5f) == (v > 0.5f) ? color0 : color1;
     return bilinear(*image, u, v);

@@ -10,8 +10,9 @@
 //    (two squares per unit). Mitsuba's defaults: colour0 = 0.4, colour1 = 0.2.
 //  * Bitmap: linear RGB pixels, row 0 (the top of the image file) at v' = 0, column 0 at
 //    u' = 0; pixel (x, y) is centred at ((x + 1/2) / W, (y + 1/2) / H). Bilinear
-//    interpolation between the four nearest pixel centres, wrap mode "repeat" (uv' is
-//    taken modulo 1 first). PNG files are sRGB-decoded at load (each texel, before
+//    interpolation between the four nearest pixel centres (or the nearest pixel), wrap mode
+//    "repeat" (uv' taken modulo 1 first), "mirror" or "clamp" (on pixel indices, as
+//    Mitsuba 3's bitmap does). PNG files are sRGB-decoded at load (each texel, before
 //    interpolation, as Mitsuba does for `raw = false`); EXR files are used as stored.
 //    Scene loaders follow Mitsuba's convention for mesh texture coordinates: OBJ files get
 //    v = 1 - t (the file's t = 0 is the bottom row of the image; Mitsuba's
@@ -27,6 +28,13 @@
 #include "core/vec.h"
 
 namespace ub {
+
+/// Bitmap lookups (Mitsuba's `filter_type`): bilinear between the four nearest pixel centres,
+/// or the pixel containing uv'.
+enum class TextureFilter : uint8_t { Bilinear, Nearest };
+/// Bitmap wrap modes (Mitsuba's `wrap_mode`), applied to pixel indices: repeat (index modulo
+/// the size), mirror (period twice the size, the second copy reversed), clamp (to the edge).
+enum class TextureWrap : uint8_t { Repeat, Mirror, Clamp };
 
 enum class TextureType : uint32_t {
     Constant = 0,      ///< color0 everywhere
@@ -59,6 +67,8 @@ struct Texture {
     Rgb color1{0.2f, 0.2f, 0.2f};        ///< Checkerboard's other colour
     UvTransform toUv;                    ///< Checkerboard, Bitmap
     std::shared_ptr<const Image> image;  ///< Bitmap: linear RGB, row 0 at v' = 0
+    TextureFilter filter = TextureFilter::Bilinear;  ///< Bitmap
+    TextureWrap wrap = TextureWrap::Repeat;          ///< Bitmap
 
     /// Value at the surface uv (before toUv). Non-finite uv gives black.
     Rgb eval(const Vec2& uv) const;

@@ -1,9 +1,11 @@
 // Mitsuba <bsdf> plugins -> unibeam materials (docs/mitsuba.md lists the mapping).
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 
 #include "core/image.h"
 #include "scene/io/mitsuba_build.h"
+#include "scene/io/mitsuba_spectra.h"
 #include "scene/texture.h"
 
 namespace ub {
@@ -34,28 +36,36 @@ int buildTexture(MitsubaBuild& b, const XmlObject& t) {
     } else if (t.type == "bitmap") {
         tex.type = TextureType::Bitmap;
         std::string filter = r.getString(t, "filter_type", "bilinear");
-        if (filter != "bilinear")
+        if (filter == "nearest")
+            tex.filter = TextureFilter::Nearest;
+        else if (filter != "bilinear")
             r.error(t.find("filter_type")->pos,
-                    t.label() + ": filter_type '" + filter + "' is not supported (only bilinear)");
+                    t.label() + ": filter_type '" + filter + "' is not one of bilinear, nearest");
         std::string wrap = r.getString(t, "wrap_mode", "repeat");
-        if (wrap != "repeat")
+        if (wrap == "mirror")
+            tex.wrap = TextureWrap::Mirror;
+        else if (wrap == "clamp")
+            tex.wrap = TextureWrap::Clamp;
+        else if (wrap != "repeat")
             r.error(t.find("wrap_mode")->pos,
-                    t.label() + ": wrap_mode '" + wrap + "' is not supported (only repeat)");
+                    t.label() + ": wrap_mode '" + wrap + "' is not one of repeat, mirror, clamp");
         const bool raw = r.getBool(t, "raw", false);
         std::string file = r.getString(t, "filename", "");
         if (file.empty()) {
             r.error(t.pos, t.label() + ": needs <string name=\"filename\">");
         } else if (std::string path = b.resolveFile(t, "filename", file); !path.empty()) {
-            std::string ext = path.size() > 4 ? path.substr(path.size() - 4) : "";
+            std::string ext = std::filesystem::path(path).extension().string();
             for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
             try {
                 if (ext == ".exr")
                     tex.image = std::make_shared<Image>(readExr(path));
                 else if (ext == ".png")
                     tex.image = std::make_shared<Image>(readPng(path, !raw));
+                else if (ext == ".jpg" || ext == ".jpeg")
+                    tex.image = std::make_shared<Image>(readJpeg(path, !raw));
                 else
                     r.error(t.find("filename")->pos,
-                            t.label() + ": '" + file + "' is not a .png or .exr file");
+                            t.label() + ": '" + file + "' is not a .png, .jpg/.jpeg or .exr file");
             } catch (const InputError& e) {
                 for (const Diagnostic& d : e.diagnostics())
                     r.error(t.find("filename")->pos, t.label() + ": " + d.format());
@@ -145,7 +155,10 @@ float readRelativeIor(XmlReader& r, const XmlObject& o) {
     return intIor / extIor;
 }
 
-void readConductorIor(MitsubaBuild& b, const XmlObject& o, Material& m) {
+/// The complex IOR of a conductor: eta and k given, or Mitsuba's `material` preset (default
+/// "none": eta 0, k 1, reflectance 1 at every angle, as Mitsuba's roughconductor has it).
+/// Returns false for "none" without eta/k (a perfect mirror).
+bool readConductorIor(MitsubaBuild& b, const XmlObject& o, Material& m) {
     XmlReader& r = b.r;
     std::string material = r.getString(o, "material", "none");
     if (o.find("eta") || o.find("k")) {
@@ -153,16 +166,18 @@ void readConductorIor(MitsubaBuild& b, const XmlObject& o, Material& m) {
             r.error(o.find("material")->pos, o.label() + ": give either 'material' or eta/k");
         m.eta = r.getColor(o, "eta", Rgb(0.0f), ColorUse::Unbounded);
         m.k = r.getColor(o, "k", Rgb(1.0f), ColorUse::Unbounded);
-        return;
+        return true;
     }
-    if (material != "none") {
-        const XmlProperty* p = o.find("material");
-        r.error(p ? p->pos : o.pos,
-                o.label() + ": named conductor '" + material +
-                    "' is not supported (its complex "
-                    "IOR is spectral data unibeam does not ship); give <rgb name=\"eta\"> "
-                    "and <rgb name=\"k\"> instead");
+    m.eta = Rgb(0.0f);
+    m.k = Rgb(1.0f);
+    if (material == "none") return false;
+    if (!namedConductor(material, &m.eta, &m.k)) {
+        std::string names;
+        for (const std::string& n : namedConductorNames()) names += (names.empty() ? "" : ", ") + n;
+        r.error(o.find("material")->pos, o.label() + ": unknown conductor material '" + material +
+                                             "' (expected none or one of " + names + ")");
     }
+    return true;
 }
 
 }  // namespace
@@ -203,24 +218,23 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
         m.type = MaterialType::Diffuse;
         readReflectance(b, o, "reflectance", Rgb(0.5f), &m.diffuse, &m.textures.diffuse);
     } else if (o.type == "conductor") {
-        readConductorIor(b, o, m);
+        const bool fresnel = readConductorIor(b, o, m);
         m.specular = r.getColor(o, "specular_reflectance", Rgb(1.0f), ColorUse::Reflectance);
-        if (o.find("eta") || o.find("k")) {
-            r.error(o.find("eta") ? o.find("eta")->pos : o.find("k")->pos,
-                    o.label() +
-                        ": a smooth conductor with a Fresnel term (eta/k) is not "
-                        "supported; only material \"none\" (a perfect mirror) is");
+        if (fresnel) {
+            const XmlProperty* p = o.find("material") ? o.find("material")
+                                   : o.find("eta")    ? o.find("eta")
+                                                      : o.find("k");
+            r.error(p->pos, o.label() +
+                                ": a smooth conductor with a Fresnel term (a named material or "
+                                "eta/k) is not supported; only material \"none\" (a perfect "
+                                "mirror) is (use roughconductor for a metal)");
         }
         m.type = MaterialType::Mirror;
     } else if (o.type == "roughconductor") {
         m.type = MaterialType::RoughConductor;
         m.alpha = readMicrofacetAlpha(r, o, &m.distribution);
         m.separableMasking = true;  // Mitsuba's MicrofacetDistribution::G = G1(i) G1(o)
-        if (!o.find("eta") && !o.find("k"))
-            r.error(o.pos, o.label() +
-                               ": needs <rgb name=\"eta\"> and <rgb name=\"k\"> (named "
-                               "materials and 'none' are not supported)");
-        readConductorIor(b, o, m);
+        readConductorIor(b, o, m);  // "none" (the default): eta 0, k 1
         m.specular = r.getColor(o, "specular_reflectance", Rgb(1.0f), ColorUse::Reflectance);
     } else if (o.type == "dielectric") {
         m.type = MaterialType::Dielectric;

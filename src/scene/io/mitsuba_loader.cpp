@@ -8,6 +8,7 @@
 #include "core/image.h"
 #include "scene/io/mitsuba_build.h"
 #include "scene/mesh_io.h"
+#include "scene/serialized_mesh.h"
 #include "scene/shapes.h"
 
 namespace ub {
@@ -16,10 +17,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kShapes = {"obj", "ply", "rectangle", "cube", "sphere"};
+const std::vector<std::string> kShapes = {"obj",       "ply",  "serialized",
+                                          "rectangle", "cube", "sphere"};
 const std::vector<std::string> kEmitters = {"area",        "point",    "spot",
                                             "directional", "constant", "envmap"};
-const std::vector<std::string> kIntegrators = {"path", "volpath", "volpathmis", "moment"};
+const std::vector<std::string> kIntegrators = {"path",   "volpath", "volpathmis",
+                                               "direct", "ptracer", "moment"};
+const std::vector<std::string> kRfilters = {"box", "tent", "gaussian"};
 const std::vector<std::string> kSamplers = {"independent", "stratified", "multijitter",
                                             "orthogonal", "ldsampler"};
 
@@ -75,10 +79,13 @@ void Builder::build() {
             readSensor(o);
         } else if (o.tag == "shape") {
             readShape(o);
+        } else if (o.tag == "emitter" && o.type == "area" && !o.id.empty()) {
+            // A named area emitter: attached to shapes with <ref id="..."/> (read there).
         } else if (o.tag == "emitter") {
             readEmitter(o);
         } else if (o.tag == "bsdf" || o.tag == "medium" || o.tag == "texture" ||
-                   o.tag == "volume" || o.tag == "phase") {
+                   o.tag == "volume" || o.tag == "phase" || o.tag == "sampler" ||
+                   o.tag == "rfilter" || o.tag == "film") {
             if (o.id.empty())
                 r_.error(o.pos, "top-level " + o.label() +
                                     " without an id cannot be used (give "
@@ -89,6 +96,11 @@ void Builder::build() {
             r_.error(o.pos, o.label() + " cannot appear at the top level of a scene");
         }
     }
+    // Mitsuba's ptracer normalises its splats over the whole filter footprint (border pixels
+    // are not renormalised); its image is rendered with that convention whatever -a chooses.
+    if (b_.scene.settings.defaultAlgorithm == "lt")
+        b_.scene.settings.pixelFilter =
+            b_.scene.settings.pixelFilter.withBorder(PixelFilterBorder::kPartitionOfUnity);
     if (!sensor)
         r_.error(XmlPos{b_.xml.file, 0, 0},
                  "the scene has no <sensor> (expected one "
@@ -109,9 +121,30 @@ void Builder::readIntegrator(const XmlObject& top) {
         }
         o = inner[0];
     }
-    if (o->type != "path" && o->type != "volpath" && o->type != "volpathmis") {
+    const bool known = o->type == "path" || o->type == "volpath" || o->type == "volpathmis" ||
+                       o->type == "direct" || o->type == "ptracer";
+    if (!known) {
         r_.unsupportedPlugin(*o, kIntegrators,
                              "choose unibeam's algorithm with `unibeam render -a`");
+        return;
+    }
+    // Parameters of every Mitsuba integrator that only change the work schedule.
+    if (o->find("samples_per_pass")) r_.getInt(*o, "samples_per_pass", 1, 1, 1 << 30);
+    if (o->find("block_size")) r_.getInt(*o, "block_size", 0, 0, 1 << 16);
+    if (r_.getBool(*o, "hide_emitters", false))
+        r_.error(o->find("hide_emitters")->pos,
+                 o->label() + ": hide_emitters = true is not supported");
+    if (o->type == "direct") {
+        // Mitsuba's direct: directly visible emitters plus emitter and BSDF sampling at the
+        // first hit, combined by MIS. That is a path of at most 2 segments (max_depth 2); the
+        // sample counts change the variance only, but a count of 0 drops a strategy (with no
+        // emitter samples point lights vanish, with no BSDF samples light seen in mirrors),
+        // which unibeam's estimators cannot reproduce.
+        const int shading = r_.getInt(*o, "shading_samples", 1, 1, 1 << 20);
+        r_.getInt(*o, "emitter_samples", shading, 1, 1 << 20);
+        r_.getInt(*o, "bsdf_samples", shading, 1, 1 << 20);
+        b_.scene.settings.maxPathLength = 2;
+        r_.checkUnused(*o);
         return;
     }
     // Mitsuba's max_depth counts scattering vertices (null / index-matched interfaces do not
@@ -124,9 +157,9 @@ void Builder::readIntegrator(const XmlObject& top) {
                                                 "-1 or a value >= 1)");
     b_.scene.settings.maxPathLength = maxDepth < 0 ? (1 << 20) : maxDepth;
     r_.getInt(*o, "rr_depth", 5, 1, 1 << 20);  // Russian roulette: variance only
-    if (r_.getBool(*o, "hide_emitters", false))
-        r_.error(o->find("hide_emitters")->pos,
-                 o->label() + ": hide_emitters = true is not supported");
+    // Mitsuba's ptracer traces paths from the emitters and connects them to the sensor:
+    // unibeam's light tracing, the algorithm used when `render` is given no -a.
+    if (o->type == "ptracer") b_.scene.settings.defaultAlgorithm = "lt";
     r_.checkUnused(*o);
 }
 
@@ -150,24 +183,36 @@ void Builder::readFilm(const XmlObject& f, int* w, int* h) {
     if (ff != "openexr" && ff != "exr")
         r_.error(f.find("file_format")->pos, f.label() + ": file_format '" + ff +
                                                  "' is not supported (unibeam writes OpenEXR)");
+    // Reconstruction filter (scene/pixel_filter.h): sampled per camera path, spread over the
+    // footprint by light-tracing splats. No <rfilter> means Mitsuba's default Gaussian.
     const XmlObject* rf = r_.child(f, "rfilter", "");
     if (!rf) {
-        r_.warning(f.pos, f.label() +
-                              ": no <rfilter>: Mitsuba's default Gaussian filter is "
-                              "replaced by unibeam's box filter (one uniform sample per pixel)");
-    } else {
-        if (rf->type != "box")
-            r_.error(rf->pos, "unsupported rfilter plugin '" + rf->type +
-                                  "' (supported: box; unibeam integrates each pixel with a box "
-                                  "filter)");
+        b_.scene.settings.pixelFilter = PixelFilter::gaussian(0.5f);
+    } else if (rf->type == "box") {
+        b_.scene.settings.pixelFilter = PixelFilter::box();
         r_.checkUnused(*rf);
+    } else if (rf->type == "tent") {
+        // Mitsuba's tent: radius default 1 pixel. Radii beyond 64 pixels are refused (each
+        // light-tracing splat is spread over (2 radius + 1)^2 pixels).
+        float radius = r_.getFloatIn(*rf, "radius", 1.0f, 0.0f, 64.0f, true);
+        if (radius > 0.0f) b_.scene.settings.pixelFilter = PixelFilter::tent(radius);
+        r_.checkUnused(*rf);
+    } else if (rf->type == "gaussian") {
+        // Mitsuba's gaussian: stddev default 0.5 pixel, cut off at 4 stddev.
+        float stddev = r_.getFloatIn(*rf, "stddev", 0.5f, 0.0f, 16.0f, true);
+        if (stddev > 0.0f) b_.scene.settings.pixelFilter = PixelFilter::gaussian(stddev);
+        r_.checkUnused(*rf);
+    } else {
+        r_.unsupportedPlugin(*rf, kRfilters,
+                             "mitchell, catmullrom and lanczos have negative lobes, which "
+                             "filter importance sampling cannot reproduce with weight 1");
     }
     r_.checkUnused(f);
 }
 
 void Builder::readSensor(const XmlObject& o) {
-    if (o.type != "perspective") {
-        r_.unsupportedPlugin(o, {"perspective"});
+    if (o.type != "perspective" && o.type != "thinlens") {
+        r_.unsupportedPlugin(o, {"perspective", "thinlens"});
         return;
     }
     int w = 768, h = 576;
@@ -177,10 +222,18 @@ void Builder::readSensor(const XmlObject& o) {
         for (const auto& k : kSamplers) known = known || s->type == k;
         if (!known) r_.unsupportedPlugin(*s, kSamplers);
         // unibeam draws independent uniform samples; the count is chosen on the command line.
-        r_.getInt(*s, "sample_count", 4, 1, 1 << 30);
+        const int count = r_.getInt(*s, "sample_count", 4, 1, 1 << 30);
         r_.getInt(*s, "seed", 0, 0, 1 << 30);
-        r_.getBool(*s, "jitter", true);
+        if (s->type != "independent" && s->type != "ldsampler") r_.getBool(*s, "jitter", true);
+        if (s->type == "orthogonal") r_.getInt(*s, "strength", 2, 1, 1 << 20);
         r_.checkUnused(*s);
+        if (known)
+            r_.warning(s->pos, s->label() +
+                                   ": unibeam uses its own independent sampler; "
+                                   "sample_count " +
+                                   std::to_string(count) +
+                                   " is not used (one sample per pixel per iteration: set "
+                                   "the iterations with `unibeam render -i`)");
     }
     const float aspect = float(w) / float(h);
     float fovX = 0.0f;
@@ -228,6 +281,18 @@ void Builder::readSensor(const XmlObject& o) {
                               ": near_clip/far_clip are not applied (unibeam's camera "
                               "has no clipping planes)");
     }
+    // Thin lens (Mitsuba's thinlens: aperture_radius, required, and focus_distance, the
+    // distance of the plane in focus along the view axis, default far_clip). Mitsuba's
+    // perspective sensor reads focus_distance and ignores it.
+    float lensRadius = 0.0f, focusDistance = 1.0f;
+    if (o.type == "thinlens") {
+        if (!o.find("aperture_radius"))
+            r_.error(o.pos, o.label() + ": needs <float name=\"aperture_radius\">");
+        lensRadius = r_.getFloatIn(o, "aperture_radius", 0.0f, 0.0f, kInf);
+        focusDistance = r_.getFloatIn(o, "focus_distance", 1e4f, 0.0f, kInf, true);
+    } else if (o.find("focus_distance")) {
+        r_.getFloatIn(o, "focus_distance", 1e4f, 0.0f, kInf, true);
+    }
     Transform m = r_.getTransform(o, "to_world");
     r_.checkUnused(o);
     // Camera space: +z forward, +y up, +x to the left of the image (Mitsuba's convention).
@@ -244,7 +309,8 @@ void Builder::readSensor(const XmlObject& o) {
     }
     if (!(fovX > 0.0f)) return;
     float fovY = 2.0f * std::atan(std::tan(0.5f * fovX * kPi / 180.0f) / aspect) * 180.0f / kPi;
-    b_.scene.camera.setup(origin, origin + normalize(fwd), normalize(up), fovY, w, h);
+    b_.scene.camera.setup(origin, origin + normalize(fwd), normalize(up), fovY, w, h, lensRadius,
+                          focusDistance);
     b_.cameraSet = true;
 }
 
@@ -298,17 +364,21 @@ void Builder::readShape(const XmlObject& o) {
     bool isSphere = false;
     Vec3 center;
     float radius = 1.0f;
-    if (o.type == "obj" || o.type == "ply") {
+    if (o.type == "obj" || o.type == "ply" || o.type == "serialized") {
         std::string file = r_.getString(o, "filename", "");
         bool faceNormals = r_.getBool(o, "face_normals", false);
         bool flipTex = o.type == "obj" ? r_.getBool(o, "flip_tex_coords", true) : false;
+        const int shapeIndex =
+            o.type == "serialized" ? r_.getInt(o, "shape_index", 0, 0, (1 << 30)) : 0;
         if (file.empty()) {
             r_.error(o.pos, o.label() + ": needs <string name=\"filename\">");
         } else {
             std::string path = b_.resolveFile(o, "filename", file);
             if (!path.empty()) {
                 Diagnostics meshDiags;
-                mesh = loadMeshFile(path, meshDiags, o.label());
+                mesh = o.type == "serialized"
+                           ? loadSerializedMesh(path, shapeIndex, faceNormals, meshDiags, o.label())
+                           : loadMeshFile(path, meshDiags, o.label());
                 for (const Diagnostic& d : meshDiags.all()) {
                     const XmlProperty* p = o.find("filename");
                     std::string msg = o.label() + ": " + d.format();
@@ -397,7 +467,13 @@ void Builder::readShape(const XmlObject& o) {
     }
     // A null BSDF on an emitter: Mitsuba lets rays pass through it; unibeam's area lights
     // are opaque, so the surface is black (documented in docs/mitsuba.md).
-    if (materialId == -1 && em) materialId = blackMaterial();
+    if (materialId == -1 && em) {
+        r_.warning(o.pos, o.label() + " '" + name +
+                              "': a null BSDF on an emitter makes an opaque black emitting "
+                              "surface (Mitsuba lets rays pass through it; unibeam's area "
+                              "lights are opaque)");
+        materialId = blackMaterial();
+    }
     const bool imaginary = materialId == -1;  // null BSDF + medium: an index-matched boundary
     if (imaginary && em)
         r_.error(em->pos, o.label() + ": a shape with a null BSDF and a medium cannot emit");
@@ -475,7 +551,9 @@ void Builder::readEmitter(const XmlObject& o) {
             }
         }
     } else if (o.type == "area") {
-        r_.error(o.pos, "an 'area' emitter must be nested inside a <shape>");
+        r_.error(o.pos,
+                 "an 'area' emitter must be nested inside a <shape> (or given an id and "
+                 "attached to shapes with <ref id=\"...\"/>)");
         return;
     } else {
         r_.unsupportedPlugin(o, kEmitters);

@@ -5,7 +5,7 @@
 // a wrong type, a missing file or a bad value is an error naming the file, the
 // line and column and the plugin. All problems are collected and thrown as one
 // InputError. Semantics that differ slightly and cannot be represented exactly
-// (e.g. Mitsuba's Gaussian default pixel filter) are warnings.
+// (e.g. Mitsuba's sampler, replaced by unibeam's own) are warnings.
 #pragma once
 
 #include <map>

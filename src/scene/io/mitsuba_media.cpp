@@ -35,6 +35,9 @@ bool readConstant(XmlReader& r, const XmlObject& o, const std::string& name, Rgb
     if (const XmlObject* v = r.child(o, "volume", name)) {
         if (v->type != "constvolume") return false;
         *out = r.getColor(*v, "value", Rgb(1.0f), use);
+        // A constant is the same in every frame: to_world (valid, as Mitsuba requires) changes
+        // nothing.
+        r.getTransform(*v, "to_world");
         r.checkUnused(*v);
         return true;
     }
@@ -151,6 +154,18 @@ bool buildMitsubaMedium(MitsubaBuild& b, const XmlObject& o, Medium* out) {
     const size_t before = r.errorCount();
     const float scale = r.getFloatIn(o, "scale", 1.0f, 0.0f, kInf);
     r.getBool(o, "sample_emitters", true);  // sampling strategy only
+    // A hint that sigma_t is the same in every channel (Mitsuba then samples distances with the
+    // first channel): the same image when it is true of sigma_t, checked below.
+    const XmlProperty* spectralHint = o.find("has_spectral_extinction");
+    const bool spectralExtinction = r.getBool(o, "has_spectral_extinction", true);
+    auto checkGrey = [&](const Rgb& st) {
+        if (!spectralExtinction && !(st.x == st.y && st.y == st.z))
+            r.error(spectralHint->pos, o.label() +
+                                           ": has_spectral_extinction = false with a sigma_t "
+                                           "that differs between channels (Mitsuba would track "
+                                           "the first channel only); give a grey sigma_t or "
+                                           "remove the parameter");
+    };
     const float g = readPhase(r, o);
     Rgb albedo(0.75f);
     const XmlObject* albedoVol = nullptr;  // a gridvolume albedo
@@ -173,6 +188,7 @@ bool buildMitsubaMedium(MitsubaBuild& b, const XmlObject& o, Medium* out) {
             const XmlObject* v = r.child(o, "volume", "sigma_t");
             r.error(v->pos, o.label() + ": sigma_t must be constant in a homogeneous medium");
         }
+        checkGrey(sigmaT);
         r.checkUnused(o);
         if (r.errorCount() != before) return false;
         const Rgb st = sigmaT * scale, ss = albedo * st;
@@ -198,6 +214,7 @@ bool buildMitsubaMedium(MitsubaBuild& b, const XmlObject& o, Medium* out) {
         r.unsupportedPlugin(*vol, {"gridvolume", "constvolume"});
         ok = false;
     }
+    if (!vol && ok) checkGrey(constSigmaT);
     if (albedoVol && !vol && ok &&
         !(constSigmaT.x == constSigmaT.y && constSigmaT.y == constSigmaT.z))
         r.error(albedoVol->pos,

@@ -16,6 +16,13 @@ bool namedIor(const std::string& name, float* ior);
 /// The names namedIor() knows, for error messages.
 std::vector<std::string> namedIorNames();
 
+/// The complex IOR (eta + i k, linear sRGB) of one of Mitsuba 3's named conductor presets
+/// ("Au", "Cu", "Al", "Ag", ..., the files of its ior/ data folder) as its rgb variants use it
+/// (mitsuba_conductors.cpp); false if the name is unknown. "none" is not in the table.
+bool namedConductor(const std::string& name, Rgb* eta, Rgb* k);
+/// The names namedConductor() knows, for error messages.
+std::vector<std::string> namedConductorNames();
+
 /// Linear sRGB of a piecewise-linear spectrum (wavelengths in nm, increasing), integrated
 /// against the CIE 1931 2-degree colour matching functions as Mitsuba's rgb variants do:
 /// reflectance-like spectra (illuminant = false) are weighted by the D65 illuminant and

@@ -294,11 +294,22 @@ void Parser::parseSceneChildren(const FileCtx& f, const pugi::xml_node& sceneNod
             std::string value;
             if (!attr(f, n, "value", &value, true)) continue;
             fs::path p(value);
-            if (p.is_relative()) p = fs::path(f.dir) / p;
             std::error_code ec;
+            if (p.is_relative()) {
+                // As Mitsuba: relative to this file's folder, else through the search path
+                // (an included file's <path> may be relative to the main scene's folder).
+                p = fs::path(f.dir) / p;
+                if (!fs::is_directory(p, ec))
+                    for (const auto& dir : scene_.searchPath)
+                        if (fs::is_directory(fs::path(dir) / value, ec)) {
+                            p = fs::path(dir) / value;
+                            break;
+                        }
+            }
             if (!fs::is_directory(p, ec)) {
                 error(pos(f, n), "<path> '" + value + "' is not a directory (resolved to '" +
-                                     p.lexically_normal().string() + "')");
+                                     p.lexically_normal().string() + "', and not found in " +
+                                     joinList(scene_.searchPath) + ")");
                 continue;
             }
             scene_.searchPath.insert(scene_.searchPath.begin(), p.lexically_normal().string());
