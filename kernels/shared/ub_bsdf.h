@@ -127,13 +127,15 @@ UB_INLINE float ub_bsdf_plastic_specular_prob(UB_PRIVATE const ub_bsdf* b,
     return ps + pd > 0.0f ? ps / (ps + pd) : 0.0f;
 }
 
-/* Multi-lobe: the probabilities of picking the Lambert and the Phong lobe when sampling from
+/* Multi-lobe: the probabilities of picking the Lambert, the Phong and the mirror lobe (the
+ * refraction has the rest) when sampling from
  * a direction on the front with cos cosTheta: albedo estimates lum(Kd), lum(Ks),
  * F lum(mirror) and, with refraction, (1 - F), normalised (SmallUPBP's Bsdf.hxx); F is the
- * Fresnel reflectance of the interface seen from there (1 without refraction). */
-UB_INLINE void ub_bsdf_multilobe_probs(UB_PRIVATE const ub_bsdf* b, float cosTheta,
-                                       UB_PRIVATE float* probDiffuse,
-                                       UB_PRIVATE float* probGlossy) {
+ * Fresnel reflectance of the interface seen from there (1 without refraction). Returns 0 if
+ * no lobe has albedo (every probability 0). */
+UB_INLINE int ub_bsdf_multilobe_probs(UB_PRIVATE const ub_bsdf* b, float cosTheta,
+                                      UB_PRIVATE float* probDiffuse, UB_PRIVATE float* probGlossy,
+                                      UB_PRIVATE float* probReflect) {
     float fresnel = (b->flags & UB_BSDF_REFRACT)
                         ? ub_fresnel_dielectric(ub_fabs(cosTheta), b->etaOther / b->etaFix)
                         : 1.0f;
@@ -144,10 +146,13 @@ UB_INLINE void ub_bsdf_multilobe_probs(UB_PRIVATE const ub_bsdf* b, float cosThe
     if (!(total >= 1e-9f)) {
         *probDiffuse = 0.0f;
         *probGlossy = 0.0f;
-        return;
+        *probReflect = 0.0f;
+        return 0;
     }
     *probDiffuse = d / total;
     *probGlossy = p / total;
+    *probReflect = fresnel * m / total;
+    return 1;
 }
 
 /* Diffuse + Phong, reflection above the surface only. */
@@ -258,8 +263,8 @@ UB_INLINE ub_float3 ub_bsdf_eval_multilobe(UB_PRIVATE const ub_bsdf* b, ub_float
     ub_float3 fix = ub_f3_from(b->localFix);
     ub_float3 f = ub_make_float3(0.0f, 0.0f, 0.0f);
     if (fix.z <= 0.0f || gen.z <= 0.0f) return f;
-    float revDiffuse, revGlossy;
-    ub_bsdf_multilobe_probs(b, gen.z, &revDiffuse, &revGlossy);
+    float revDiffuse, revGlossy, revReflect;
+    ub_bsdf_multilobe_probs(b, gen.z, &revDiffuse, &revGlossy, &revReflect);
     f = ub_f3_scale(ub_f3_from(b->diffuse), UB_INV_PI);
     *directPdfW = b->probDiffuse * ub_lambert_pdf(gen.z);
     *reversePdfW = revDiffuse * ub_lambert_pdf(fix.z);

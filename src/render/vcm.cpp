@@ -189,7 +189,7 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
                                                   options.clCache);
                 beamKernels_ = prepareDeviceMedia(scene, cl_.get(),
                                                   upbp_.pb2d || upbp_.photonBeams(), &deviceMedia_);
-                const bool beamKernels = beamKernels_ || !upbp_.pb2d && !upbp_.photonBeams();
+                const bool beamKernels = beamKernels_ || (!upbp_.pb2d && !upbp_.photonBeams());
                 backendNote_ = "estimate pass on OpenCL device '" + cl_->device().device + "' (" +
                                cl_->device().platform + ")" +
                                (beamKernels ? ""

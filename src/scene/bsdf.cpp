@@ -363,16 +363,11 @@ void Bsdf::setupMultiLobe() {
         fresnelFix_ = 1.0f;  // SmallUPBP: without refraction the mirror has weight 1
     }
     packShared();  // the lobe probabilities come from the shared function
-    ub_bsdf_multilobe_probs(&shared_, localDirFix_.z, &probDiffuse_, &probGlossy_);
-    const float d = luminance(colors_.diffuse), p = luminance(colors_.glossy);
-    const float r = fresnelFix_ * luminance(colors_.specular);
-    const float t = mat.refract ? 1.0f - fresnelFix_ : 0.0f;
-    const float total = d + p + r + t;
-    if (!(total >= 1e-9f)) {
+    if (!ub_bsdf_multilobe_probs(&shared_, localDirFix_.z, &probDiffuse_, &probGlossy_,
+                                 &probReflect_)) {
         black_ = true;
         return;
     }
-    probReflect_ = r / total;
     isDelta_ = probDiffuse_ == 0.0f && probGlossy_ == 0.0f;
     // Russian roulette: a bound that does not depend on dirFix (the MIS partials assume both
     // subpaths through a vertex continue with the same probability): with refraction the
