@@ -3,9 +3,12 @@
  * (src/estimators/bvh.h), and evaluating each pair with the shared per-estimator math
  * (ub_pb2d.h, ub_bp2d.h, ub_bb1d.h) and the medium along the beam: the closed form in
  * homogeneous media (ub_medium_homogeneous.h), regular tracking through the NanoVDB grid
- * in grid media (ub_grid_medium.h; grids[m] describes medium m's grid in gridData). Grid
- * media with an albedo grid or trilinear filtering run these estimators on the host.
- * out: 3 floats per query. */
+ * in grid media (ub_grid_medium.h; grids[m] describes medium m's grid in gridData), read from
+ * tables (ub_beam_table.h): each photon beam's, built by the host (beamPieces from
+ * beamRanges[2 b], beamRanges[2 b + 1] of them; none: walk per pair), and each query beam's,
+ * built by its work-item at its first pair in UB_QUERY_PIECES private pieces (a longer beam
+ * walks per pair). Grid media with an albedo grid or trilinear filtering run these
+ * estimators on the host. out: 3 floats per query. */
 #include "ub_bb1d.h"
 #include "ub_bp2d.h"
 #include "ub_bvh.h"
@@ -14,6 +17,11 @@
 #include "ub_pb2d.h"
 
 #define UB_BVH_STACK 64
+/* Pieces of a query beam's private table: long query beams through the bundled VDB smoke
+ * cross up to ~100 non-empty pieces (docs/performance.md). A build option may change it. */
+#ifndef UB_QUERY_PIECES
+#define UB_QUERY_PIECES 128
+#endif
 
 /* Depth-first walk of the BVH in the host twin's order (src/estimators/bvh.h: the right
  * child is pushed first, so the left one is visited first): for every leaf whose path
@@ -55,12 +63,15 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     if (!m.homogeneous) ub_grid_accessor_init(&acc, gridData, gi);
     ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
     ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+    ub_beam_piece table[UB_QUERY_PIECES];
+    ub_uint tableState = UB_TABLE_UNBUILT;
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     UB_BVH_WALK(nodes, ub_bvh_meets(n, o, invD, qb.length), {
         ub_photon_point ph = photons[prims[k]];
         float t = 0.0f;
         if (!ub_pb2d_pair(ph, qb, radius * radius, minLength, maxLength, &t)) continue;
-        ub_segment_eval s = ub_beam_segment(m, gi, &acc, qb, t);
+        ub_segment_eval s =
+            ub_query_beam_segment(m, gi, &acc, qb, t, table, UB_QUERY_PIECES, &tableState);
         ub_float3 c = ub_pb2d_contribution(mis, ph, qb, s, t, m.g, normalization);
         sx += c.x;
         sy += c.y;
@@ -71,8 +82,10 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
 
 /* bp2d: query points x photon beams (BVH over the diced beam parts). */
 __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_beam_part* parts,
-                               __global const ub_bvh_node* nodes, __global const uint* prims,
-                               __global const ub_grid_info* grids, __global const uchar* gridData,
+                               __global const ub_beam_piece* beamPieces,
+                               __global const uint* beamRanges, __global const ub_bvh_node* nodes,
+                               __global const uint* prims, __global const ub_grid_info* grids,
+                               __global const uchar* gridData,
                                __global const ub_query_point* queries, uint queryCount,
                                __global const ub_medium_info* media, ub_mis_constants mis,
                                float radius, float normalization, uint minLength, uint maxLength,
@@ -91,7 +104,9 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
         ub_beam pb = beams[part.beam];
         float t = 0.0f;
         if (!ub_bp2d_pair(q, pb, part, radius * radius, minLength, maxLength, &t)) continue;
-        ub_segment_eval s = ub_beam_segment(m, gi, &acc, pb, t);
+        ub_segment_eval s =
+            ub_photon_beam_segment(m, gi, &acc, pb, t, beamPieces + beamRanges[2u * part.beam],
+                                   beamRanges[2u * part.beam + 1u]);
         ub_float3 c = ub_bp2d_contribution(mis, pb, q, s, t, m.g, normalization);
         sx += c.x;
         sy += c.y;
@@ -102,12 +117,13 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
 
 /* bb1d: query beams x photon beams (BVH over the diced beam parts). */
 __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_beam_part* parts,
-                               __global const ub_bvh_node* nodes, __global const uint* prims,
-                               __global const ub_grid_info* grids, __global const uchar* gridData,
-                               __global const ub_beam* queries, uint queryCount,
-                               __global const ub_medium_info* media, ub_mis_constants mis,
-                               float radius, float normalization, uint minLength, uint maxLength,
-                               __global float* out) {
+                               __global const ub_beam_piece* beamPieces,
+                               __global const uint* beamRanges, __global const ub_bvh_node* nodes,
+                               __global const uint* prims, __global const ub_grid_info* grids,
+                               __global const uchar* gridData, __global const ub_beam* queries,
+                               uint queryCount, __global const ub_medium_info* media,
+                               ub_mis_constants mis, float radius, float normalization,
+                               uint minLength, uint maxLength, __global float* out) {
     uint i = get_global_id(0);
     if (i >= queryCount) return;
     ub_beam qb = queries[i];
@@ -117,6 +133,8 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
     if (!m.homogeneous) ub_grid_accessor_init(&acc, gridData, gi);
     ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
     ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+    ub_beam_piece table[UB_QUERY_PIECES];
+    ub_uint tableState = UB_TABLE_UNBUILT;
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     UB_BVH_WALK(nodes, ub_bvh_meets(n, o, invD, qb.length), {
         ub_beam_part part = parts[prims[k]];
@@ -124,8 +142,11 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
         float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
         if (!ub_bb1d_pair(qb, pb, part, radius * radius, minLength, maxLength, &tc, &tl, &sinTheta))
             continue;
-        ub_segment_eval sl = ub_beam_segment(m, gi, &acc, pb, tl);
-        ub_segment_eval sc = ub_beam_segment(m, gi, &acc, qb, tc);
+        ub_segment_eval sl =
+            ub_photon_beam_segment(m, gi, &acc, pb, tl, beamPieces + beamRanges[2u * part.beam],
+                                   beamRanges[2u * part.beam + 1u]);
+        ub_segment_eval sc =
+            ub_query_beam_segment(m, gi, &acc, qb, tc, table, UB_QUERY_PIECES, &tableState);
         ub_float3 c =
             ub_bb1d_contribution(mis, pb, qb, sl, sc, tl, tc, sinTheta, m.g, normalization);
         sx += c.x;

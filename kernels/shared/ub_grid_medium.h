@@ -19,6 +19,7 @@
 #ifndef UB_GRID_MEDIUM_H
 #define UB_GRID_MEDIUM_H
 
+#include "ub_beam_table.h"
 #include "ub_medium_homogeneous.h"
 
 #ifdef __OPENCL_C_VERSION__
@@ -56,10 +57,16 @@ typedef struct {
 /* The optical depth of [0, tMax] along o + t d (world space, t in world units) and the
  * extinction of its first and last non-empty pieces (at t = 0 and where the walk ends).
  * tMax = 0: no piece; *sigmaTFirst and *sigmaTLast are then the extinction of the piece a
- * walk starting at o would visit first (over [0, firstLength]). */
-UB_INLINE float ub_grid_optical_depth(ub_grid_info g, UB_PRIVATE ub_grid_accessor* acc, ub_float3 o,
-                                      ub_float3 d, float tMax, float firstLength,
-                                      UB_PRIVATE float* sigmaTFirst, UB_PRIVATE float* sigmaTLast) {
+ * walk starting at o would visit first (over [0, firstLength]).
+ * pieces (cap entries; 0 with cap 0): the walk's pieces as a table (ub_beam_table.h), as far
+ * as they fit; *count: how many pieces the walk visited (more than cap: the table is
+ * incomplete). */
+UB_INLINE float ub_grid_walk(ub_grid_info g, UB_PRIVATE ub_grid_accessor* acc, ub_float3 o,
+                             ub_float3 d, float tMax, float firstLength,
+                             UB_PRIVATE float* sigmaTFirst, UB_PRIVATE float* sigmaTLast,
+                             UB_PRIVATE ub_beam_piece* pieces, ub_uint cap,
+                             UB_PRIVATE ub_uint* count) {
+    *count = 0u;
     const int onlyFirst = !(tMax > 0.0f);
     if (onlyFirst) tMax = firstLength;
     float tau = 0.0f;
@@ -101,6 +108,12 @@ UB_INLINE float ub_grid_optical_depth(ub_grid_info g, UB_PRIVATE ub_grid_accesso
         if (!visited) *sigmaTFirst = (st); \
         *sigmaTLast = (st);                \
         visited = 1;                       \
+        if (*count < cap) {                \
+            pieces[*count].t0 = (ta);      \
+            pieces[*count].sigmaT = (st);  \
+            pieces[*count].tau0 = tau;     \
+        }                                  \
+        *count += 1u;                      \
         tau += (st) * ((tb) - (ta));       \
         if (onlyFirst) return 0.0f;        \
     }
@@ -150,25 +163,23 @@ UB_INLINE float ub_grid_optical_depth(ub_grid_info g, UB_PRIVATE ub_grid_accesso
     return tau;
 }
 
-/* The ub_segment_eval of [0, t] along beam b in grid medium g (as the host's tabulated
- * BeamMedium::eval gives it): T = exp(-tau), sigma_s = albedo sigma_t at the end, the
- * stopping densities sigma_t T at either end, passing T. */
+/* ub_grid_walk without a table. */
+UB_INLINE float ub_grid_optical_depth(ub_grid_info g, UB_PRIVATE ub_grid_accessor* acc, ub_float3 o,
+                                      ub_float3 d, float tMax, float firstLength,
+                                      UB_PRIVATE float* sigmaTFirst, UB_PRIVATE float* sigmaTLast) {
+    ub_uint n = 0u;
+    return ub_grid_walk(g, acc, o, d, tMax, firstLength, sigmaTFirst, sigmaTLast,
+                        (UB_PRIVATE ub_beam_piece*)0, 0u, &n);
+}
+
+/* The ub_segment_eval of [0, t] along beam b in grid medium g by a walk from the beam start
+ * (as the host's tabulated BeamMedium::eval gives it, ub_grey_segment). */
 UB_INLINE ub_segment_eval ub_grid_segment(ub_grid_info g, UB_PRIVATE ub_grid_accessor* acc,
                                           ub_beam b, float t) {
     float sFirst = 0.0f, sLast = 0.0f;
     const float tau = ub_grid_optical_depth(g, acc, ub_f3_from(b.origin), ub_f3_from(b.dir), t,
                                             b.length, &sFirst, &sLast);
-    const float T = ub_exp(-tau);
-    ub_segment_eval e;
-    for (int a = 0; a < 3; ++a) {
-        e.transmittance[a] = T;
-        e.sigmaS[a] = g.albedo[a] * sLast;
-    }
-    e.stopFwdL = sLast * T;
-    e.stopRevStartL = sFirst * T;
-    e.passProb = T;
-    e.contProb = ub_medium_cont_prob(e.sigmaS[0], e.sigmaS[1], e.sigmaS[2], sLast, sLast, sLast);
-    return e;
+    return ub_grey_segment(tau, sFirst, sLast, g.albedo[0], g.albedo[1], g.albedo[2]);
 }
 
 /* The medium along beam b from its piece start to t, whatever kind medium m is: the closed
@@ -176,6 +187,39 @@ UB_INLINE ub_segment_eval ub_grid_segment(ub_grid_info g, UB_PRIVATE ub_grid_acc
 UB_INLINE ub_segment_eval ub_beam_segment(ub_medium_info m, ub_grid_info g,
                                           UB_PRIVATE ub_grid_accessor* acc, ub_beam b, float t) {
     return m.homogeneous ? ub_homogeneous_segment(m, t) : ub_grid_segment(g, acc, b, t);
+}
+
+/* A photon beam's medium at t from its table in a global buffer (count pieces from
+ * `pieces`; count 0: no table, walk), else as ub_beam_segment. */
+UB_INLINE ub_segment_eval ub_photon_beam_segment(ub_medium_info m, ub_grid_info g,
+                                                 UB_PRIVATE ub_grid_accessor* acc, ub_beam b,
+                                                 float t, UB_GLOBAL const ub_beam_piece* pieces,
+                                                 ub_uint count) {
+    if (m.homogeneous || count == 0u) return ub_beam_segment(m, g, acc, b, t);
+    float sFirst = 0.0f, sLast = 0.0f;
+    const float tau = ub_beam_table_tau_g(pieces, count, t, &sFirst, &sLast);
+    return ub_grey_segment(tau, sFirst, sLast, g.albedo[0], g.albedo[1], g.albedo[2]);
+}
+
+/* A query beam's medium at t, its table built in `table` (cap pieces) at the first call:
+ * *state is UB_TABLE_UNBUILT before it, then the table's piece count, or UB_TABLE_OVERFLOW
+ * when the beam has more than cap pieces (then every call walks from the start). */
+UB_INLINE ub_segment_eval ub_query_beam_segment(ub_medium_info m, ub_grid_info g,
+                                                UB_PRIVATE ub_grid_accessor* acc, ub_beam b,
+                                                float t, UB_PRIVATE ub_beam_piece* table,
+                                                ub_uint cap, UB_PRIVATE ub_uint* state) {
+    if (m.homogeneous) return ub_homogeneous_segment(m, t);
+    if (*state == UB_TABLE_UNBUILT) {
+        float sFirst = 0.0f, sLast = 0.0f;
+        ub_uint n = 0u;
+        ub_grid_walk(g, acc, ub_f3_from(b.origin), ub_f3_from(b.dir), b.length, b.length, &sFirst,
+                     &sLast, table, cap, &n);
+        *state = n <= cap ? n : UB_TABLE_OVERFLOW;
+    }
+    if (*state == UB_TABLE_OVERFLOW || *state == 0u) return ub_grid_segment(g, acc, b, t);
+    float sFirst = 0.0f, sLast = 0.0f;
+    const float tau = ub_beam_table_tau_p(table, *state, t, &sFirst, &sLast);
+    return ub_grey_segment(tau, sFirst, sLast, g.albedo[0], g.albedo[1], g.albedo[2]);
 }
 
 #ifdef __OPENCL_C_VERSION__

@@ -611,25 +611,29 @@ void ClRuntime::estimatePB2D(const std::vector<ub_photon_point>& photons, const 
 }
 
 void ClRuntime::estimateBP2D(const std::vector<ub_beam>& beams,
-                             const std::vector<ub_beam_part>& parts, const Bvh& bvh,
+                             const std::vector<ub_beam_part>& parts,
+                             const std::vector<ub_beam_piece>& pieces,
+                             const std::vector<uint32_t>& ranges, const Bvh& bvh,
                              const std::vector<ub_query_point>& queries, const EstimateArgs& a,
                              std::vector<Rgb>* out) {
     if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
     runEstimate(bp2d_, "clEnqueueNDRangeKernel(ub_bp2d_estimate)",
-                withGrids({bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()),
-                           bufferArg(bvh.prims())},
+                withGrids({bufferArg(beams), bufferArg(parts), bufferArg(pieces), bufferArg(ranges),
+                           bufferArg(bvh.nodes()), bufferArg(bvh.prims())},
                           gridArgs(a)),
                 bufferArg(queries), queries.size(), a, out);
 }
 
 void ClRuntime::estimateBB1D(const std::vector<ub_beam>& beams,
-                             const std::vector<ub_beam_part>& parts, const Bvh& bvh,
+                             const std::vector<ub_beam_part>& parts,
+                             const std::vector<ub_beam_piece>& pieces,
+                             const std::vector<uint32_t>& ranges, const Bvh& bvh,
                              const std::vector<ub_beam>& queries, const EstimateArgs& a,
                              std::vector<Rgb>* out) {
     if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
     runEstimate(bb1d_, "clEnqueueNDRangeKernel(ub_bb1d_estimate)",
-                withGrids({bufferArg(beams), bufferArg(parts), bufferArg(bvh.nodes()),
-                           bufferArg(bvh.prims())},
+                withGrids({bufferArg(beams), bufferArg(parts), bufferArg(pieces), bufferArg(ranges),
+                           bufferArg(bvh.nodes()), bufferArg(bvh.prims())},
                           gridArgs(a)),
                 bufferArg(queries), queries.size(), a, out);
 }

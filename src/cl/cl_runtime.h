@@ -98,10 +98,15 @@ class ClRuntime {
     void estimatePB2D(const std::vector<ub_photon_point>& photons, const Bvh& spheres,
                       const std::vector<ub_beam>& queries, const EstimateArgs& a,
                       std::vector<Rgb>* out);
+    /// bp2d and bb1d: pieces and ranges are the photon beams' medium tables
+    /// (estimators/beam_medium.h flattenBeamTables; 2 ranges per beam, all 0 in homogeneous
+    /// media).
     void estimateBP2D(const std::vector<ub_beam>& beams, const std::vector<ub_beam_part>& parts,
+                      const std::vector<ub_beam_piece>& pieces, const std::vector<uint32_t>& ranges,
                       const Bvh& bvh, const std::vector<ub_query_point>& queries,
                       const EstimateArgs& a, std::vector<Rgb>* out);
     void estimateBB1D(const std::vector<ub_beam>& beams, const std::vector<ub_beam_part>& parts,
+                      const std::vector<ub_beam_piece>& pieces, const std::vector<uint32_t>& ranges,
                       const Bvh& bvh, const std::vector<ub_beam>& queries, const EstimateArgs& a,
                       std::vector<Rgb>* out);
     /// Surface merging (kernels/surf.cl) over surface photons and surface queries; tables:

@@ -51,14 +51,21 @@ ub_medium_info mediumInfo(const Medium& m) {
 
 void BeamMedium::build() {
     built_ = true;
-    if (!tabulated_) return;
-    const Vec3 o(beam_->origin[0], beam_->origin[1], beam_->origin[2]);
-    const Vec3 d(beam_->dir[0], beam_->dir[1], beam_->dir[2]);
-    float tau = 0.0f;
-    gridPieces(*medium_, o, d, beam_->length, [&](float ta, float tb, float sigmaT) {
-        pieces_.push_back({ta, sigmaT, tau});
-        tau += sigmaT * (tb - ta);
-    });
+    if (!tabulated_ || !(beam_->length > 0.0f)) return;
+    const ub_grid_info g = gridInfo(*medium_, 0);
+    ub_grid_accessor acc{medium_->grid->grid().getAccessor()};
+    const ub_float3 o = ub_f3_from(beam_->origin), d = ub_f3_from(beam_->dir);
+    // The walk fills what fits and counts the rest: one more walk when 64 were too few.
+    pieces_.resize(64);
+    for (;;) {
+        float sFirst = 0.0f, sLast = 0.0f;
+        ub_uint n = 0;
+        ub_grid_walk(g, &acc, o, d, beam_->length, beam_->length, &sFirst, &sLast, pieces_.data(),
+                     ub_uint(pieces_.size()), &n);
+        const bool fits = n <= pieces_.size();
+        pieces_.resize(n);
+        if (fits) break;
+    }
 }
 
 ub_segment_eval BeamMedium::eval(float t) const {
@@ -79,29 +86,24 @@ ub_segment_eval BeamMedium::eval(float t) const {
                                          s.sigmaT1[1], s.sigmaT1[2]);
         return e;
     }
-    // The piece holding t: the last one starting at or before t (a t on a piece boundary
-    // belongs to the piece it starts, as in the walk, whose last piece ends at t).
-    auto it = std::upper_bound(pieces_.begin(), pieces_.end(), t,
-                               [](float x, const Piece& p) { return x < p.t0; });
-    const Piece& p = it == pieces_.begin() ? pieces_.front() : *(it - 1);
-    // The walk to t ends in the piece before a boundary at exactly t.
-    const Piece& last =
-        (it != pieces_.begin() && p.t0 == t && it - 1 != pieces_.begin()) ? *(it - 2) : p;
-    const float tau = last.tau0 + last.sigmaT * (t - last.t0);
-    const float T = std::exp(-tau);
-    const float sigmaT0 = pieces_.front().sigmaT, sigmaT1 = last.sigmaT;
+    float sFirst = 0.0f, sLast = 0.0f;
+    const float tau =
+        ub_beam_table_tau_g(pieces_.data(), ub_uint(pieces_.size()), t, &sFirst, &sLast);
+    // The albedo at the point: constant, or from the medium's albedo grid.
     const Rgb albedo = mediumAlbedoAt(*medium_, o + d * t);
-    ub_segment_eval e;
-    for (int a = 0; a < 3; ++a) {
-        e.transmittance[a] = T;
-        e.sigmaS[a] = albedo[a] * sigmaT1;
+    return ub_grey_segment(tau, sFirst, sLast, albedo[0], albedo[1], albedo[2]);
+}
+
+void flattenBeamTables(const std::vector<BeamMedium>& media, std::vector<ub_beam_piece>* pieces,
+                       std::vector<uint32_t>* ranges) {
+    pieces->clear();
+    ranges->assign(2 * media.size(), 0u);
+    for (size_t b = 0; b < media.size(); ++b) {
+        const std::vector<ub_beam_piece>& p = media[b].pieces();
+        (*ranges)[2 * b] = uint32_t(pieces->size());
+        (*ranges)[2 * b + 1] = uint32_t(p.size());
+        pieces->insert(pieces->end(), p.begin(), p.end());
     }
-    e.stopFwdL = sigmaT1 * T;
-    e.stopRevStartL = sigmaT0 * T;
-    e.passProb = T;
-    e.contProb =
-        ub_medium_cont_prob(e.sigmaS[0], e.sigmaS[1], e.sigmaS[2], sigmaT1, sigmaT1, sigmaT1);
-    return e;
 }
 
 }  // namespace ub

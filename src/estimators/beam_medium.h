@@ -3,16 +3,18 @@
 //
 // In a grid medium (nearest filtering) the extinction is constant on the pieces
 // regular tracking visits, so the optical depth along the beam is piecewise
-// linear in t: one walk over the whole beam gives a table of pieces (start t,
-// extinction, optical depth at the start), and every later evaluation is a
-// binary search plus an exponential -- the same values as a walk from the beam
-// start to t (scene/medium.h evalMediumSegment), up to the rounding of the sum,
-// at O(log pieces) instead of O(voxels). Homogeneous media use their closed form,
-// trilinear grids evalMediumSegment itself.
+// linear in t: one walk over the whole beam (the kernels' DDA, ub_grid_walk)
+// gives a table of pieces (kernels/shared/ub_beam_table.h), and every later
+// evaluation is a binary search plus an exponential -- the same values as a walk
+// from the beam start to t (scene/medium.h evalMediumSegment), up to the rounding
+// of the sum, at O(log pieces) instead of O(voxels). The beam kernels read the
+// photon beams' tables (flattenBeamTables) and build the query beams' own.
+// Homogeneous media use their closed form, trilinear grids evalMediumSegment.
 #pragma once
 
 #include <vector>
 
+#include "kernels/shared/ub_beam_table.h"
 #include "kernels/shared/ub_medium_homogeneous.h"
 #include "kernels/shared/ub_upbp_records.h"
 
@@ -30,18 +32,22 @@ class BeamMedium {
     bool built() const { return built_; }
     /// The medium from the beam's piece start to distance t in [0, b.length] (after build()).
     ub_segment_eval eval(float t) const;
-    size_t bytes() const { return pieces_.capacity() * sizeof(Piece); }
+    size_t bytes() const { return pieces_.capacity() * sizeof(ub_beam_piece); }
+    /// The table (empty: homogeneous or trilinear medium, or a beam of no length).
+    const std::vector<ub_beam_piece>& pieces() const { return pieces_; }
 
   private:
-    struct Piece {
-        float t0, sigmaT, tau0;
-    };
     const Medium* medium_ = nullptr;
     const ub_beam* beam_ = nullptr;
     bool tabulated_ = false, built_ = false;
-    std::vector<Piece> pieces_;
+    std::vector<ub_beam_piece> pieces_;
     ub_medium_info info_{};  ///< homogeneous media: the closed form of the kernels
 };
+
+/// The photon beams' tables for the beam kernels: the pieces of beam b are
+/// pieces[ranges[2 b]], ... (ranges[2 b + 1] of them; 0: none, the kernel walks).
+void flattenBeamTables(const std::vector<BeamMedium>& media, std::vector<ub_beam_piece>* pieces,
+                       std::vector<uint32_t>* ranges);
 
 /// What the kernels know of a medium (kernels/shared/ub_medium_homogeneous.h).
 ub_medium_info mediumInfo(const Medium& m);

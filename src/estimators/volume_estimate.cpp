@@ -121,7 +121,14 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         photonMedia[i].reset(*in.scene, beams[i]);
         photonMedia[i].build();
     });
-    size_t mediaBytes = photonMedia.size() * sizeof(BeamMedium);
+    // The beam kernels read the tables flattened (empty in homogeneous media).
+    std::vector<ub_beam_piece> beamPieces;
+    std::vector<uint32_t> beamRanges;
+    if (in.beamKernels && in.cl && (t.bp2d || t.bb1d))
+        flattenBeamTables(photonMedia, &beamPieces, &beamRanges);
+    size_t mediaBytes = photonMedia.size() * sizeof(BeamMedium) +
+                        beamPieces.size() * sizeof(ub_beam_piece) +
+                        beamRanges.size() * sizeof(uint32_t);
     for (const BeamMedium& m : photonMedia) mediaBytes += m.bytes();
     // Tabulated after the walk (its size is known only then): at most this one structure
     // goes over the budget before the render stops.
@@ -164,7 +171,7 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         perPoint[UB_TECH_BP2D].assign(nPoints, Rgb(0.0f));
         const float r = in.radius[UB_TECH_BP2D];
         if (beamCl) {
-            beamCl->estimateBP2D(beams, parts, beamBvh, *in.queryPoints,
+            beamCl->estimateBP2D(beams, parts, beamPieces, beamRanges, beamBvh, *in.queryPoints,
                                  clArgs(UB_TECH_BP2D, ub_bp2d_normalization(in.beamPathCount, r)),
                                  &perPoint[UB_TECH_BP2D]);
             st.pairs[UB_TECH_BP2D] = VolumeEstimateStats::kNotCounted;
@@ -189,7 +196,7 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         perBeam[UB_TECH_BB1D].assign(nBeams, Rgb(0.0f));
         const float r = in.radius[UB_TECH_BB1D];
         if (beamCl) {
-            beamCl->estimateBB1D(beams, parts, beamBvh, *in.queryBeams,
+            beamCl->estimateBB1D(beams, parts, beamPieces, beamRanges, beamBvh, *in.queryBeams,
                                  clArgs(UB_TECH_BB1D, ub_bb1d_normalization(in.beamPathCount, r)),
                                  &perBeam[UB_TECH_BB1D]);
             st.pairs[UB_TECH_BB1D] = VolumeEstimateStats::kNotCounted;

@@ -28,6 +28,8 @@ const char* materialTypeName(MaterialType t) {
             return "rough_plastic";
         case MaterialType::ThinDielectric:
             return "thin_dielectric";
+        case MaterialType::MultiLobe:
+            return "multi_lobe";
     }
     return "unknown";
 }
