@@ -38,8 +38,6 @@ ub_require(tinyobjloader_FOUND "tinyobjloader (OBJ meshes)" libtinyobjloader-dev
 find_package(pugixml CONFIG QUIET)
 ub_require(pugixml_FOUND "pugixml (Mitsuba XML scenes)" libpugixml-dev)
 
-find_package(assimp CONFIG QUIET)
-ub_require(assimp_FOUND "Assimp (PLY meshes)" libassimp-dev)
 
 find_package(OpenCL QUIET)
 ub_require(OpenCL_FOUND "OpenCL ICD loader and headers" "ocl-icd-opencl-dev opencl-headers")

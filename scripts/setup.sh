@@ -10,7 +10,7 @@ PACKAGES=(
   libembree-dev libtbb-dev libopenexr-dev libpng-dev zlib1g-dev libjpeg62-turbo-dev
   libopenvdb-dev libnanovdb-dev libboost-iostreams-dev
   ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd clinfo
-  nlohmann-json3-dev libcli11-dev libtinyobjloader-dev libassimp-dev libpugixml-dev
+  nlohmann-json3-dev libcli11-dev libtinyobjloader-dev libpugixml-dev
   libgtest-dev libgmock-dev libbenchmark-dev clang-format
   python3-matplotlib chromium
 )

@@ -741,7 +741,7 @@ const std::vector<Case> kCases = {
       {"m.ply", "@data:meshes/bad_index.ply"}},
      "s.json",
      {},
-     "m.ply: error: at /shapes/0: vertex index 17 out of range (mesh has 3 vertices)"},
+     "m.ply:13:7: error: at /shapes/0: vertex index 17 out of range (mesh has 3 vertices)"},
     {"ply_garbage",
      {{"s.json", "{\n"
             "\"camera\": {\"position\": [0, 0, 5], \"target\": [0, 0, 0], \"up\": [0, 1, 0], \"fov\": 40, \"resolution\": [8, 8]},\n"
@@ -754,7 +754,7 @@ const std::vector<Case> kCases = {
       {"m.ply", "@data:meshes/garbage.ply"}},
      "s.json",
      {},
-     "m.ply: error: at /shapes/0: cannot read PLY file: Invalid .ply file: Incorrect magic number (expected 'ply' or 'PLY')."},
+     "m.ply:1: error: at /shapes/0: not a PLY file: the first line is 'this is not a ply fi' (expected 'ply')"},
     {"ply_huge_count",
      {{"s.json", "{\n"
             "\"camera\": {\"position\": [0, 0, 5], \"target\": [0, 0, 0], \"up\": [0, 1, 0], \"fov\": 40, \"resolution\": [8, 8]},\n"
@@ -780,7 +780,7 @@ const std::vector<Case> kCases = {
       {"m.ply", "@data:meshes/truncated_binary.ply"}},
      "s.json",
      {},
-     "m.ply: error: at /shapes/0: vertex index 168430083 out of range (mesh has 4 vertices)"},
+     "m.ply: error: at /shapes/0: PLY list 'vertex_indices' of 'face' element 2 has 3 entries, more than the rest of the file holds (at byte offset"},
     {"serialized_bad_magic",
      {{"s.xml", "<scene version=\"3.0.0\">\n"
             "    <sensor type=\"perspective\">\n"

@@ -1,4 +1,4 @@
-// Mesh file loading: OBJ (tinyobjloader) and PLY (Assimp), and every error the
+// Mesh file loading: OBJ (tinyobjloader) and PLY (scene/ply_reader.h), and every error the
 // loader reports, with its message text.
 #include "scene/mesh_io.h"
 
@@ -225,12 +225,135 @@ TEST(MeshIo, ErrorPlyNoTriangles) {
 
 TEST(MeshIo, ErrorPlyGarbageAndTruncated) {
     Diagnostic d = loadError(meshPath("garbage.ply"));
-    EXPECT_TRUE(contains(d.message, "cannot read PLY file: ")) << d.message;
-    EXPECT_TRUE(contains(d.message, "magic number")) << d.message;  // Assimp's reason
-    // Assimp does not notice the missing bytes itself; the garbage it reads for the
-    // last face is caught by the index check.
+    EXPECT_EQ(d.line, 1);
+    EXPECT_EQ(d.message,
+              "not a PLY file: the first line is 'this is not a ply fi' (expected 'ply')");
+    // The last face's list announces 3 indices where fewer bytes are left.
     d = loadError(meshPath("truncated_binary.ply"));
-    EXPECT_TRUE(contains(d.message, "out of range (mesh has 4 vertices)")) << d.message;
+    EXPECT_TRUE(contains(d.message, "PLY list 'vertex_indices' of 'face' element ")) << d.message;
+    EXPECT_TRUE(contains(d.message, "more than the rest of the file holds (at byte offset "))
+        << d.message;
+}
+
+namespace {
+
+/// Writes `text` (binary) as a temporary .ply file and returns its path.
+std::string tempPly(const std::string& name, const std::string& text) {
+    const std::string path = testing::TempDir() + "ub_mesh_io_" + name + ".ply";
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+    return path;
+}
+
+const char* kTriangleHeader =
+    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+    "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+
+}  // namespace
+
+// The same tetrahedron in big-endian binary, with double positions, an extra per-vertex
+// property, an element the reader skips (edges, with a list), and a face as one quad plus
+// one triangle: what the reader must read and what it must step over.
+TEST(MeshIo, PlyBigEndianDoublesExtraElementsAndPolygons) {
+    std::string body;
+    auto be = [&](const void* p, int n) {
+        const unsigned char* b = static_cast<const unsigned char*>(p);
+        for (int i = n - 1; i >= 0; --i) body.push_back(char(b[i]));
+    };
+    const double pos[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    for (const auto& p : pos) {
+        for (double c : p) be(&c, 8);
+        const unsigned short quality = 7;
+        be(&quality, 2);
+    }
+    // element edge 1: list uchar int, then a uchar
+    body.push_back(char(2));
+    for (int v : {0, 1}) be(&v, 4);
+    body.push_back(char(9));
+    // element face 2: the quad as one face, then a degenerate 2-vertex "face" (a line)
+    body.push_back(char(4));
+    for (int v : {0, 1, 2, 3}) be(&v, 4);
+    body.push_back(char(2));
+    for (int v : {0, 2}) be(&v, 4);
+    const std::string path =
+        tempPly("bigendian",
+                "ply\nformat binary_big_endian 1.0\nelement vertex 4\nproperty double x\n"
+                "property double y\nproperty double z\nproperty ushort quality\n"
+                "element edge 1\nproperty list uchar int vertex_indices\nproperty uchar "
+                "flags\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n" +
+                    body);
+    Diagnostics diags;
+    TriangleMesh m = loadMeshFile(path, diags, "/shapes/0");
+    ASSERT_FALSE(diags.hasErrors()) << diags.all()[0].format();
+    ASSERT_EQ(m.positions.size(), 4u);
+    ASSERT_EQ(m.triangleCount(), 2u);  // the quad as a fan
+    EXPECT_NEAR(meshArea(m), 1.0f, 1e-6f);
+    EXPECT_EQ(m.positions[2].x, 1.0f);
+    EXPECT_EQ(m.positions[2].y, 1.0f);
+    ASSERT_EQ(diags.warnings().size(), 1u);
+    EXPECT_EQ(diags.warnings()[0].message, "ignored 1 point and line primitives");
+}
+
+// Values that are no number of their type, list counts out of their type's range or beyond
+// what the file holds, negative indices, a missing coordinate: each an error with its line
+// and column (ASCII), never an allocation of what a count announces.
+TEST(MeshIo, ErrorPlyBadValuesAndCounts) {
+    const std::string vertices = "0 0 0\n1 0 0\n0 1 0\n";
+    struct Case {
+        std::string name, text, message;
+        int line, column;
+    };
+    const std::vector<Case> cases = {
+        {"letter", std::string(kTriangleHeader) + "0 0 0\n1 x 0\n0 1 0\n3 0 1 2\n",
+         "PLY value 'x' of property 'y' of 'vertex' element 1 (expected a float number)", 11, 3},
+        {"count300", std::string(kTriangleHeader) + vertices + "300 0 1 2\n",
+         "PLY list count '300' of property 'vertex_indices' of 'face' element 0 (expected a "
+         "uchar integer in its range)",
+         13, 1},
+        {"countdigits", std::string(kTriangleHeader) + vertices + "41015555555555555555 0 1 2\n",
+         "PLY list count '41015555555555555555' of property 'vertex_indices' of 'face' element 0 "
+         "(expected a uchar integer in its range)",
+         13, 1},
+        {"negative", std::string(kTriangleHeader) + vertices + "3 0 -1 2\n",
+         "vertex index -1 out of range (mesh has 3 vertices)", 13, 5},
+        {"fraction", std::string(kTriangleHeader) + vertices + "3 0 1.5 2\n",
+         "PLY list entry '1.5' of property 'vertex_indices' of 'face' element 0 (expected a int "
+         "integer in its range)",
+         13, 5},
+        {"noz",
+         "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+         "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0\n1 0\n0 "
+         "1\n3 0 1 2\n",
+         "PLY element 'vertex' has no 'z' property (expected float properties x, y and z)", 3, 0},
+        {"noformat", "ply\nelement vertex 0\nproperty float x\nend_header\n",
+         "PLY header has no 'format' line (expected 'format ascii 1.0' or a binary format)", 2, 0},
+        {"propfirst", "ply\nformat ascii 1.0\nproperty float x\nend_header\n",
+         "PLY property 'x' before any element line", 3, 0},
+    };
+    for (const Case& c : cases) {
+        Diagnostic d = loadError(tempPly(c.name, c.text));
+        EXPECT_EQ(d.message, c.message) << c.name;
+        EXPECT_EQ(d.line, c.line) << c.name;
+        EXPECT_EQ(d.column, c.column) << c.name;
+    }
+    // A uint count of 4e9 in a binary file of a few bytes: refused before any allocation.
+    std::string body(36, '\0');
+    body += std::string("\x00\x28\x6b\xee", 4);  // 4,000,000,000 (little endian) entries
+    Diagnostic d = loadError(
+        tempPly("hugelist",
+                "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+                "property float y\nproperty float z\nelement face 1\nproperty list uint "
+                "int vertex_indices\nend_header\n" +
+                    body));
+    EXPECT_EQ(d.message,
+              "PLY list 'vertex_indices' of 'face' element 0 has 4000000000 entries, more than the "
+              "rest of the file holds (at byte offset 204; truncated or corrupt file?)");
+    // A last value without a newline after it is still a value.
+    Diagnostics diags;
+    TriangleMesh m = loadMeshFile(
+        tempPly("nonewline", std::string(kTriangleHeader) + vertices + "3 0 1 2"), diags, "");
+    EXPECT_FALSE(diags.hasErrors()) << diags.all()[0].format();
+    EXPECT_EQ(m.triangleCount(), 1u);
 }
 
 // CRLF line endings, groups, smoothing groups and material statements: materials
@@ -244,9 +367,8 @@ TEST(MeshIo, ObjWithCrlfAndMaterialStatements) {
     EXPECT_TRUE(diags.all().empty()) << diags.all()[0].format();
 }
 
-// Assimp reserves memory for every element a PLY header announces before reading any: a header
-// claiming 4e9 vertices ended in std::bad_alloc (or the OOM killer). Counts are checked against
-// the bytes the file has first; a negative count is not a count.
+// A header claiming 4e9 vertices must not end in std::bad_alloc (or the OOM killer): counts
+// are checked against the bytes the file has first; a negative count is not a count.
 TEST(MeshIo, ErrorPlyCountsTheFileCannotHold) {
     Diagnostic d = loadError(meshPath("huge_count.ply"));
     EXPECT_EQ(d.line, 4);

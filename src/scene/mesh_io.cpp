@@ -1,21 +1,18 @@
-// Mesh files: OBJ through tinyobjloader, PLY (ASCII and binary) through Assimp.
+// Mesh files: OBJ through tinyobjloader, PLY (ASCII and binary) through unibeam's own
+// reader (scene/ply_reader.h, which says why).
 //
 // tinyobjloader reads unparsable numbers as 0 and accepts out-of-range face
 // indices in triangles, so OBJ files get a light validation pass first that
 // reports such problems with their line and column; only a valid file is handed
 // to tinyobjloader. OBJ has one index per attribute (v/vt/vn); the result has one
 // vertex per distinct (v, vt, vn) combination used by a face. Normals and uvs are
-// kept only if every face corner has them. Assimp reports PLY errors without
-// positions; its output is checked for non-finite positions and bad indices here.
+// kept only if every face corner has them.
 // Vertex numbers in messages are the file's own: 1-based for OBJ, 0-based for PLY.
 #include "scene/mesh_io.h"
 
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
-#include <assimp/Importer.hpp>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -27,6 +24,8 @@
 #include <regex>
 #include <sstream>
 #include <unordered_map>
+
+#include "scene/ply_reader.h"
 
 namespace ub {
 
@@ -317,254 +316,13 @@ bool loadObj(const std::string& path, const std::string& text, Reporter& rep, Tr
 
 // ---- PLY ----------------------------------------------------------------------
 
-/// Checks the element counts of a PLY header against the file size before Assimp sees the
-/// file: Assimp reserves memory for every announced element first, so a corrupt or hostile
-/// count (`element vertex 4000000000`) would end in an allocation failure rather than a
-/// message. Each element needs at least its scalar properties' bytes (binary; a list at least
-/// its count) or two characters per property (ASCII: a digit and a separator). Anything else
-/// in the header is left to Assimp. Returns false (with an error) on a count the file cannot
-/// hold.
-bool checkPlyCounts(const std::string& path, Reporter& rep) {
-    std::ifstream in(path, std::ios::binary);
-    std::error_code ec;
-    const uintmax_t fileBytes = std::filesystem::file_size(path, ec);
-    if (!in || ec) return true;  // Assimp reports unreadable files
-    auto scalarBytes = [](const std::string& t) -> int {
-        if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
-        if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-        if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" ||
-            t == "float32")
-            return 4;
-        if (t == "double" || t == "float64") return 8;
-        return 0;
-    };
-    struct Element {
-        std::string name;
-        unsigned long long count = 0;
-        int line = 0;
-        uintmax_t minBytes = 0;  // per element
-    };
-    std::vector<Element> elements;
-    bool ascii = false;
-    std::string line;
-    int lineNo = 0;
-    uintmax_t headerBytes = 0;
-    bool ended = false;
-    while (lineNo < 10000 && std::getline(in, line)) {
-        ++lineNo;
-        headerBytes += line.size() + 1;
-        // Control characters other than tab (and a final CR): the stream reads \v or \f as a
-        // separator, Assimp does not, and it then looks for end_header for ever (found by
-        // fuzz_mesh_ply: "end_header\v0 0 0 ..." hung).
-        // (Not on the first line: Assimp reports a file without the magic itself.)
-        for (size_t i = 0; lineNo > 1 && i < line.size(); ++i) {
-            const unsigned char c = static_cast<unsigned char>(line[i]);
-            if (c < 0x20 && c != '\t' && !(c == '\r' && i + 1 == line.size())) {
-                char hex[8];
-                std::snprintf(hex, sizeof(hex), "0x%02x", unsigned(c));
-                rep.error(std::string("PLY header line has control character ") + hex +
-                              " at column " + std::to_string(i + 1) +
-                              " (expected header lines of printable text, words separated by "
-                              "spaces)",
-                          lineNo, int(i) + 1);
-                return false;
-            }
-        }
-        std::istringstream ls(line);
-        std::string kw;
-        ls >> kw;
-        if (kw == "end_header") {
-            ended = true;
-            break;
-        }
-        // Every header line must be one of PLY's: Assimp 5.2 crashes on some it cannot read
-        // (found by fuzz_mesh_ply: "format binary_comment" and a "propert|" line, SEGV).
-        if (kw == "format") {
-            std::string f;
-            ls >> f;
-            ascii = f == "ascii";
-            if (f != "ascii" && f != "binary_little_endian" && f != "binary_big_endian") {
-                rep.error("PLY format '" + f +
-                              "' (expected ascii, binary_little_endian or binary_big_endian)",
-                          lineNo);
-                return false;
-            }
-        } else if (lineNo > 1 && !kw.empty() && kw != "element" && kw != "property" &&
-                   kw != "comment" && kw != "obj_info") {
-            rep.error("unknown PLY header line '" + line.substr(0, 40) +
-                          "' (expected format, element, property, comment, obj_info or "
-                          "end_header)",
-                      lineNo);
-            return false;
-        }
-        if (kw == "element") {
-            Element e;
-            std::string count;
-            ls >> e.name >> count;
-            e.line = lineNo;
-            const bool digits = !count.empty() && count.size() <= 19 &&
-                                count.find_first_not_of("0123456789") == std::string::npos;
-            if (!digits) {
-                rep.error("PLY element '" + e.name + "' has count '" + count +
-                              "' (expected a non-negative integer)",
-                          lineNo);
-                return false;
-            }
-            e.count = std::stoull(count);
-            elements.push_back(e);
-        } else if (kw == "property" && !elements.empty()) {
-            std::string type;
-            ls >> type;
-            {
-                std::istringstream check(line);
-                std::string k, t1, t2, t3, name;
-                check >> k >> t1;
-                const bool ok = t1 == "list" ? bool(check >> t2 >> t3 >> name) &&
-                                                   scalarBytes(t2) > 0 && scalarBytes(t3) > 0
-                                             : scalarBytes(t1) > 0 && bool(check >> name);
-                if (!ok) {
-                    rep.error("PLY property line '" + line.substr(0, 60) +
-                                  "' (expected 'property TYPE NAME' or 'property list "
-                                  "COUNT_TYPE INDEX_TYPE NAME' with PLY's scalar types)",
-                              lineNo);
-                    return false;
-                }
-            }
-            if (ascii) {
-                elements.back().minBytes += 2;
-            } else if (type == "list") {
-                std::string countType;
-                ls >> countType;
-                elements.back().minBytes += uintmax_t(scalarBytes(countType));
-            } else {
-                elements.back().minBytes += uintmax_t(scalarBytes(type));
-            }
-        }
-    }
-    if (!ended) {
-        // Without the magic Assimp reports the file as no PLY at all. With it, Assimp 5.2
-        // looks for end_header for ever (found by fuzz_mesh_ply: a 79-byte file hung).
-        in.clear();
-        in.seekg(0);
-        std::string first;
-        std::getline(in, first);
-        // Assimp takes any file starting with these three letters, in any case, for a PLY
-        // (found by fuzz_mesh_ply: "ply" then NUL bytes, and "plY", hung as well).
-        const bool magic = first.size() >= 3 && std::tolower((unsigned char)first[0]) == 'p' &&
-                           std::tolower((unsigned char)first[1]) == 'l' &&
-                           std::tolower((unsigned char)first[2]) == 'y';
-        if (!magic) return true;
-        rep.error("PLY header has no 'end_header' line" +
-                      std::string(lineNo >= 10000 ? " in its first 10000 lines" : "") +
-                      " (expected the element and property lines to end with 'end_header'; "
-                      "truncated or corrupt file?)",
-                  lineNo);
-        return false;
-    }
-    const uintmax_t available = fileBytes > headerBytes ? fileBytes - headerBytes : 0;
-    uintmax_t needed = 0;
-    for (const Element& e : elements) {
-        const uintmax_t per = std::max<uintmax_t>(1, e.minBytes);
-        // Compared by division so that count * per cannot overflow.
-        if (e.count > (available - std::min(needed, available)) / per) {
-            rep.error("PLY header announces " + std::to_string(e.count) + " '" + e.name +
-                          "' elements (at least " + std::to_string(per) +
-                          " bytes each), but the file has only " + std::to_string(available) +
-                          " bytes after the header (truncated or corrupt file?)",
-                      e.line);
-            return false;
-        }
-        needed += e.count * per;
-    }
-    return true;
-}
-
 bool loadPly(const std::string& path, Reporter& rep, TriangleMesh* out) {
-    if (!checkPlyCounts(path, rep)) return false;
-    Assimp::Importer importer;
-    // Read without post-processing, check the face indices ourselves (Assimp's own
-    // validation names no index values), then validate and triangulate; no vertex
-    // joining or any other step that changes topology.
-    const aiScene* scene = importer.ReadFile(path, 0);
-    if (!scene) {
-        std::string why = trimmed(importer.GetErrorString());
-        rep.error("cannot read PLY file" + (why.empty() ? std::string() : ": " + why));
-        return false;
-    }
-    size_t faceCount = 0;
-    for (unsigned i = 0; i < scene->mNumMeshes; ++i) {
-        const aiMesh* mesh = scene->mMeshes[i];
-        faceCount += mesh->mNumFaces;
-        for (unsigned f = 0; f < mesh->mNumFaces; ++f)
-            for (unsigned k = 0; k < mesh->mFaces[f].mNumIndices; ++k)
-                if (mesh->mFaces[f].mIndices[k] >= mesh->mNumVertices) {
-                    rep.error("vertex index " + std::to_string(mesh->mFaces[f].mIndices[k]) +
-                              " out of range (mesh has " + std::to_string(mesh->mNumVertices) +
-                              " vertices)");
-                    return false;
-                }
-    }
-    if (faceCount == 0) {
-        rep.error("PLY file has no triangles (expected a 'face' element)");
-        return false;
-    }
-    scene = importer.ApplyPostProcessing(aiProcess_ValidateDataStructure | aiProcess_Triangulate);
-    if (!scene) {
-        std::string why = trimmed(importer.GetErrorString());
-        rep.error("cannot read PLY file" + (why.empty() ? std::string() : ": " + why));
-        return false;
-    }
-    TriangleMesh& m = *out;
-    size_t ignored = 0;
-    bool hasNormals = true, hasUvs = true;
-    for (unsigned i = 0; i < scene->mNumMeshes; ++i) {
-        hasNormals = hasNormals && scene->mMeshes[i]->HasNormals();
-        hasUvs = hasUvs && scene->mMeshes[i]->HasTextureCoords(0);
-    }
-    for (unsigned i = 0; i < scene->mNumMeshes; ++i) {
-        const aiMesh* mesh = scene->mMeshes[i];
-        const uint32_t base = uint32_t(m.positions.size());
-        for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
-            const aiVector3D& p = mesh->mVertices[v];
-            m.positions.push_back(Vec3(p.x, p.y, p.z));
-            if (hasNormals) {
-                const aiVector3D& n = mesh->mNormals[v];
-                m.normals.push_back(Vec3(n.x, n.y, n.z));
-            }
-            if (hasUvs) {
-                const aiVector3D& t = mesh->mTextureCoords[0][v];
-                m.uvs.push_back(Vec2(t.x, t.y));
-            }
-        }
-        for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
-            const aiFace& face = mesh->mFaces[f];
-            if (face.mNumIndices != 3) {
-                ++ignored;
-                continue;
-            }
-            for (int k = 0; k < 3; ++k) {
-                if (face.mIndices[k] >= mesh->mNumVertices) {
-                    rep.error("vertex index " + std::to_string(face.mIndices[k]) +
-                              " out of range (mesh has " + std::to_string(mesh->mNumVertices) +
-                              " vertices)");
-                    return false;
-                }
-                m.indices.push_back(base + face.mIndices[k]);
-            }
-        }
-    }
-    if (ignored > 0)
-        rep.warning("ignored " + std::to_string(ignored) + " point and line primitives");
-    for (size_t v = 0; v < m.positions.size(); ++v)
-        if (!isFinite(m.positions[v])) {
-            rep.error("non-finite vertex position at vertex " + std::to_string(v));
-            return false;
-        }
-    if (m.indices.empty()) {
-        rep.error("PLY file has no triangles (expected a 'face' element)");
-        return false;
-    }
-    return true;
+    PlyReport report;
+    report.error = [&](const std::string& msg, int line, int column) {
+        rep.error(msg, line, column);
+    };
+    report.warning = [&](const std::string& msg, int line) { rep.warning(msg, line); };
+    return readPly(path, report, out);
 }
 
 /// Drops zero-area triangles (one warning with their count); false if none is left.

@@ -1,4 +1,4 @@
-// Triangle mesh files: OBJ (tinyobjloader) and PLY (Assimp). Meshes are
+// Triangle mesh files: OBJ (tinyobjloader) and PLY (scene/ply_reader.h). Meshes are
 // validated: non-finite positions, out-of-range indices and meshes without
 // any non-degenerate triangle are errors; degenerate (zero-area) triangles are
 // dropped with a warning that says how many.
