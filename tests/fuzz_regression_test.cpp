@@ -177,6 +177,14 @@ const std::vector<Case> kCases = {
      2,
      {"mesh.ply:4: error: at /shapes/0: PLY element 'vertex' has no 'y' property (expected "
       "float properties x, y and z)"}},
+    // The reader's own first finding (UBSan): a negative int32 list count in a binary body
+    // was converted to an unsigned count. Negative counts are errors; this input's header
+    // already has a second format line.
+    {"fuzz_mesh_ply",
+     "negative-binary-list-count.ply",
+     2,
+     {"mesh.ply:3: error: at /shapes/0: PLY header has a second 'format' line (expected one, "
+      "on line 2)"}},
     // Hangs: Assimp 5.2 looked for end_header for ever when a file starting with "ply" (any
     // case) had none, and it crashed (SEGV) on a header line it could not read. The reader
     // reports a missing end_header, any line that is not PLY's, and a first line that is not

@@ -320,6 +320,13 @@ TEST(MeshIo, ErrorPlyBadValuesAndCounts) {
          "PLY list entry '1.5' of property 'vertex_indices' of 'face' element 0 (expected a int "
          "integer in its range)",
          13, 5},
+        {"negativecount",
+         "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+         "property float z\nelement face 1\nproperty list int int vertex_indices\nend_header\n" +
+             vertices + "-5 0 1 2\n",
+         "PLY list 'vertex_indices' of 'face' element 0 has count -5 (expected a non-negative "
+         "count; at line 13)",
+         13, 1},
         {"noz",
          "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
          "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0\n1 0\n0 "

@@ -304,6 +304,11 @@ bool readPly(const std::string& path, const PlyReport& report, TriangleMesh* out
         }
         if (kw.empty() || kw == "comment" || kw == "obj_info") continue;
         if (kw == "format") {
+            if (haveFormat) {
+                report.error("PLY header has a second 'format' line (expected one, on line 2)",
+                             lineNo, 0);
+                return false;
+            }
             std::string f, version;
             ls >> f >> version;
             if (f == "ascii")
@@ -500,6 +505,14 @@ bool readPly(const std::string& path, const PlyReport& report, TriangleMesh* out
                 double count = 0;
                 if (!body.next(p.countType, &count, &bad))
                     return fail("list count", p.countTypeName);
+                if (count < 0.0) {  // a signed count type
+                    report.error("PLY list '" + p.name + "' of '" + e.name + "' element " +
+                                     std::to_string(k) + " has count " +
+                                     std::to_string(static_cast<long long>(count)) +
+                                     " (expected a non-negative count; at " + body.where() + ")",
+                                 body.line(), body.column());
+                    return false;
+                }
                 // A list needs its entries' bytes (binary) or a character and a separator
                 // each (ASCII): a count the rest of the file cannot hold is an error.
                 const uint64_t n = uint64_t(count);
