@@ -11,7 +11,10 @@
 // query counts of the last iteration and the image mean (a sanity check). Not run by ctest.
 //
 // Usage: bench_upbp [--runs N] [--sets s1,s2,...] [--backends host,opencl] [--resolution WxH]
-//                   [SCENE ...]
+//                   [--radius-of media|scene] [SCENE ...]
+//   --radius-of scene: the volumetric radii are 0.001 of the scene's bounding sphere (half the
+//   diagonal of the geometry's bounding box), SmallUPBP's convention, so that both renderers
+//   use the same absolute radius; media (default): 0.001 of the media's radius, unibeam's.
 //   default scenes: cornell-fog, cornell-smoke, forward-scattering (scenes/) and the SmallUPBP
 //   candle, mirrorballs, bunny (scenes/smallupbp/)
 #include <sys/resource.h>
@@ -46,7 +49,7 @@ std::vector<std::string> splitList(const std::string& list) {
 }
 
 int runOne(const std::string& path, const std::string& set, int runs, int width, int height,
-           const std::string& backend) {
+           const std::string& backend, bool sceneRadius) {
     std::vector<Diagnostic> warnings;
     std::unique_ptr<Scene> scene = loadScene(path, &warnings);
     scene->camera = scene->camera.resized(width, height, scene->settings.keepHorizontalFov);
@@ -58,6 +61,14 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
     opt.radius = 0.0015f;
     opt.alpha = 0.75f;
     opt.radiusPP3D = opt.radiusPB2D = opt.radiusBP2D = opt.radiusBB1D = 0.001f;
+    if (sceneRadius) {
+        opt.radiusIsRelative = false;  // every radius absolute, surf's too
+        opt.radius = 0.0015f * scene->sceneSphere.radius;
+        opt.radiusPP3D = opt.radiusPB2D = opt.radiusBP2D = opt.radiusBB1D =
+            0.001f * scene->sceneSphere.radius;
+        std::printf("    volumetric radius %.5g (0.001 of the scene radius %.5g)\n",
+                    double(opt.radiusPP3D), double(scene->sceneSphere.radius));
+    }
     opt.alphaPP3D = opt.alphaPB2D = opt.alphaBP2D = opt.alphaBB1D = 1.0f;
     opt.shortPhotonBeams = true;
     opt.shortQueryBeams = false;
@@ -88,6 +99,7 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
 
 int main(int argc, char** argv) {
     int runs = 3, width = 256, height = 256;
+    bool sceneRadius = false;
     std::vector<std::string> backends = {"host"};
     std::vector<std::string> scenes,
         sets = {"upbp:bpt", "upbp:pp3d", "upbp:pb2d", "upbp:bp2d", "upbp:bb1d", "upbp"};
@@ -99,6 +111,13 @@ int main(int argc, char** argv) {
             sets = splitList(argv[++i]);
         } else if (a == "--backends" && i + 1 < argc) {
             backends = splitList(argv[++i]);
+        } else if (a == "--radius-of" && i + 1 < argc) {
+            const std::string of = argv[++i];
+            if (of != "scene" && of != "media") {
+                std::fprintf(stderr, "bench_upbp: --radius-of expects media or scene\n");
+                return 2;
+            }
+            sceneRadius = of == "scene";
         } else if (a == "--resolution" && i + 1 < argc) {
             if (std::sscanf(argv[++i], "%dx%d", &width, &height) != 2 || width < 1 || height < 1) {
                 std::fprintf(stderr, "bench_upbp: --resolution expects WxH\n");
@@ -128,7 +147,7 @@ int main(int argc, char** argv) {
                 }
                 if (pid == 0) {
                     try {
-                        std::_Exit(runOne(scene, set, runs, width, height, backend));
+                        std::_Exit(runOne(scene, set, runs, width, height, backend, sceneRadius));
                     } catch (const std::exception& e) {
                         std::fprintf(stderr, "bench_upbp: %s %s: %s\n", scene.c_str(), set.c_str(),
                                      e.what());
