@@ -101,9 +101,9 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     UB_BVH_WALK(nodes, ub_bvh_contains(n, p), {
         ub_beam_part part = parts[prims[k]];
-        ub_beam pb = beams[part.beam];
         float t = 0.0f;
-        if (!ub_bp2d_pair(q, pb, part, radius * radius, minLength, maxLength, &t)) continue;
+        if (!ub_bp2d_pair(q, part, radius * radius, minLength, maxLength, &t)) continue;
+        ub_beam pb = beams[part.beam];
         ub_segment_eval s =
             ub_photon_beam_segment(m, gi, &acc, pb, t, beamPieces + beamRanges[2u * part.beam],
                                    beamRanges[2u * part.beam + 1u]);
@@ -138,10 +138,10 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     UB_BVH_WALK(nodes, ub_bvh_meets(n, o, invD, qb.length), {
         ub_beam_part part = parts[prims[k]];
-        ub_beam pb = beams[part.beam];
         float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
-        if (!ub_bb1d_pair(qb, pb, part, radius * radius, minLength, maxLength, &tc, &tl, &sinTheta))
+        if (!ub_bb1d_pair(qb, part, radius * radius, minLength, maxLength, &tc, &tl, &sinTheta))
             continue;
+        ub_beam pb = beams[part.beam];
         ub_segment_eval sl =
             ub_photon_beam_segment(m, gi, &acc, pb, tl, beamPieces + beamRanges[2u * part.beam],
                                    beamRanges[2u * part.beam + 1u]);

@@ -2,6 +2,7 @@
  * the hashed grid's buckets around it. All math is kernels/shared/ub_pp3d.h (the host twin
  * src/estimators/pp3d_estimator.cpp runs the same per-pair function over the same buffers
  * in the same order). out: 3 floats per query. */
+#include "ub_bvh.h"
 #include "ub_hash_grid.h"
 #include "ub_medium_homogeneous.h"
 #include "ub_pp3d.h"
@@ -56,6 +57,9 @@ __kernel void ub_layout_probe(__global uint* out) {
     out[9] = (uint)sizeof(ub_surface_query);
     out[10] = (uint)((__private char*)&s.bsdf.tableIndex - (__private char*)&s);
     out[11] = (uint)((__private char*)&s.pixel - (__private char*)&s);
+    ub_beam_part part;
+    out[12] = (uint)sizeof(ub_beam_part);
+    out[13] = (uint)((__private char*)&part.pathLength - (__private char*)&part);
 }
 
 #ifdef UB_FORCE_BUILD_ERROR

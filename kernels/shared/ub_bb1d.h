@@ -26,24 +26,22 @@ UB_INLINE float ub_bb1d_normalization(float beamPaths, float radius) {
     return 1.0f / (beamPaths * 2.0f * radius);
 }
 
-/* Whether query beam qb and the part `part` of photon beam pb make a bb1d pair (same
- * medium, path length in range, lines within radius, closest approach on both beams and in
- * this part); writes the parameters and sin(theta). */
-UB_INLINE int ub_bb1d_pair(ub_beam qb, ub_beam pb, ub_beam_part part, float radiusSqr,
-                           ub_uint minLength, ub_uint maxLength, UB_PRIVATE float* tc,
-                           UB_PRIVATE float* tl, UB_PRIVATE float* sinTheta) {
-    if (pb.mediumId != qb.mediumId) return 0;
-    ub_uint length = pb.pathLength + qb.pathLength;
+/* Whether query beam qb and part `part` of a photon beam make a bb1d pair (same medium, path
+ * length in range, lines within radius, closest approach on both beams and in this part);
+ * writes the parameters and sin(theta). Reads the beam's copy in the part. */
+UB_INLINE int ub_bb1d_pair(ub_beam qb, ub_beam_part part, float radiusSqr, ub_uint minLength,
+                           ub_uint maxLength, UB_PRIVATE float* tc, UB_PRIVATE float* tl,
+                           UB_PRIVATE float* sinTheta) {
+    if (part.mediumId != qb.mediumId) return 0;
+    ub_uint length = part.pathLength + qb.pathLength;
     if (length > maxLength || length < minLength) return 0;
-    float d2 = ub_beam_beam_dist2(ub_f3_from(qb.origin), ub_f3_from(qb.dir), ub_f3_from(pb.origin),
-                                  ub_f3_from(pb.dir), tc, tl, sinTheta);
+    float d2 = ub_beam_beam_dist2(ub_f3_from(qb.origin), ub_f3_from(qb.dir),
+                                  ub_f3_from(part.origin), ub_f3_from(part.dir), tc, tl, sinTheta);
     if (d2 < 0.0f || d2 > radiusSqr) return 0;
-    if (*tc < 0.0f || *tc > qb.length || *tl < 0.0f || *tl > pb.length) return 0;
-    return ub_beam_part_holds(part, *tl, pb.length);
+    if (*tc < 0.0f || *tc > qb.length || *tl < 0.0f || *tl > part.length) return 0;
+    return ub_beam_part_holds(part, *tl, part.length);
 }
 
-/* Contribution of photon beam pb at t_l to query beam qb at t_c (ub_beam_beam_dist2),
- * sl / sc their media over [0, t_l] / [0, t_c]. normalization = 1 / (N_B 2 r). */
 UB_INLINE ub_float3 ub_bb1d_contribution(ub_mis_constants c, ub_beam pb, ub_beam qb,
                                          ub_segment_eval sl, ub_segment_eval sc, float tl, float tc,
                                          float sinTheta, float g, float normalization) {

@@ -25,18 +25,18 @@ UB_INLINE float ub_bp2d_normalization(float beamPaths, float radius) {
     return 1.0f / (beamPaths * UB_PI * radius * radius);
 }
 
-/* Whether query point q and the part `part` of photon beam pb make a bp2d pair (same medium,
+/* Whether query point q and part `part` of a photon beam make a bp2d pair (same medium,
  * path length in range, q within radius of the beam, and its projection in this part, so
- * each beam counts once); writes the beam parameter. */
-UB_INLINE int ub_bp2d_pair(ub_query_point q, ub_beam pb, ub_beam_part part, float radiusSqr,
-                           ub_uint minLength, ub_uint maxLength, UB_PRIVATE float* t) {
-    if (pb.mediumId != q.mediumId) return 0;
-    ub_uint length = pb.pathLength + q.pathLength;
+ * each beam counts once); writes the beam parameter. Reads the beam's copy in the part. */
+UB_INLINE int ub_bp2d_pair(ub_query_point q, ub_beam_part part, float radiusSqr, ub_uint minLength,
+                           ub_uint maxLength, UB_PRIVATE float* t) {
+    if (part.mediumId != q.mediumId) return 0;
+    ub_uint length = part.pathLength + q.pathLength;
     if (length > maxLength || length < minLength) return 0;
-    float d2 = ub_point_beam_dist2(ub_f3_from(q.pos), ub_f3_from(pb.origin), ub_f3_from(pb.dir),
-                                   pb.length, t);
+    float d2 = ub_point_beam_dist2(ub_f3_from(q.pos), ub_f3_from(part.origin), ub_f3_from(part.dir),
+                                   part.length, t);
     if (d2 < 0.0f || d2 > radiusSqr) return 0;
-    return ub_beam_part_holds(part, *t, pb.length);
+    return ub_beam_part_holds(part, *t, part.length);
 }
 
 /* Contribution of photon beam pb at parameter t to query point q, the beam's medium over

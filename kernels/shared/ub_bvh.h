@@ -16,10 +16,18 @@ typedef struct {
     ub_uint count;
 } ub_bvh_node;
 
-/* A piece of a photon beam diced for the BVH: parameters [t0, t1] of beam `beam`. */
+/* A piece of a photon beam diced for the BVH: parameters [t0, t1] of beam `beam`, with a
+ * copy of what the pair tests read of the beam (ub_bp2d_pair, ub_bb1d_pair), so that a walk
+ * reads its candidates from the parts alone, stored in leaf order (prims is the identity):
+ * the full beam is fetched only for the pairs. 48 bytes. */
 typedef struct {
+    float origin[3];
+    float length; /* the beam's */
+    float dir[3];
+    ub_uint mediumId;
     ub_uint beam;
     float t0, t1;
+    ub_uint pathLength;
 } ub_beam_part;
 
 UB_INLINE int ub_bvh_contains(ub_bvh_node n, ub_float3 p) {
@@ -56,5 +64,13 @@ UB_INLINE int ub_bvh_meets(ub_bvh_node n, ub_float3 o, ub_float3 invD, float len
 UB_INLINE int ub_beam_part_holds(ub_beam_part p, float t, float beamLength) {
     return !(t < p.t0 || (t >= p.t1 && p.t1 < beamLength));
 }
+
+#ifndef __OPENCL_C_VERSION__
+#include <cstddef>
+static_assert(sizeof(ub_beam_part) == 48, "ub_beam_part layout");
+static_assert(offsetof(ub_beam_part, dir) == 16, "ub_beam_part layout");
+static_assert(offsetof(ub_beam_part, beam) == 32, "ub_beam_part layout");
+static_assert(offsetof(ub_beam_part, pathLength) == 44, "ub_beam_part layout");
+#endif
 
 #endif /* UB_BVH_H */

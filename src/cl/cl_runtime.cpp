@@ -337,7 +337,7 @@ ClRuntime::ClRuntime(int platform, int device, const std::string& cacheDir,
 }
 
 namespace {
-constexpr int kProbeEntries = 12;  // what kernels/pp3d.cl's ub_layout_probe writes
+constexpr int kProbeEntries = 14;  // what kernels/pp3d.cl's ub_layout_probe writes
 }  // namespace
 
 void ClRuntime::checkLayout() {
@@ -370,7 +370,9 @@ void ClRuntime::checkLayout() {
                                          cl_uint(sizeof(ub_light_vertex)),
                                          cl_uint(sizeof(ub_surface_query)),
                                          cl_uint(offsetof(ub_surface_query, bsdf.tableIndex)),
-                                         cl_uint(offsetof(ub_surface_query, pixel))};
+                                         cl_uint(offsetof(ub_surface_query, pixel)),
+                                         cl_uint(sizeof(ub_beam_part)),
+                                         cl_uint(offsetof(ub_beam_part, pathLength))};
     const char* what[kProbeEntries] = {"sizeof(ub_photon_point)",
                                        "sizeof(ub_query_point)",
                                        "sizeof(ub_beam)",
@@ -382,7 +384,9 @@ void ClRuntime::checkLayout() {
                                        "sizeof(ub_light_vertex)",
                                        "sizeof(ub_surface_query)",
                                        "offsetof(ub_surface_query, bsdf.tableIndex)",
-                                       "offsetof(ub_surface_query, pixel)"};
+                                       "offsetof(ub_surface_query, pixel)",
+                                       "sizeof(ub_beam_part)",
+                                       "offsetof(ub_beam_part, pathLength)"};
     for (int i = 0; i < kProbeEntries; ++i)
         if (device[i] != host[i])
             throw ClError("OpenCL: device '" + desc_.device +

@@ -34,11 +34,11 @@ void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
         beamParts.querySegment(Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length,
                                [&](uint32_t k) {
                                    const BeamPart& part = parts[k];
-                                   const ub_beam& pb = beams[part.beam];
                                    float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
-                                   if (!ub_bb1d_pair(qb, pb, part, r * r, ub_uint(in.minLength),
+                                   if (!ub_bb1d_pair(qb, part, r * r, ub_uint(in.minLength),
                                                      ub_uint(in.maxLength), &tc, &tl, &sinTheta))
                                        return;
+                                   const ub_beam& pb = beams[part.beam];
                                    if (!queryMedium.built()) queryMedium.build();
                                    const ub_segment_eval sl = photonMedia[part.beam].eval(tl);
                                    const ub_segment_eval sc = queryMedium.eval(tc);

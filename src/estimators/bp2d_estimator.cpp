@@ -29,10 +29,10 @@ void estimateBP2D(const VolumeEstimateInput& in, const Bvh& beamParts,
         Rgb sum(0.0f);
         beamParts.queryPoint(Vec3(p.x, p.y, p.z), [&](uint32_t k) {
             const BeamPart& part = parts[k];
-            const ub_beam& pb = beams[part.beam];
             float t = 0.0f;
-            if (!ub_bp2d_pair(q, pb, part, r * r, ub_uint(in.minLength), ub_uint(in.maxLength), &t))
+            if (!ub_bp2d_pair(q, part, r * r, ub_uint(in.minLength), ub_uint(in.maxLength), &t))
                 return;
+            const ub_beam& pb = beams[part.beam];
             const ub_segment_eval s = photonMedia[part.beam].eval(t);
             const ub_float3 c = ub_bp2d_contribution(in.mis, pb, q, s, t, g, normalization);
             sum += Rgb(c.x, c.y, c.z);
