@@ -5,7 +5,8 @@
 
 namespace ub {
 
-void Bvh::build(const std::vector<Bounds3>& boxes) {
+void Bvh::build(const std::vector<Bounds3>& boxes, uint32_t leafSize) {
+    leafSize_ = std::max(1u, leafSize);
     nodes_.clear();
     prims_.resize(boxes.size());
     if (boxes.empty()) return;
@@ -14,7 +15,7 @@ void Bvh::build(const std::vector<Bounds3>& boxes) {
         prims_[i] = i;
         centres[i] = boxes[i].center();
     }
-    nodes_.reserve(2 * boxes.size() / kLeafSize + 1);
+    nodes_.reserve(2 * boxes.size() / leafSize_ + 1);
     buildNode(boxes, centres, 0, uint32_t(boxes.size()));
 }
 
@@ -36,7 +37,7 @@ uint32_t Bvh::buildNode(const std::vector<Bounds3>& boxes, std::vector<Vec3>& ce
     const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
     // Depth stays below 64 (the traversal stack): median splits halve the range, and a
     // range whose centres coincide becomes a leaf however large it is.
-    if (end - begin <= kLeafSize || !(ext[axis] > 0.0f)) {
+    if (end - begin <= leafSize_ || !(ext[axis] > 0.0f)) {
         node.first = begin;
         node.count = end - begin;
         nodes_[self] = node;

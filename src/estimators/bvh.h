@@ -6,8 +6,9 @@
 //
 // Built top-down: a node's primitives are split at the median of their box
 // centres along the axis of largest centre extent, down to leaves of at most
-// kLeafSize primitives (O(n log n) with nth_element; 8 measured faster than 4 and 16
-// for bb1d, whose candidates are cheap, docs/performance.md). Median splits keep the
+// leafSize primitives (O(n log n) with nth_element; measured, docs/performance.md: 8
+// for the beam parts, faster than 4 and 16 for bb1d, whose candidates are cheap; 4 for the
+// photon spheres of pb2d, where 8 halved the kernel's speed). Median splits keep the
 // tree balanced whatever the beam distribution; for the long, thin boxes of
 // beams a SAH split would cut traversal cost further (not done).
 //
@@ -31,10 +32,8 @@ static_assert(sizeof(BvhNode) == 32, "BvhNode layout");
 
 class Bvh {
   public:
-    static constexpr uint32_t kLeafSize = 8;
-
-    /// Builds over boxes[i], i = 0..n-1; visits report i.
-    void build(const std::vector<Bounds3>& boxes);
+    /// Builds over boxes[i], i = 0..n-1, leaves of at most leafSize; visits report i.
+    void build(const std::vector<Bounds3>& boxes, uint32_t leafSize = 4);
     bool empty() const { return nodes_.empty(); }
     size_t nodeCount() const { return nodes_.size(); }
     size_t bytes() const { return nodes_.size() * sizeof(BvhNode) + prims_.size() * 4; }
@@ -60,6 +59,7 @@ class Bvh {
     void traverse(Accept&& accept, Visit&& visit) const;
     uint32_t buildNode(const std::vector<Bounds3>& boxes, std::vector<Vec3>& centres,
                        uint32_t begin, uint32_t end);
+    uint32_t leafSize_ = 4;
 
     std::vector<BvhNode> nodes_;
     std::vector<uint32_t> prims_;

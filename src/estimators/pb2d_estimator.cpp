@@ -16,9 +16,9 @@
 
 namespace ub {
 
-void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres, std::vector<Rgb>* out,
+void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres,
+                  const std::vector<ub_photon_point>& photons, std::vector<Rgb>* out,
                   size_t* pairs) {
-    const std::vector<ub_photon_point>& photons = *in.photonPoints;
     const std::vector<ub_beam>& queries = *in.queryBeams;
     if (photons.empty() || queries.empty()) return;
     const float r = in.radius[UB_TECH_PB2D];

@@ -74,6 +74,7 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
                    sizeof(ub_photon_point), in.radius[UB_TECH_PP3D]);
     }
     Bvh spheres;
+    std::vector<ub_photon_point> sphereOrder;
     if (t.pb2d) {
         // Boxes, nodes (at most 2 n / leaf size + 1) and the primitive list.
         reserve(photons.size() * (sizeof(Bounds3) + sizeof(Vec3) + 4 + 2 * sizeof(BvhNode)),
@@ -86,6 +87,10 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
             boxes[i].extend(p + Vec3(r, r, r));
         }
         spheres.build(boxes);
+        // A copy of the photons in leaf order, read one after the other by the walks.
+        reserve(photons.size() * sizeof(ub_photon_point), "pb2d lookup (photons in leaf order)");
+        sphereOrder = photons;
+        spheres.permuteToLeafOrder(&sphereOrder);
     }
     Bvh beamBvh;
     std::vector<BeamPart> parts;
@@ -128,7 +133,7 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
                 boxes.push_back(cylinderBox(vec(b.origin), vec(b.dir), a, e, r));
             }
         }
-        beamBvh.build(boxes);
+        beamBvh.build(boxes, 8);
         // The parts in leaf order, so that a walk reads its candidates one after the other.
         beamBvh.permuteToLeafOrder(&parts);
     }
@@ -152,7 +157,8 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     reserve(mediaBytes, "photon-beam medium tables");
     st.lookupBytes += mediaBytes;
     st.buildSeconds = secondsSince(t0);
-    st.lookupBytes += spheres.bytes() + beamBvh.bytes() + parts.size() * sizeof(BeamPart);
+    st.lookupBytes += spheres.bytes() + sphereOrder.size() * sizeof(ub_photon_point) +
+                      beamBvh.bytes() + parts.size() * sizeof(BeamPart);
 
     t0 = std::chrono::steady_clock::now();
     std::vector<Rgb> perPoint[4], perBeam[4];
@@ -201,12 +207,12 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         perBeam[UB_TECH_PB2D].assign(nBeams, Rgb(0.0f));
         const float r = in.radius[UB_TECH_PB2D];
         if (beamCl) {
-            beamCl->estimatePB2D(photons, spheres, *in.queryBeams,
+            beamCl->estimatePB2D(sphereOrder, spheres, *in.queryBeams,
                                  clArgs(UB_TECH_PB2D, ub_pb2d_normalization(in.lightPathCount, r)),
                                  &perBeam[UB_TECH_PB2D]);
             st.pairs[UB_TECH_PB2D] = VolumeEstimateStats::kNotCounted;
         } else {
-            estimatePB2D(in, spheres, &perBeam[UB_TECH_PB2D], &st.pairs[UB_TECH_PB2D]);
+            estimatePB2D(in, spheres, sphereOrder, &perBeam[UB_TECH_PB2D], &st.pairs[UB_TECH_PB2D]);
         }
     }
     if (t.bb1d) {
