@@ -56,9 +56,11 @@ std::string caseName(const ::testing::TestParamInfo<HandCase>& info) {
 // tracing spreads its splats over the filter's footprint, pt samples it. interop_lens.xml:
 // thinlens sensor with a tent filter (light tracing needs a pinhole: pt and vpt only).
 // round_shapes.xml (disk, cylinder), instancing.xml (shapegroup, instance) and conductor.xml
-// (smooth conductor): pt and bpt (bpt's light subpaths reflect off the Fresnel mirrors too).
-// They have no media, so vpt and vbpt would render pt's and bpt's images exactly (the same
-// random numbers: measured identical statistics) and are not repeated.
+// (smooth conductor): pt and bpt (bpt's light subpaths reflect off the Fresnel mirrors too),
+// and for the conductor also vcm and upbp (merging after the mirrors). They have no media, so
+// vpt and vbpt would render pt's and bpt's images exactly (the same random numbers: measured
+// identical statistics) and are not repeated; lt alone cannot see the mirrors from the camera
+// (delta reflections toward a pinhole), which Mitsuba's path renders.
 // interop_ptracer.xml: Mitsuba's ptracer (unibeam's lt) with the default tent, whose border
 // pixels Mitsuba does not renormalise (PixelFilterBorder::kPartitionOfUnity; with the
 // renormalised filter lt is 15-20% brighter than the reference along the left and right
@@ -87,6 +89,8 @@ const HandCase kCases[] = {
     {"instancing", "bpt", 256},
     {"conductor", "pt", 512},
     {"conductor", "bpt", 256},
+    {"conductor", "vcm", 256},
+    {"conductor", "upbp", 128},
 };
 
 class MitsubaHandWritten : public ::testing::TestWithParam<HandCase> {};
