@@ -158,7 +158,7 @@ const std::vector<Case> kCases = {
             "}\n"}},
      "s.json",
      {},
-     "s.json:5:10: error: at /shapes/0/type: unknown shape type 'torus'; valid types: obj, ply, rectangle, cube, sphere"},
+     "s.json:5:10: error: at /shapes/0/type: unknown shape type 'torus'; valid types: obj, ply, rectangle, cube, sphere, disk, cylinder"},
     {"json_missing_mesh_file",
      {{"s.json", "{\n"
             "\"camera\": {\"position\": [0, 0, 5], \"target\": [0, 0, 0], \"up\": [0, 1, 0], \"fov\": 40, \"resolution\": [8, 8]},\n"

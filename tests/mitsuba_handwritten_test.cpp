@@ -13,7 +13,9 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <ostream>
+#include <sstream>
 #include <string>
 
 #include "scene/io/mitsuba_loader.h"
@@ -53,6 +55,12 @@ std::string caseName(const ::testing::TestParamInfo<HandCase>& info) {
 // interop.xml (Gaussian filter, direct, Au preset, JPEG, serialized mesh): bpt's light
 // tracing spreads its splats over the filter's footprint, pt samples it. interop_lens.xml:
 // thinlens sensor with a tent filter (light tracing needs a pinhole: pt and vpt only).
+// round_shapes.xml (disk, cylinder), instancing.xml (shapegroup, instance) and conductor.xml
+// (smooth conductor): pt and bpt (bpt's light subpaths reflect off the Fresnel mirrors too),
+// and for the conductor also vcm and upbp (merging after the mirrors). They have no media, so
+// vpt and vbpt would render pt's and bpt's images exactly (the same random numbers: measured
+// identical statistics) and are not repeated; lt alone cannot see the mirrors from the camera
+// (delta reflections toward a pinhole), which Mitsuba's path renders.
 // interop_ptracer.xml: Mitsuba's ptracer (unibeam's lt) with the default tent, whose border
 // pixels Mitsuba does not renormalise (PixelFilterBorder::kPartitionOfUnity; with the
 // renormalised filter lt is 15-20% brighter than the reference along the left and right
@@ -75,6 +83,14 @@ const HandCase kCases[] = {
     {"interop_ptracer", "pt", 512},
     {"interop_ptracer", "bpt", 256},
     {"interop_ptracer", "vbpt", 256},
+    {"round_shapes", "pt", 512},
+    {"round_shapes", "bpt", 256},
+    {"instancing", "pt", 512},
+    {"instancing", "bpt", 256},
+    {"conductor", "pt", 512},
+    {"conductor", "bpt", 256},
+    {"conductor", "vcm", 256},
+    {"conductor", "upbp", 128},
 };
 
 class MitsubaHandWritten : public ::testing::TestWithParam<HandCase> {};
@@ -111,4 +127,68 @@ TEST(MitsubaHandWrittenPower, BoxFilterIsDistinguishedFromMitsubasGaussian) {
         test::renderAgainstReference(*scene, "pt", 512, ref, refVar, kReferenceSamples);
     test::printReferenceCheck("interop pt with a box filter", check);
     EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the pixel filter";
+}
+
+namespace {
+
+/// The scene kDir/NAME.xml with `from` replaced by `to` (which must occur once), at 48x48.
+std::unique_ptr<Scene> loadEdited(const std::string& name, const std::string& from,
+                                  const std::string& to) {
+    std::stringstream ss;
+    ss << std::ifstream(kDir + "/" + name + ".xml").rdbuf();
+    std::string text = ss.str();
+    const size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    EXPECT_EQ(text.find(from, at + 1), std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    return loadMitsubaSceneFromString(text, name + ".xml", kDir, {{"res", "48"}});
+}
+
+test::ReferenceCheck checkAgainst(const std::string& name, const Scene& scene, const char* algo,
+                                  int iterations, const std::string& label) {
+    const std::string base = kDir + "/" + name;
+    const Image ref = readExr(base + "_ref.exr"), refVar = readExr(base + "_ref_var.exr");
+    test::ReferenceCheck check =
+        test::renderAgainstReference(scene, algo, iterations, ref, refVar, kReferenceSamples);
+    test::printReferenceCheck(label, check);
+    return check;
+}
+
+}  // namespace
+
+// Power of the conductor check: the same scene with perfect mirrors (no Fresnel term, what
+// unibeam's Mirror was before) fails.
+TEST(MitsubaHandWrittenPower, ConductorWithoutFresnelIsDistinguished) {
+    std::unique_ptr<Scene> scene = loadMitsubaScene(kDir + "/conductor.xml", {{"res", "48"}});
+    int fresnel = 0;
+    for (Material& m : scene->materials)
+        if (m.type == MaterialType::Mirror && m.conductorFresnel) {
+            m.conductorFresnel = false;
+            ++fresnel;
+        }
+    ASSERT_EQ(fresnel, 3);  // Au, eta/k and Cr; the "none" sphere is a perfect mirror anyway
+    const test::ReferenceCheck check =
+        checkAgainst("conductor", *scene, "pt", 512, "conductor pt without the Fresnel term");
+    EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the Fresnel term";
+}
+
+// Power of the round-shape check: the cylinder's checkerboard shifted by one square in u (an
+// error of 1/16 turn in where u = 0 lies around the axis; Mitsuba's checkerboard has period 1
+// in uv, 16 squares around at scale 8) fails.
+TEST(MitsubaHandWrittenPower, CylinderUvShiftIsDistinguished) {
+    std::unique_ptr<Scene> scene = loadEdited(
+        "round_shapes", R"(<transform name="to_uv"><scale x="8" y="3"/></transform>)",
+        R"(<transform name="to_uv"><translate x="0.0625"/><scale x="8" y="3"/></transform>)");
+    const test::ReferenceCheck check =
+        checkAgainst("round_shapes", *scene, "pt", 512, "round_shapes pt, cylinder u shifted");
+    EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the cylinder's uvs";
+}
+
+// Power of the instancing check: the mirrored instance rendered unmirrored fails.
+TEST(MitsubaHandWrittenPower, InstanceTransformIsDistinguished) {
+    std::unique_ptr<Scene> scene = loadEdited("instancing", R"(<scale x="-0.9" y="0.9" z="0.9"/>)",
+                                              R"(<scale x="0.9" y="0.9" z="0.9"/>)");
+    const test::ReferenceCheck check =
+        checkAgainst("instancing", *scene, "pt", 512, "instancing pt, instance not mirrored");
+    EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the mirroring";
 }

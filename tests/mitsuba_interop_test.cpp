@@ -212,16 +212,18 @@ TEST(MitsubaInterop, NamedConductorPresets) {
     e = errorsOf(scene("", conductor("<string name=\"material\" value=\"Au\"/><rgb name=\"eta\" "
                                      "value=\"1\"/>")));
     EXPECT_TRUE(contains(e, "give either 'material' or eta/k")) << e;
-    // A smooth conductor: only "none" (a mirror); a Fresnel conductor is an error.
+    // A smooth conductor: "none" is a perfect mirror, a preset a mirror with its Fresnel
+    // term (tests/mitsuba_shapes_test.cpp checks the parameters).
     s = load(scene(
         "", "<shape type=\"sphere\"><bsdf type=\"conductor\"/></shape>\n" + std::string(kLight)));
     EXPECT_EQ(s->materials[0].type, MaterialType::Mirror);
-    e = errorsOf(scene("",
-                       "<shape type=\"sphere\"><bsdf type=\"conductor\"><string "
-                       "name=\"material\" value=\"Au\"/></bsdf></shape>\n" +
-                           std::string(kLight)));
-    EXPECT_TRUE(contains(e, "<bsdf type=\"conductor\">: a smooth conductor with a Fresnel term"))
-        << e;
+    EXPECT_FALSE(s->materials[0].conductorFresnel);
+    s = load(scene("",
+                   "<shape type=\"sphere\"><bsdf type=\"conductor\"><string "
+                   "name=\"material\" value=\"Au\"/></bsdf></shape>\n" +
+                       std::string(kLight)));
+    EXPECT_EQ(s->materials[0].type, MaterialType::Mirror);
+    EXPECT_TRUE(s->materials[0].conductorFresnel);
 }
 
 TEST(MitsubaInterop, TopLevelSamplerAndNamedAreaEmitterAreAttachedByRef) {

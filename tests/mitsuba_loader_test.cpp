@@ -222,8 +222,8 @@ TEST(MitsubaXml, UnsupportedPluginNamesFileLineAndPlugin) {
                          "scene.xml:10:3: error: unsupported bsdf plugin 'hair' (supported: "
                          "diffuse, conductor"))
         << e;
-    std::string s = errorsOf(scene(std::string(kLight) + "<shape type=\"disk\"/>\n"));
-    EXPECT_TRUE(contains(s, "scene.xml:9:1: error: unsupported shape plugin 'disk'")) << s;
+    std::string s = errorsOf(scene(std::string(kLight) + "<shape type=\"linearcurve\"/>\n"));
+    EXPECT_TRUE(contains(s, "scene.xml:9:1: error: unsupported shape plugin 'linearcurve'")) << s;
 }
 
 TEST(MitsubaXml, UnsupportedParameterIsAnError) {

@@ -444,7 +444,7 @@ TEST(JsonLoaderErrors, UnknownTypesListValidTypes) {
               "rough_plastic, thin_dielectric, multi_lobe");
     EXPECT_EQ(d[1].message,
               "unknown shape type 'cone' (did you mean 'cube'?); valid types: obj, ply, "
-              "rectangle, cube, sphere");
+              "rectangle, cube, sphere, disk, cylinder");
     EXPECT_EQ(d[2].message,
               "unknown light type 'laser'; valid types: point, spot, directional, "
               "constant, envmap (area lights are shapes with an \"emission\")");

@@ -7,7 +7,10 @@
 //                   (Lafortune & Willems 1994). One lobe is picked with probability
 //                   proportional to the luminance of its reflectance; the pdf is the
 //                   mixture of both lobe pdfs (one-sample MIS, as SmallVCM).
-//  Mirror           delta reflection, weight `specular`.
+//  Mirror           delta reflection, weight `specular`, times the conductor Fresnel
+//                   reflectance F(cos_fix) of eta + i k per channel when the material has
+//                   conductorFresnel (Mitsuba's smooth conductor; cos_fix = cos_gen, so the
+//                   weight is the same in both transport directions).
 //  Dielectric       smooth interface, exact unpolarised Fresnel F; reflection picked
 //                   with probability F, refraction with 1 - F; weights `specular`
 //                   times 1 (reflection) or (eta_fix/eta_gen)^2 for radiance and 1 for
@@ -48,7 +51,8 @@
 // Russian roulette (continuationProb): max over RGB of the albedo estimate,
 // clamped to [0,1] as SmallVCM: diffuse (+ glossy); mirror `specular`; dielectrics
 // `specular` (1 for clear glass; refraction weights may exceed 1 for radiance, RR
-// uses the tint only); rough conductor `specular` * F_conductor(cos_fix).
+// uses the tint only); rough conductor and mirror `specular` * F_conductor(cos_fix) (the
+// mirror's F is 1 without conductorFresnel).
 #include "scene/bsdf.h"
 
 #include "core/sampling.h"
@@ -151,7 +155,7 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
             break;
         }
         case MaterialType::Mirror:
-            contProb_ = maxComponent(colors_.specular);
+            contProb_ = maxComponent(colors_.specular * mirrorReflectance());
             break;
         case MaterialType::Dielectric:
         case MaterialType::RoughDielectric:
@@ -376,6 +380,11 @@ void Bsdf::setupMultiLobe() {
         mat.refract ? 1.0f : maxComponent(colors_.diffuse + colors_.glossy + colors_.specular);
 }
 
+Rgb Bsdf::mirrorReflectance() const {
+    if (!mat_->conductorFresnel) return Rgb(1.0f);
+    return fresnelConductor(std::fabs(localDirFix_.z), mat_->eta, mat_->k);
+}
+
 bool Bsdf::hasNullLobe() const {
     return mat_ && mat_->type == MaterialType::ThinDielectric;
 }
@@ -387,7 +396,9 @@ Rgb Bsdf::sampleDelta(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThet
     float prob = 1.0f;
     Rgb weight = colors_.specular;
     uint32_t event = kEventReflect;
-    if (mat_->type == MaterialType::Plastic) {
+    if (mat_->type == MaterialType::Mirror) {
+        weight = colors_.specular * mirrorReflectance();
+    } else if (mat_->type == MaterialType::Plastic) {
         // Coating reflection: f cos / pdf = specular F(fix) / P(specular) (Mitsuba 3).
         prob = plasticSpecularProb(fix.z);
         weight = colors_.specular * fresnelFix_;

@@ -139,6 +139,9 @@ class Bsdf {
     float plasticTransmittance(float cosTheta) const;
     Rgb sampleDelta(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
                     uint32_t* sampledEvent) const;
+    /// Mirror: the conductor Fresnel reflectance at dirFix's angle (1 without
+    /// Material::conductorFresnel).
+    Rgb mirrorReflectance() const;
 
     const Material* mat_ = nullptr;
     SurfaceColors colors_;    ///< RGB parameters at this point (textures resolved)

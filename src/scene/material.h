@@ -13,7 +13,8 @@ namespace ub {
 enum class MaterialType : uint32_t {
     Diffuse = 0,  ///< Lambertian, reflectance `diffuse`
     Phong = 1,    ///< SmallVCM model: Lambert `diffuse` + modified Phong lobe `glossy`, `exponent`
-    Mirror = 2,   ///< perfect specular reflection scaled by `specular`
+    Mirror = 2,   ///< specular reflection scaled by `specular` (x the conductor Fresnel term
+                  ///< of `eta`, `k` when `conductorFresnel`)
     Dielectric = 3,  ///< smooth glass: Fresnel reflection + refraction, `ior`, tint `specular`
     RoughConductor =
         4,  ///< GGX microfacet conductor: `eta`, `k` (RGB), roughness `alpha`, tint `specular`
@@ -50,8 +51,12 @@ struct Material {
     float exponent = 1.0f;          ///< Phong exponent (> 0)
     Rgb specular{1, 1, 1};          ///< Mirror / Dielectric / Rough* tint
     float ior = 1.5f;               ///< Dielectric, RoughDielectric: interior / exterior IOR
-    Rgb eta{0.2f, 0.92f, 1.1f};  ///< RoughConductor: real part of the complex IOR (default: copper)
+    Rgb eta{0.2f, 0.92f, 1.1f};  ///< RoughConductor, Mirror with conductorFresnel: real part of the
+                                 ///< complex IOR (default: copper)
     Rgb k{3.9f, 2.45f, 2.14f};   ///< RoughConductor: imaginary part
+    /// Mirror: multiply the reflection by the conductor Fresnel reflectance of eta + i k at
+    /// the angle of incidence (Mitsuba's smooth `conductor`); false: a perfect mirror.
+    bool conductorFresnel = false;
     float alpha =
         0.1f;  ///< GGX roughness (alpha = roughness^2 convention NOT used: alpha as given)
     /// RoughConductor, RoughDielectric reflection: Smith masking-shadowing G2 separable,

@@ -1,5 +1,6 @@
 #include "scene/shapes.h"
 
+#include <cmath>
 #include <utility>
 
 namespace ub {
@@ -41,6 +42,77 @@ TriangleMesh makeCube() {
     addFace(m, z, x, y);
     addFace(m, -z, y, x);
     return m;
+}
+
+namespace {
+
+/// Point i of `segments` on the unit circle (index `segments` is index 0, bit for bit).
+Vec3 circlePoint(int i, int segments) {
+    const double phi = 2.0 * 3.14159265358979323846 * double(i % segments) / double(segments);
+    return Vec3(float(std::cos(phi)), float(std::sin(phi)), 0.0f);
+}
+
+}  // namespace
+
+TriangleMesh makeDisk(int segments) {
+    TriangleMesh m;
+    const float n = float(segments);
+    for (int i = 0; i < segments; ++i) {
+        const uint32_t base = uint32_t(m.positions.size());
+        m.positions.push_back(Vec3(0.0f));
+        m.positions.push_back(circlePoint(i, segments));
+        m.positions.push_back(circlePoint(i + 1, segments));
+        m.uvs.push_back(Vec2(0.0f, (float(i) + 0.5f) / n));
+        m.uvs.push_back(Vec2(1.0f, float(i) / n));
+        m.uvs.push_back(Vec2(1.0f, float(i + 1) / n));
+        // Counter-clockwise seen from +z: the geometric normal is +z.
+        for (uint32_t k : {0u, 1u, 2u}) m.indices.push_back(base + k);
+    }
+    return m;
+}
+
+TriangleMesh makeCylinder(int segments) {
+    TriangleMesh m;
+    const float n = float(segments);
+    for (int i = 0; i <= segments; ++i) {
+        const Vec3 c = circlePoint(i, segments);
+        const float u = float(i) / n;
+        m.positions.push_back(c);                     // 2i: bottom (z = 0)
+        m.positions.push_back(Vec3(c.x, c.y, 1.0f));  // 2i + 1: top (z = 1)
+        m.normals.push_back(c);
+        m.normals.push_back(c);
+        m.uvs.push_back(Vec2(u, 0.0f));
+        m.uvs.push_back(Vec2(u, 1.0f));
+    }
+    for (int i = 0; i < segments; ++i) {
+        const uint32_t b0 = uint32_t(2 * i), t0 = b0 + 1, b1 = b0 + 2, t1 = b0 + 3;
+        // Counter-clockwise seen from outside: cross(b1 - b0, t1 - b0) points away from the axis.
+        for (uint32_t k : {b0, b1, t1, b0, t1, t0}) m.indices.push_back(k);
+    }
+    return m;
+}
+
+Transform cylinderPlacement(const Vec3& p0, const Vec3& p1, float radius) {
+    const float len = length(p1 - p0);
+    const Frame f((p1 - p0) / len);
+    Transform t;
+    for (int i = 0; i < 3; ++i) {
+        t.m[i][0] = f.s[i] * radius;
+        t.m[i][1] = f.t[i] * radius;
+        t.m[i][2] = f.n[i] * len;
+        t.m[i][3] = p0[i];
+    }
+    return t;
+}
+
+bool keepsCylinderCircular(const Transform& t) {
+    Vec3 c[3];
+    for (int j = 0; j < 3; ++j) c[j] = Vec3(t.m[0][j], t.m[1][j], t.m[2][j]);
+    const float l0 = length(c[0]), l1 = length(c[1]), l2 = length(c[2]);
+    const float tol = 1e-4f;
+    return std::fabs(l0 - l1) <= tol * l0 && std::fabs(dot(c[0], c[1])) <= tol * l0 * l1 &&
+           std::fabs(dot(c[0], c[2])) <= tol * l0 * l2 &&
+           std::fabs(dot(c[1], c[2])) <= tol * l1 * l2 && t.determinant3() > 0.0f;
 }
 
 void transformMesh(TriangleMesh& mesh, const Transform& toWorld) {

@@ -73,6 +73,38 @@ std::vector<std::string> metalNames() {
     return names;
 }
 
+/// The complex IOR of a conductor: "metal" (a preset of kMetals) or both "eta" and "k".
+/// Without them: an error when `required`, else false (and mat is unchanged).
+bool readConductorIor(JsonReader& r, const Json& m, const std::string& ptr, Material& mat,
+                      bool required) {
+    const Json* metal = r.member(m, ptr, "metal", Presence::Optional, "");
+    bool hasEta = m.contains("eta"), hasK = m.contains("k");
+    if (metal) {
+        std::string metalPtr = jsonPointerChild(ptr, "metal");
+        if (hasEta || hasK) {
+            r.error(metalPtr, "give either \"metal\" or both \"eta\" and \"k\", not both");
+        }
+        std::string name = r.string(*metal, metalPtr);
+        if (name == "aluminum") name = "aluminium";
+        auto it = std::find_if(std::begin(kMetals), std::end(kMetals),
+                               [&](const MetalPreset& p) { return name == p.name; });
+        if (it != std::end(kMetals)) {
+            mat.eta = it->eta;
+            mat.k = it->k;
+        } else if (!name.empty()) {
+            r.error(metalPtr, "unknown metal '" + name + "'" + didYouMean(name, metalNames()) +
+                                  "; valid metals: " + joinNames(metalNames()));
+        }
+    } else if (hasEta || hasK) {
+        mat.eta = r.getRgb(m, ptr, "eta", Presence::Required, NumberRange::positive(), mat.eta);
+        mat.k = r.getRgb(m, ptr, "k", Presence::Required, NumberRange::nonNegative(), mat.k);
+    } else if (required) {
+        r.error(ptr, "a rough_conductor needs \"metal\" (one of " + joinNames(metalNames()) +
+                         ") or both \"eta\" and \"k\" (RGB)");
+    }
+    return metal || hasEta || hasK;
+}
+
 /// Reflectances are albedos: a component above 1 would create energy.
 const NumberRange kReflectance = NumberRange::closed(0.0, 1.0);
 
@@ -163,10 +195,13 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
                 break;
             }
     } else if (type == "mirror") {
+        // A perfect mirror, or with "metal" or "eta" and "k" a smooth conductor: reflectance
+        // x F_conductor(cos theta_i) (Mitsuba's smooth `conductor`).
         mat.type = MaterialType::Mirror;
-        keys.insert(keys.end(), {"reflectance", "two_sided"});
+        keys.insert(keys.end(), {"reflectance", "metal", "eta", "k", "two_sided"});
         r.checkKeys(m, ptr, keys, "mirror material");
         colour("reflectance", Rgb(1.0f), &mat.specular, &mat.textures.specular);
+        mat.conductorFresnel = readConductorIor(r, m, ptr, mat, false);
     } else if (type == "dielectric" || type == "rough_dielectric") {
         bool rough = type == "rough_dielectric";
         mat.type = rough ? MaterialType::RoughDielectric : MaterialType::Dielectric;
@@ -188,31 +223,7 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         r.checkKeys(m, ptr, keys, "rough_conductor material");
         mat.separableMasking = readMasking(r, m, ptr);
         mat.distribution = readDistribution(r, m, ptr);
-        const Json* metal = r.member(m, ptr, "metal", Presence::Optional, "");
-        bool hasEta = m.contains("eta"), hasK = m.contains("k");
-        if (metal) {
-            std::string metalPtr = jsonPointerChild(ptr, "metal");
-            if (hasEta || hasK) {
-                r.error(metalPtr, "give either \"metal\" or both \"eta\" and \"k\", not both");
-            }
-            std::string name = r.string(*metal, metalPtr);
-            if (name == "aluminum") name = "aluminium";
-            auto it = std::find_if(std::begin(kMetals), std::end(kMetals),
-                                   [&](const MetalPreset& p) { return name == p.name; });
-            if (it != std::end(kMetals)) {
-                mat.eta = it->eta;
-                mat.k = it->k;
-            } else if (!name.empty()) {
-                r.error(metalPtr, "unknown metal '" + name + "'" + didYouMean(name, metalNames()) +
-                                      "; valid metals: " + joinNames(metalNames()));
-            }
-        } else if (hasEta || hasK) {
-            mat.eta = r.getRgb(m, ptr, "eta", Presence::Required, NumberRange::positive(), mat.eta);
-            mat.k = r.getRgb(m, ptr, "k", Presence::Required, NumberRange::nonNegative(), mat.k);
-        } else {
-            r.error(ptr, "a rough_conductor needs \"metal\" (one of " + joinNames(metalNames()) +
-                             ") or both \"eta\" and \"k\" (RGB)");
-        }
+        readConductorIor(r, m, ptr, mat, true);
         mat.alpha =
             r.getNumber(m, ptr, "alpha", Presence::Required, NumberRange::leftOpen(0.0, 1.0), 0.1f);
         colour("tint", Rgb(1.0f), &mat.specular, &mat.textures.specular);

@@ -3,6 +3,7 @@
 // emissive shape also creates its area light.
 #include <cmath>
 #include <filesystem>
+#include <utility>
 
 #include "scene/io/json_scene_parts.h"
 #include "scene/mesh_io.h"
@@ -123,7 +124,8 @@ Transform readJsonTransform(JsonReader& r, const Json& v, const std::string& ptr
 
 namespace {
 
-const std::vector<std::string> kShapeTypes = {"obj", "ply", "rectangle", "cube", "sphere"};
+const std::vector<std::string> kShapeTypes = {"obj",    "ply",  "rectangle", "cube",
+                                              "sphere", "disk", "cylinder"};
 
 /// True if t maps spheres to spheres (rotation/reflection times a uniform scale); its
 /// scale factor goes to *scale.
@@ -174,6 +176,10 @@ void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
         keys.push_back("file");
     } else if (type == "sphere") {
         keys.insert(keys.end(), {"center", "radius"});
+    } else if (type == "disk") {
+        keys.push_back("flip_normals");
+    } else if (type == "cylinder") {
+        keys.insert(keys.end(), {"p0", "p1", "radius", "flip_normals"});
     } else if (type != "rectangle" && type != "cube") {
         r.error(typePtr, "unknown shape type '" + type + "'" + didYouMean(type, kShapeTypes) +
                              "; valid types: " + joinNames(kShapeTypes));
@@ -273,6 +279,29 @@ void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
             shape.mesh = makeRectangle();
         } else if (type == "cube") {
             shape.mesh = makeCube();
+        } else if (type == "disk") {
+            shape.mesh = makeDisk();
+        } else if (type == "cylinder") {
+            // Mitsuba's cylinder: axis p0 -> p1, open (no caps); the transform may not make
+            // it elliptic (docs/scene-format.md).
+            const Vec3 p0 = r.getVec3(v, ptr, "p0", Presence::Optional, Vec3(0.0f));
+            const Vec3 p1 = r.getVec3(v, ptr, "p1", Presence::Optional, Vec3(0, 0, 1));
+            const float radius =
+                r.getNumber(v, ptr, "radius", Presence::Optional, NumberRange::positive(), 1.0f);
+            if (!(length(p1 - p0) > 0.0f)) {
+                r.error(jsonPointerChild(ptr, v.contains("p1") ? "p1" : "p0"),
+                        "p0 and p1 are the same point: they must differ (they give the "
+                        "cylinder's axis)");
+            } else if (radius > 0.0f) {
+                const Transform placed = toWorld * cylinderPlacement(p0, p1, radius);
+                if (!keepsCylinderCircular(placed))
+                    r.error(jsonPointerChild(ptr, "transform"),
+                            "a cylinder's transform must keep it circular: rotations, "
+                            "translations and scales that are the same in every direction "
+                            "across its axis, no mirroring");
+                shape.mesh = makeCylinder();
+                toWorld = placed;
+            }
         } else {
             std::string file = r.getString(v, ptr, "file", Presence::Required);
             std::string filePtr = jsonPointerChild(ptr, "file");
@@ -302,6 +331,12 @@ void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
             }
         }
         if (shape.mesh.triangleCount() > 0) {
+            if (r.getBool(v, ptr, "flip_normals", false)) {
+                // Turns the normals (and the emitting side) inwards, as Mitsuba's flip_normals.
+                for (size_t t = 0; t + 2 < shape.mesh.indices.size(); t += 3)
+                    std::swap(shape.mesh.indices[t + 1], shape.mesh.indices[t + 2]);
+                for (Vec3& n : shape.mesh.normals) n = -n;
+            }
             transformMesh(shape.mesh, toWorld);
             float area = meshArea(shape.mesh);
             if (!(area > 0.0f) || !std::isfinite(area))

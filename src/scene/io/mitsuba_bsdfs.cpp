@@ -218,18 +218,11 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
         m.type = MaterialType::Diffuse;
         readReflectance(b, o, "reflectance", Rgb(0.5f), &m.diffuse, &m.textures.diffuse);
     } else if (o.type == "conductor") {
-        const bool fresnel = readConductorIor(b, o, m);
-        m.specular = r.getColor(o, "specular_reflectance", Rgb(1.0f), ColorUse::Reflectance);
-        if (fresnel) {
-            const XmlProperty* p = o.find("material") ? o.find("material")
-                                   : o.find("eta")    ? o.find("eta")
-                                                      : o.find("k");
-            r.error(p->pos, o.label() +
-                                ": a smooth conductor with a Fresnel term (a named material or "
-                                "eta/k) is not supported; only material \"none\" (a perfect "
-                                "mirror) is (use roughconductor for a metal)");
-        }
+        // Mitsuba's smooth conductor: specular_reflectance x F_conductor(cos theta_i, eta + i k);
+        // material "none" (the default, no eta/k) is a perfect mirror (F = 1).
         m.type = MaterialType::Mirror;
+        m.conductorFresnel = readConductorIor(b, o, m);
+        m.specular = r.getColor(o, "specular_reflectance", Rgb(1.0f), ColorUse::Reflectance);
     } else if (o.type == "roughconductor") {
         m.type = MaterialType::RoughConductor;
         m.alpha = readMicrofacetAlpha(r, o, &m.distribution);

@@ -17,8 +17,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kShapes = {"obj",       "ply",  "serialized",
-                                          "rectangle", "cube", "sphere"};
+const std::vector<std::string> kShapes = {"obj",    "ply",  "serialized", "rectangle",  "cube",
+                                          "sphere", "disk", "cylinder",   "shapegroup", "instance"};
 const std::vector<std::string> kEmitters = {"area",        "point",    "spot",
                                             "directional", "constant", "envmap"};
 const std::vector<std::string> kIntegrators = {"path",   "volpath", "volpathmis",
@@ -38,6 +38,25 @@ float similarityScale(const Transform& t) {
     return s;
 }
 
+/// A shape's geometry: a triangle mesh, or a sphere's centre and radius.
+struct ShapeGeometry {
+    TriangleMesh mesh;
+    bool isSphere = false;
+    Vec3 center;
+    float radius = 1.0f;
+};
+
+/// The shapes of a `shapegroup`, built once in the group's space and copied per instance.
+struct ShapeGroupShapes {
+    struct Member {
+        std::string name;
+        ShapeGeometry geometry;
+        int materialId = -1;
+    };
+    bool ok = false;  ///< false: the group had errors (reported once, where it is defined)
+    std::vector<Member> members;
+};
+
 class Builder {
   public:
     Builder(MitsubaBuild& b) : b_(b), r_(b.r) {}
@@ -48,6 +67,9 @@ class Builder {
     void readSensor(const XmlObject& o);
     void readFilm(const XmlObject& o, int* w, int* h);
     void readShape(const XmlObject& o);
+    void readGeometry(const XmlObject& o, ShapeGeometry* g);
+    const ShapeGroupShapes& shapeGroup(const XmlObject& group);
+    void readInstance(const XmlObject& o);
     void readEmitter(const XmlObject& o);
     int defaultMaterial();
     int blackMaterial();
@@ -60,6 +82,8 @@ class Builder {
     int defaultMaterial_ = -1;
     int blackMaterial_ = -1;
     const XmlObject* envObject_ = nullptr;
+    std::map<const XmlObject*, ShapeGroupShapes> groups_;
+    int instanceCount_ = 0;
 };
 
 void Builder::build() {
@@ -348,22 +372,14 @@ int Builder::blackMaterial() {
     return oneSidedDiffuse(0.0f, "emitter default (black diffuse)", &blackMaterial_);
 }
 
-void Builder::readShape(const XmlObject& o) {
-    const size_t before = r_.errorCount();
-    bool known = false;
-    for (const auto& k : kShapes) known = known || o.type == k;
-    if (!known) {
-        r_.unsupportedPlugin(o, kShapes);
-        return;
-    }
-    const std::string name =
-        o.id.empty() ? o.type + " " + std::to_string(b_.scene.shapes.size()) : o.id;
+// The geometry of a shape plugin in world space (or, for a shape in a shapegroup, in the
+// group's space): its mesh, or the centre and radius of a sphere.
+void Builder::readGeometry(const XmlObject& o, ShapeGeometry* g) {
     Transform toWorld = r_.getTransform(o, "to_world");
     bool flipNormals = r_.getBool(o, "flip_normals", false);
-    TriangleMesh mesh;
-    bool isSphere = false;
-    Vec3 center;
-    float radius = 1.0f;
+    TriangleMesh& mesh = g->mesh;
+    const XmlProperty* toWorldProp = o.find("to_world");
+    const XmlPos& toWorldPos = toWorldProp ? toWorldProp->pos : o.pos;
     if (o.type == "obj" || o.type == "ply" || o.type == "serialized") {
         std::string file = r_.getString(o, "filename", "");
         bool faceNormals = r_.getBool(o, "face_normals", false);
@@ -396,24 +412,57 @@ void Builder::readShape(const XmlObject& o) {
         mesh = makeRectangle();
     } else if (o.type == "cube") {
         mesh = makeCube();
+    } else if (o.type == "disk") {
+        // Mitsuba's disk: the unit disk in z = 0 with normal +z, any to_world except one that
+        // shears its plane (Mitsuba refuses those); a non-uniform scale makes an ellipse,
+        // which the transformed mesh represents exactly.
+        mesh = makeDisk();
+        const Vec3 du = toWorld.vector(Vec3(1, 0, 0)), dv = toWorld.vector(Vec3(0, 1, 0));
+        if (std::fabs(dot(du, dv)) > 1e-4f * length(du) * length(dv))
+            r_.error(toWorldPos, o.label() +
+                                     ": to_world shears the disk (its x and y axes are not "
+                                     "perpendicular after it), which Mitsuba's disk rejects");
+    } else if (o.type == "cylinder") {
+        // Mitsuba's cylinder: the unit cylinder (radius 1, z in [0, 1]) placed by
+        // translate(p0) * frame(p1 - p0) * scale(radius, radius, |p1 - p0|), then to_world.
+        // The frame is Mitsuba's (Duff et al. 2017, unibeam's Frame), which fixes where
+        // u = 0 lies around the axis.
+        const Vec3 p0 = r_.getPoint(o, "p0", Vec3(0.0f)), p1 = r_.getPoint(o, "p1", Vec3(0, 0, 1));
+        const float radius = r_.getFloatIn(o, "radius", 1.0f, 0.0f, kInf, true);
+        const float len = length(p1 - p0);
+        if (!(len > 0.0f)) {
+            r_.error(o.find("p1") ? o.find("p1")->pos : o.pos,
+                     o.label() + ": p0 and p1 must differ (they give the cylinder's axis)");
+        } else if (radius > 0.0f) {
+            toWorld = toWorld * cylinderPlacement(p0, p1, radius);
+            // Mitsuba keeps the cylinder circular: it takes the radius from one axis and warns
+            // about shear or unequal scales across the axis. unibeam refuses those instead of
+            // rendering a different shape, and mirroring (Mitsuba's normals would point in).
+            if (!keepsCylinderCircular(toWorld))
+                r_.error(toWorldPos, o.label() +
+                                         ": to_world must keep the cylinder circular: a "
+                                         "rotation, translation and scale, the scale the same "
+                                         "in every direction across the axis, and no "
+                                         "mirroring");
+            mesh = makeCylinder();
+        }
     } else {
-        isSphere = true;
-        center = r_.getPoint(o, "center", Vec3(0.0f));
-        radius = r_.getFloatIn(o, "radius", 1.0f, 0.0f, kInf, true);
+        g->isSphere = true;
+        Vec3 center = r_.getPoint(o, "center", Vec3(0.0f));
+        float radius = r_.getFloatIn(o, "radius", 1.0f, 0.0f, kInf, true);
         float s = similarityScale(toWorld);
         if (!(s > 0)) {
-            const XmlProperty* p = o.find("to_world");
-            r_.error(p ? p->pos : o.pos, o.label() +
-                                             ": a sphere's to_world must be a rotation, "
-                                             "translation and uniform scale");
+            r_.error(toWorldPos, o.label() +
+                                     ": a sphere's to_world must be a rotation, "
+                                     "translation and uniform scale");
         }
-        center = toWorld.point(center);
-        radius *= s;
+        g->center = toWorld.point(center);
+        g->radius = radius * s;
         if (flipNormals)
             r_.error(o.find("flip_normals")->pos,
                      o.label() + ": flip_normals is not supported for spheres");
     }
-    if (!isSphere && !mesh.indices.empty()) {
+    if (!g->isSphere && !mesh.indices.empty()) {
         if (flipNormals) {
             for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
                 std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
@@ -421,6 +470,37 @@ void Builder::readShape(const XmlObject& o) {
         }
         transformMesh(mesh, toWorld);
     }
+}
+
+void Builder::readShape(const XmlObject& o) {
+    const size_t before = r_.errorCount();
+    bool known = false;
+    for (const auto& k : kShapes) known = known || o.type == k;
+    if (!known) {
+        r_.unsupportedPlugin(o, kShapes);
+        return;
+    }
+    if (o.type == "shapegroup") {
+        // Not rendered itself: validated (and its shapes built) once, copied per instance.
+        shapeGroup(o);
+        if (o.id.empty())
+            r_.warning(o.pos, o.label() +
+                                  " has no id: no instance can reference it, so it is not "
+                                  "rendered");
+        return;
+    }
+    if (o.type == "instance") {
+        readInstance(o);
+        return;
+    }
+    const std::string name =
+        o.id.empty() ? o.type + " " + std::to_string(b_.scene.shapes.size()) : o.id;
+    ShapeGeometry g;
+    readGeometry(o, &g);
+    TriangleMesh& mesh = g.mesh;
+    const bool isSphere = g.isSphere;
+    const Vec3 center = g.center;
+    const float radius = g.radius;
 
     const XmlObject* em = r_.child(o, "emitter", "");
     int materialId = -2;
@@ -492,6 +572,117 @@ void Builder::readShape(const XmlObject& o) {
     if (boundary) {
         b_.scene.setMediumBoundary(shapeId, interiorId, 0, imaginary);
         b_.scene.setExteriorMedium(shapeId, exteriorId);
+    }
+}
+
+// Mitsuba's shapegroup holds shapes that only appear through instances. unibeam flattens
+// instancing: the members are built once here (in the group's space) and every instance adds
+// transformed copies of them (docs/mitsuba.md). As in Mitsuba, a member cannot be a
+// shapegroup or an instance, nor carry an emitter; unibeam also refuses media on members.
+const ShapeGroupShapes& Builder::shapeGroup(const XmlObject& group) {
+    auto found = groups_.find(&group);
+    if (found != groups_.end()) return found->second;
+    ShapeGroupShapes& out = groups_[&group];
+    const size_t before = r_.errorCount();
+    const std::string groupName = group.id.empty() ? std::string("shapegroup") : group.id;
+    int index = 0;
+    for (const XmlObject* member : r_.children(group, "shape")) {
+        const XmlObject& o = *member;
+        ++index;
+        if (o.type == "shapegroup" || o.type == "instance") {
+            r_.error(o.pos, group.label() + ": a shapegroup cannot hold a " + o.type +
+                                " (nested instancing is not permitted, as in Mitsuba)");
+            continue;
+        }
+        bool known = false;
+        for (const auto& k : kShapes) known = known || o.type == k;
+        if (!known) {
+            r_.unsupportedPlugin(o, kShapes);
+            continue;
+        }
+        const size_t memberBefore = r_.errorCount();
+        ShapeGroupShapes::Member m;
+        m.name = o.id.empty() ? o.type + " " + std::to_string(index - 1) : o.id;
+        readGeometry(o, &m.geometry);
+        if (const XmlObject* bsdf = r_.child(o, "bsdf", ""))
+            m.materialId = buildMitsubaBsdf(b_, *bsdf);
+        else
+            m.materialId = defaultMaterial();
+        if (r_.child(o, "emitter", ""))
+            r_.error(r_.lastChildPos(), o.label() + " in " + group.label() +
+                                            ": instancing of emitters is not supported (nor "
+                                            "in Mitsuba)");
+        for (const char* side : {"interior", "exterior"})
+            if (r_.child(o, "medium", side))
+                r_.error(r_.lastChildPos(), o.label() + " in " + group.label() +
+                                                ": a shape in a shapegroup cannot be a medium "
+                                                "boundary (not supported)");
+        r_.checkUnused(o);
+        if (r_.errorCount() != memberBefore) continue;
+        if (m.materialId == -1) {
+            r_.warning(o.pos, o.label() + " '" + m.name + "' in shapegroup '" + groupName +
+                                  "' has a null BSDF and no medium: it is invisible and is "
+                                  "left out");
+            continue;
+        }
+        out.members.push_back(std::move(m));
+    }
+    r_.checkUnused(group);
+    out.ok = r_.errorCount() == before;
+    return out;
+}
+
+void Builder::readInstance(const XmlObject& o) {
+    const size_t before = r_.errorCount();
+    const std::string name = o.id.empty() ? "instance " + std::to_string(instanceCount_) : o.id;
+    ++instanceCount_;
+    const Transform toWorld = r_.getTransform(o, "to_world");
+    const XmlProperty* toWorldProp = o.find("to_world");
+    const XmlObject* group = nullptr;
+    for (const XmlChild& c : o.children) {
+        const XmlObject& obj = *c.object;
+        c.used = true;
+        const bool isRef = c.pos.file != obj.pos.file || c.pos.line != obj.pos.line ||
+                           c.pos.column != obj.pos.column;
+        const std::string what = isRef ? "<ref id=\"" + obj.id + "\"> names " + obj.label() +
+                                             " (defined at " + obj.pos.file + ":" +
+                                             std::to_string(obj.pos.line) + ")"
+                                       : "nested " + obj.label();
+        if (obj.tag != "shape" || obj.type != "shapegroup")
+            r_.error(c.pos, o.label() + ": " + what + "; expected a shapegroup");
+        else if (group)
+            r_.error(c.pos, o.label() + ": " + what +
+                                ", a second shapegroup (an instance references exactly one)");
+        else
+            group = &obj;
+    }
+    if (!group && r_.errorCount() == before)
+        r_.error(o.pos, o.label() +
+                            ": needs the shapegroup it instantiates (<ref id=\"...\"/> to a "
+                            "<shape type=\"shapegroup\" id=\"...\">)");
+    r_.checkUnused(o);
+    if (r_.errorCount() != before || !group) return;
+    const ShapeGroupShapes& shapes = shapeGroup(*group);
+    if (!shapes.ok) return;  // its errors were reported with the group
+    const float scale = similarityScale(toWorld);
+    for (const ShapeGroupShapes::Member& m : shapes.members) {
+        const std::string memberName = name + "/" + m.name;
+        if (m.geometry.isSphere) {
+            if (!(scale > 0)) {
+                r_.error(toWorldProp ? toWorldProp->pos : o.pos,
+                         o.label() +
+                             ": to_world must be a rotation, translation and uniform "
+                             "scale, since shapegroup member '" +
+                             m.name + "' is a sphere");
+                return;
+            }
+            b_.scene.addSphere(toWorld.point(m.geometry.center), m.geometry.radius * scale,
+                               m.materialId, -1, memberName);
+        } else {
+            TriangleMesh mesh = m.geometry.mesh;
+            transformMesh(mesh, toWorld);
+            b_.scene.addMesh(std::move(mesh), m.materialId, -1, memberName);
+        }
     }
 }
 
