@@ -39,10 +39,6 @@ namespace ub {
 
 namespace {
 
-std::string rgbText(const Rgb& c) {
-    return formatNumber(c.x) + " " + formatNumber(c.y) + " " + formatNumber(c.z);
-}
-
 struct Context {
     std::string objPath, auxPath;
     Diagnostics& diags;
