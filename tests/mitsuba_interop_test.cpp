@@ -13,6 +13,7 @@
 #include "scene/io/mitsuba_loader.h"
 #include "scene/io/mitsuba_spectra.h"
 #include "scene/texture.h"
+#include "tests/support/mitsuba_text.h"
 #include "tests/support/vol_file.h"
 
 using namespace ub;
@@ -37,16 +38,11 @@ std::string scene(const std::string& film, const std::string& body = kLight,
 }
 
 std::unique_ptr<Scene> load(const std::string& text, std::vector<Diagnostic>* warnings = nullptr) {
-    return loadMitsubaSceneFromString(text, "scene.xml", ".", {}, warnings);
+    return test::loadMitsubaText(text, warnings);
 }
 
 std::string errorsOf(const std::string& text) {
-    try {
-        load(text);
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
+    return test::mitsubaErrorsOf(text);
 }
 
 }  // namespace

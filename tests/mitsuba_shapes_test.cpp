@@ -19,6 +19,7 @@
 #include "scene/io/mitsuba_loader.h"
 #include "scene/io/mitsuba_spectra.h"
 #include "scene/shapes.h"
+#include "tests/support/mitsuba_text.h"
 
 using namespace ub;
 namespace fs = std::filesystem;
@@ -42,16 +43,11 @@ std::string scene(const std::string& body) {
 }
 
 std::unique_ptr<Scene> load(const std::string& text) {
-    return loadMitsubaSceneFromString(text, "scene.xml", ".", {});
+    return test::loadMitsubaText(text);
 }
 
 std::string errorsOf(const std::string& text) {
-    try {
-        load(text);
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
+    return test::mitsubaErrorsOf(text);
 }
 
 void expectRgb(const Rgb& got, const Rgb& want) {
