@@ -117,6 +117,18 @@ fs::path prepare(const std::string& target, const std::string& data, const fs::p
                 ext + R"("}}}, "shapes": [{"type": "cube", "material": "m"}, )" + light + "]"));
         return dir / "scene.json";
     }
+    if (target == "fuzz_serialized_mesh") {
+        // The target picks shape index size % 3; a Mitsuba scene does so explicitly.
+        writeFile(dir / "mesh.serialized", data);
+        writeFile(dir / "scene.xml",
+                  "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"><film "
+                  "type=\"hdrfilm\"><integer name=\"width\" value=\"8\"/><integer "
+                  "name=\"height\" value=\"8\"/></film></sensor>\n<emitter "
+                  "type=\"constant\"/>\n<shape type=\"serialized\"><string name=\"filename\" "
+                  "value=\"mesh.serialized\"/><integer name=\"shape_index\" value=\"" +
+                      std::to_string(data.size() % 3) + "\"/></shape>\n</scene>\n");
+        return dir / "scene.xml";
+    }
     ADD_FAILURE() << "no way to give the CLI an input of target " << target;
     return {};
 }
@@ -227,6 +239,13 @@ const std::vector<Case> kCases = {
      {"mesh.obj:10:4: error: at /shapes/0: face corner '3/' ends with '/' (expected v, v/vt, "
       "v//vn or v/vt/vn)",
       "scene.json:3:", "mesh file 'mesh.obj' could not be loaded"}},
+    // UBSan (pointer overflow): a shape dictionary entry of 2^64 - 1 wrapped the bound check
+    // (offset + 4 > end) and was used as the shape's offset.
+    {"fuzz_serialized_mesh",
+     "dictionary-offset-wraps.serialized",
+     2,
+     {"invalid .serialized file: the dictionary gives shape 1 the offset 18446744073709551615, "
+      "outside the file's shape data"}},
     // A seed (tests/data/mitsuba/media.xml with its include): UBSan's alignment check in
     // oneTBB's concurrent_hash_map under OpenVDB (fuzz/ubsan_ignorelist.txt); it loads.
     {"fuzz_mitsuba_scene", "tbb-hash-map-sentinel-downcast.xml", 0, {}},

@@ -297,7 +297,8 @@ TriangleMesh loadSerializedMesh(const std::string& path, int shapeIndex, bool fa
                               (count > 0 ? " (0.." + std::to_string(count - 1) + ")" : "")};
             const size_t at = file.size() - 4 - entry * (count - uint32_t(shapeIndex));
             const uint64_t offset = version == 4 ? le64(&file[at]) : le32(&file[at]);
-            if (offset + 4 > at)
+            // (offset + 4 would wrap for an offset near 2^64: compared without the sum.)
+            if (offset > at || at - offset < 4)
                 throw Failure{"the dictionary gives shape " + std::to_string(shapeIndex) +
                               " the offset " + std::to_string(offset) +
                               ", outside the file's shape data"};
