@@ -48,6 +48,18 @@ std::unique_ptr<Scene> smoke32() {
                                    std::string(UNIBEAM_SOURCE_DIR) + "/scenes");
 }
 
+/// upbp on smoke32() with the host backend: radii that find pairs at 32x32, 256 beam paths.
+RenderOptions smokeOptions() {
+    RenderOptions opt;
+    opt.algorithm = "upbp";
+    opt.backend = "host";
+    opt.maxPathLength = 6;
+    opt.radiusPP3D = 0.04f;
+    opt.radiusPB2D = opt.radiusBP2D = opt.radiusBB1D = 0.02f;
+    opt.beamPaths = 256;
+    return opt;
+}
+
 RenderOptions pp3dOptions(const std::string& backend) {
     RenderOptions opt;
     opt.algorithm = "upbp:bpt+pp3d";
@@ -202,13 +214,7 @@ TEST(OpenClEstimate, WholeRenderAgreesBetweenBackendsInAGridMedium) {
     auto scene = smoke32();
     ASSERT_TRUE(scene);
     ASSERT_EQ(scene->media[0].type, MediumType::kGrid);
-    RenderOptions opt;
-    opt.algorithm = "upbp";
-    opt.backend = "host";
-    opt.maxPathLength = 6;
-    opt.radiusPP3D = 0.04f;
-    opt.radiusPB2D = opt.radiusBP2D = opt.radiusBB1D = 0.02f;
-    opt.beamPaths = 256;
+    RenderOptions opt = smokeOptions();
     auto host = makeIntegrator(*scene, opt);
     opt.backend = "opencl";
     auto cl = makeIntegrator(*scene, opt);
@@ -226,13 +232,7 @@ TEST(OpenClEstimate, WholeRenderAgreesBetweenBackendsInAGridMedium) {
 TEST(OpenClEstimate, BeamKernelsInAGridMediumEqualTheirTwins) {
     auto scene = smoke32();
     ASSERT_TRUE(scene);
-    RenderOptions opt;
-    opt.algorithm = "upbp";
-    opt.backend = "host";
-    opt.maxPathLength = 6;
-    opt.radiusPP3D = 0.04f;
-    opt.radiusPB2D = opt.radiusBP2D = opt.radiusBB1D = 0.02f;
-    opt.beamPaths = 256;
+    RenderOptions opt = smokeOptions();
     VertexCM engine(*scene, opt);
     Image img;
     engine.renderIteration(1, img);
