@@ -4,7 +4,9 @@
 //    and filter_type; the sigma_t gridvolume reads a named .vdb grid; errors name
 //    file:line:col;
 //  * JSON: "albedo_grid", "albedo_file", "albedo_filter" of heterogeneous media and their
-//    errors at the JSON pointer of the key.
+//    errors at the JSON pointer of the key;
+//  * chromatic extinction: a 3-channel sigma_t (.vol, vec3 .vdb grid, a spectrally varying
+//    constant with an albedo grid) in both formats.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -235,11 +237,13 @@ TEST(MitsubaAlbedo, VdbGridNamesForSigmaTAndAlbedo) {
                          "present: 'albedo' (vec3s), 'density' (float), 'sigma' (float), "
                          "'tint' (float)"))
         << e;
-    // sigma_t needs a float grid.
-    e = xmlErrors(
+    // A vec3 grid as sigma_t: a chromatic extinction, one density per channel.
+    s = loadXml(
         xmlScene(heterogeneous(gridVolume("sigma_t", "media.vdb", named + "albedo\"/>"), "")),
         dir.path.string());
-    EXPECT_TRUE(contains(e, "expected a float (density) grid")) << e;
+    ASSERT_TRUE(s->media[0].chromatic());
+    expectRgbNear(mediumCoefficientsAt(s->media[0], Vec3(0.5f)).sigmaT, Rgb(0.5f, 0.25f, 1.0f),
+                  "vec3 sigma_t");
 }
 
 TEST(MitsubaAlbedo, UnsupportedAlbedoVolumesAreErrorsWithPositions) {
@@ -255,12 +259,14 @@ TEST(MitsubaAlbedo, UnsupportedAlbedoVolumesAreErrorsWithPositions) {
                                 ": error: <volume type=\"gridvolume\">: filter_type 'cubic' is "
                                 "not one of trilinear, nearest"))
         << e;
-    // An extinction grid with 3 channels.
-    text = xmlScene(heterogeneous(gridVolume("sigma_t", "rgb_sigma.vol"), ""));
+    // An extinction grid with 3 channels and the hint that sigma_t is grey.
+    text = "<medium id=\"m\" type=\"heterogeneous\">" + gridVolume("sigma_t", "rgb_sigma.vol") +
+           "<boolean name=\"has_spectral_extinction\" value=\"false\"/></medium>";
+    text = xmlScene(text);
     e = xmlErrors(text, dir.path.string());
-    EXPECT_TRUE(contains(e, where(text, "<string name=\"filename\"") +
-                                ": error: <volume type=\"gridvolume\">: 'rgb_sigma.vol' has 3 "
-                                "channels; an extinction grid needs 1"))
+    EXPECT_TRUE(contains(e, where(text, "<boolean name=\"has_spectral_extinction\"") +
+                                ": error: <medium type=\"heterogeneous\">: "
+                                "has_spectral_extinction = false with a 3-channel sigma_t grid"))
         << e;
     // Albedo values above 1.
     text = xmlScene(heterogeneous(sigma, gridVolume("albedo", "hot.vol")));
@@ -275,23 +281,35 @@ TEST(MitsubaAlbedo, UnsupportedAlbedoVolumesAreErrorsWithPositions) {
                                 ": error: <volume type=\"gridvolume\">: grid_name applies to .vdb "
                                 "files only"))
         << e;
-    // An albedo volume in a homogeneous medium, or with a constant sigma_t.
-    text = xmlScene("<medium id=\"m\" type=\"homogeneous\">" + gridVolume("albedo", "albedo.vol") +
-                    "</medium>");
-    e = xmlErrors(text, dir.path.string());
-    EXPECT_TRUE(contains(e, where(text, "<volume name=\"albedo\"") +
-                                ": error: <medium type=\"homogeneous\">: a spatially varying "
-                                "albedo (<volume type=\"gridvolume\">) needs a heterogeneous "
-                                "medium"))
-        << e;
-    text = xmlScene(heterogeneous("<rgb name=\"sigma_t\" value=\"1, 2, 3\"/>",
-                                  gridVolume("albedo", "albedo.vol")));
-    e = xmlErrors(text, dir.path.string());
-    EXPECT_TRUE(contains(e, where(text, "<volume name=\"albedo\"") +
-                                ": error: <medium type=\"heterogeneous\">: a spatially varying "
-                                "albedo (<volume type=\"gridvolume\">) with a spectrally varying "
-                                "constant sigma_t is not supported"))
-        << e;
+    // An albedo volume in a homogeneous medium (Mitsuba's homogeneous takes a volume albedo):
+    // a grid medium of constant density (sigma_t 2 x scale 1.5) with that albedo grid.
+    {
+        auto sc = loadXml(xmlScene("<medium id=\"m\" type=\"homogeneous\"><float name=\"sigma_t\" "
+                                   "value=\"2\"/><float name=\"scale\" value=\"1.5\"/>" +
+                                   gridVolume("albedo", "albedo.vol",
+                                              "<string name=\"filter_type\" value=\"nearest\"/>") +
+                                   "</medium>"),
+                          dir.path.string());
+        const Medium& m = sc->media[0];
+        ASSERT_EQ(m.type, MediumType::kGrid);
+        ASSERT_TRUE(m.albedoGrid);
+        const MediumCoefficients c = mediumCoefficientsAt(m, Vec3(0.75f, 0.5f, 0.5f));
+        expectRgbNear(c.sigmaT, Rgb(3.0f), "homogeneous sigma_t");
+        expectRgbNear(c.sigmaS, Rgb(0.7f, 0.8f, 0.9f) * 3.0f, "homogeneous sigma_s");
+    }
+    // With a spectrally varying constant sigma_t: one constant grid per channel.
+    {
+        auto sc = loadXml(xmlScene(heterogeneous("<rgb name=\"sigma_t\" value=\"1, 2, 3\"/>",
+                                                 gridVolume("albedo", "albedo.vol"))),
+                          dir.path.string());
+        const Medium& m = sc->media[0];
+        ASSERT_TRUE(m.chromatic());
+        ASSERT_TRUE(m.albedoGrid);
+        for (const Vec3& p : {Vec3(0.25f, 0.5f, 0.5f), Vec3(-3, 7, 2)})
+            expectRgbNear(mediumCoefficientsAt(m, p).sigmaT, Rgb(1, 2, 3), "constant sigma_t");
+        const Rgb T = transmittance(m, Vec3(-1.0f, 0.5f, 0.5f), Vec3(1, 0, 0), 0.5f);
+        expectRgbNear(T, Rgb(std::exp(-0.5f), std::exp(-1.0f), std::exp(-1.5f)), "T");
+    }
     // An unknown volume plugin lists the supported ones.
     text = xmlScene(heterogeneous(sigma, "<volume name=\"albedo\" type=\"noise\"/>"));
     e = xmlErrors(text, dir.path.string());
@@ -407,4 +425,57 @@ TEST(JsonAlbedo, AlbedoGridErrorsNameTheKey) {
     EXPECT_TRUE(contains(e, "at /media/smoke/albedo_file: VDB file 'missing.vdb' not found")) << e;
     e = err(R"({"type": "heterogeneous", "file": "smoke.vdb", "albedo_grid": 3})");
     EXPECT_TRUE(contains(e, "/media/smoke/albedo_grid")) << e;
+}
+
+// ---- Chromatic extinction (3-channel sigma_t grids) -------------------------------------
+
+// A 3-channel .vol as sigma_t is one density grid per channel; a channel that is zero
+// everywhere is an empty channel (transmittance 1), not an error.
+TEST(MitsubaChromatic, ThreeChannelVolIsAChromaticExtinction) {
+    ScratchDir dir;
+    writeBinaryFile(dir / "rgb.vol", volBytes(2, 1, 1, 3, {0.5f, 1.0f, 2.0f, 0.0f, 3.0f, 0.25f}));
+    writeBinaryFile(dir / "no_blue.vol",
+                    volBytes(2, 1, 1, 3, {1.0f, 2.0f, 0.0f, 3.0f, 4.0f, 0.0f}));
+    const std::string nearest = "<string name=\"filter_type\" value=\"nearest\"/>";
+    auto s = loadXml(
+        xmlScene(heterogeneous(
+            gridVolume("sigma_t", "rgb.vol", nearest) + "<float name=\"scale\" value=\"2\"/>", "")),
+        dir.path.string());
+    const Medium& m = s->media[0];
+    ASSERT_TRUE(m.chromatic());
+    // The .vol spans the unit cube: voxel 0 is x in [0, 0.5), voxel 1 [0.5, 1).
+    expectRgbNear(mediumCoefficientsAt(m, Vec3(0.25f, 0.5f, 0.5f)).sigmaT, Rgb(1, 2, 4), "voxel 0");
+    expectRgbNear(mediumCoefficientsAt(m, Vec3(0.75f, 0.5f, 0.5f)).sigmaT, Rgb(0, 6, 0.5f),
+                  "voxel 1");
+    // Across both voxels (0.5 each): tau = 2 * 0.5 * (v0 + v1) per channel.
+    const Rgb T = transmittance(m, Vec3(-1.0f, 0.5f, 0.5f), Vec3(1, 0, 0), 3.0f);
+    expectRgbNear(T, Rgb(std::exp(-0.5f), std::exp(-4.0f), std::exp(-2.25f)), "T");
+
+    s = loadXml(xmlScene(heterogeneous(gridVolume("sigma_t", "no_blue.vol", nearest), "")),
+                dir.path.string());
+    ASSERT_TRUE(s->media[0].chromatic());
+    const Rgb T2 = transmittance(s->media[0], Vec3(-1.0f, 0.5f, 0.5f), Vec3(1, 0, 0), 3.0f);
+    expectRgbNear(T2, Rgb(std::exp(-2.0f), std::exp(-3.0f), 1.0f), "no blue");
+    // Trilinear (Mitsuba's default) reads the same grid as chromatic too.
+    s = loadXml(xmlScene(heterogeneous(gridVolume("sigma_t", "rgb.vol"), "")), dir.path.string());
+    EXPECT_TRUE(s->media[0].chromatic());
+    EXPECT_EQ(s->media[0].filter, GridFilter::kTrilinear);
+}
+
+// JSON: a vec3 grid named by "grid" is a chromatic extinction.
+TEST(JsonChromatic, Vec3DensityGridIsAChromaticExtinction) {
+    ScratchDir dir;
+    writeJsonVdbs(dir);
+    auto s = loadJsonSceneFromString(
+        jsonScene(R"({"type": "heterogeneous", "file": "smoke.vdb", "grid": "albedo",
+                      "density_scale": 2})"),
+        "scene.json", dir.path.string());
+    const Medium& m = s->media[0];
+    ASSERT_TRUE(m.chromatic());
+    expectRgbNear(mediumCoefficientsAt(m, Vec3(1.0f, 0.0f, 1.0f)).sigmaT, Rgb(1.0f, 0.5f, 2.0f),
+                  "vec3 density");
+    // A float grid stays grey.
+    s = loadJsonSceneFromString(jsonScene(R"({"type": "heterogeneous", "file": "smoke.vdb"})"),
+                                "scene.json", dir.path.string());
+    EXPECT_FALSE(s->media[0].chromatic());
 }

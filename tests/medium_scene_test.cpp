@@ -313,7 +313,10 @@ TEST(MediaJson, VdbFileErrorsNameFileAndGrid) {
         auto vec = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
         vec->setName("velocity");
         vec->tree().setValue(openvdb::Coord(0, 0, 0), openvdb::Vec3s(1.0f));
-        openvdb::GridPtrVec grids{vec};
+        auto labels = openvdb::Int32Grid::create(0);
+        labels->setName("labels");
+        labels->tree().setValue(openvdb::Coord(0, 0, 0), 7);
+        openvdb::GridPtrVec grids{vec, labels};
         openvdb::io::File((tmp.path / "vector.vdb").string()).write(grids);
     }
     auto scene = [](const std::string& file, const std::string& grid) {
@@ -328,8 +331,11 @@ TEST(MediaJson, VdbFileErrorsNameFileAndGrid) {
     EXPECT_TRUE(contains(err, "not a readable OpenVDB file")) << err;
     err = allErrors(scene("ok.vdb", "smoke"), base);
     EXPECT_TRUE(contains(err, "no grid of that name in the file; grids present: 'density'")) << err;
-    err = allErrors(scene("vector.vdb", "velocity"), base);
-    EXPECT_TRUE(contains(err, "expected a float (density) grid")) << err;
+    // A vec3 grid is a chromatic density (one per channel); an int grid is neither.
+    EXPECT_EQ(allErrors(scene("vector.vdb", "velocity"), base), "");
+    err = allErrors(scene("vector.vdb", "labels"), base);
+    EXPECT_TRUE(contains(err, "expected a float (1 channel) or vec3s (3 channels) density grid"))
+        << err;
     err = allErrors(scene("missing.vdb", "density"), base);
     EXPECT_TRUE(contains(err, "VDB file 'missing.vdb' not found")) << err;
 }

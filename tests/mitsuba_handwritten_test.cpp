@@ -61,6 +61,8 @@ std::string caseName(const ::testing::TestParamInfo<HandCase>& info) {
 // vpt and vbpt would render pt's and bpt's images exactly (the same random numbers: measured
 // identical statistics) and are not repeated; lt alone cannot see the mirrors from the camera
 // (delta reflections toward a pinhole), which Mitsuba's path renders.
+// chromatic.xml (3-channel sigma_t grids, trilinear and nearest): vpt, vbpt and upbp (every
+// estimator; the beam estimators evaluate the chromatic grids per pair on the host).
 // interop_ptracer.xml: Mitsuba's ptracer (unibeam's lt) with the default tent, whose border
 // pixels Mitsuba does not renormalise (PixelFilterBorder::kPartitionOfUnity; with the
 // renormalised filter lt is 15-20% brighter than the reference along the left and right
@@ -91,6 +93,9 @@ const HandCase kCases[] = {
     {"conductor", "bpt", 256},
     {"conductor", "vcm", 256},
     {"conductor", "upbp", 128},
+    {"chromatic", "vpt", 256},
+    {"chromatic", "vbpt", 128},
+    {"chromatic", "upbp", 64},
 };
 
 class MitsubaHandWritten : public ::testing::TestWithParam<HandCase> {};
@@ -191,4 +196,20 @@ TEST(MitsubaHandWrittenPower, InstanceTransformIsDistinguished) {
     const test::ReferenceCheck check =
         checkAgainst("instancing", *scene, "pt", 512, "instancing pt, instance not mirrored");
     EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the mirroring";
+}
+
+// Power of the chromatic check: the same scene with the red channel's extinction in every
+// channel (a grey sigma_t, what the loader could do with a 3-channel grid) fails.
+TEST(MitsubaHandWrittenPower, GreyExtinctionIsDistinguishedFromChromatic) {
+    std::unique_ptr<Scene> scene = loadMitsubaScene(kDir + "/chromatic.xml", {{"res", "48"}});
+    int chromatic = 0;
+    for (Medium& m : scene->media)
+        if (m.chromatic()) {
+            m.gridG = m.gridB = nullptr;
+            ++chromatic;
+        }
+    ASSERT_EQ(chromatic, 2);
+    const test::ReferenceCheck check =
+        checkAgainst("chromatic", *scene, "vpt", 256, "chromatic vpt with a grey sigma_t");
+    EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see chromatic extinction";
 }

@@ -7,8 +7,9 @@ SCENE_ref_var.exr (per-sample variance, estimated from the spread of batch means
 var_sample = B * var(batch means of B samples)), 48x48, Mitsuba's `scalar_rgb` variant,
 and SCENE_ref.json with the Mitsuba version, sample count and batches.
 
-The scenes' inputs (textures/tiles.png, volumes/density.vol, volumes/albedo.vol) are
-written by --make-inputs, with Mitsuba's own writers.
+The scenes' inputs (textures/tiles.png, textures/stripes.jpg, volumes/density.vol,
+volumes/albedo.vol, volumes/chromatic.vol) are written by --make-inputs, with Mitsuba's own
+writers.
 
 Usage (not run by the tests; the outputs are committed):
     python3 -m venv venv && venv/bin/pip install mitsuba==3.9.1 numpy
@@ -69,6 +70,19 @@ def make_inputs(folder):
     mi.VolumeGrid(dens[..., None].astype(np.float32)).write(str(folder / "volumes" / "density.vol"))
     alb = np.stack([0.95 - 0.6 * Xv, 0.4 + 0.5 * Yv, 0.9 * np.ones_like(Xv)], -1)
     mi.VolumeGrid(alb.astype(np.float32)).write(str(folder / "volumes" / "albedo.vol"))
+    make_chromatic_volume(folder)
+
+
+def make_chromatic_volume(folder):
+    """A 12^3 sigma_t grid with 3 channels (chromatic.xml): the red, green and blue densities
+    peak in different places, and blue has a thin floor everywhere."""
+    n = 12
+    c = (np.arange(n) + 0.5) / n
+    Z, Y, X = np.meshgrid(c, c, c, indexing="ij")
+    blob = lambda x, y, z, w: np.exp(-((X - x) ** 2 + (Y - y) ** 2 + (Z - z) ** 2) / w)
+    st = np.stack([1.2 * blob(0.3, 0.5, 0.5, 0.05), 1.0 * blob(0.65, 0.4, 0.5, 0.06),
+                   0.6 * blob(0.5, 0.7, 0.4, 0.04) + 0.1], -1)
+    mi.VolumeGrid(st.astype(np.float32)).write(str(folder / "volumes" / "chromatic.vol"))
 
 
 def main():

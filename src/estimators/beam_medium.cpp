@@ -14,7 +14,9 @@ namespace ub {
 void BeamMedium::reset(const Scene& scene, const ub_beam& b) {
     medium_ = &scene.media[b.mediumId];
     beam_ = &b;
-    tabulated_ = medium_->type == MediumType::kGrid && medium_->filter != GridFilter::kTrilinear;
+    // The table is grey (one extinction per piece): chromatic grids evaluate per pair.
+    tabulated_ = medium_->type == MediumType::kGrid && medium_->filter != GridFilter::kTrilinear &&
+                 !medium_->chromatic();
     built_ = false;
     pieces_.clear();
     info_ = mediumInfo(*medium_);

@@ -9,7 +9,8 @@
 // from the beam start to t (scene/medium.h evalMediumSegment), up to the rounding
 // of the sum, at O(log pieces) instead of O(voxels). The beam kernels read the
 // photon beams' tables (flattenBeamTables) and build the query beams' own.
-// Homogeneous media use their closed form, trilinear grids evalMediumSegment.
+// Homogeneous media use their closed form, trilinear and chromatic grids
+// evalMediumSegment.
 #pragma once
 
 #include <vector>

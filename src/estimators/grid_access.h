@@ -26,10 +26,11 @@ static inline float ub_grid_probe(ub_grid_accessor* a, int i, int j, int k, int*
 
 namespace ub {
 
-/// Whether the kernels can evaluate grid medium m (nearest filtering, no albedo grid).
+/// Whether the kernels can evaluate grid medium m (nearest filtering, grey extinction, no
+/// albedo grid).
 inline bool gridMediumOnDevice(const Medium& m) {
     return m.type != MediumType::kHomogeneous && m.grid && m.filter == GridFilter::kNearest &&
-           !m.albedoGrid;
+           !m.albedoGrid && !m.chromatic();
 }
 
 /// The kernels' description of grid medium m, its grid at byte gridOffset of the buffer.

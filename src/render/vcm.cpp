@@ -194,8 +194,9 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
                                cl_->device().platform + ")" +
                                (beamKernels ? ""
                                             : ": pp3d and surf; pb2d, bp2d, bb1d on the host (a "
-                                              "grid medium with an albedo grid or trilinear "
-                                              "filtering has no beam kernel)") +
+                                              "grid medium with an albedo grid, chromatic "
+                                              "sigma_t or trilinear filtering has no beam "
+                                              "kernel)") +
                                "; " + cl_->programNote();
             } catch (const ClError& e) {
                 cl_.reset();

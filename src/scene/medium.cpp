@@ -38,16 +38,21 @@ bool forEachPiece(const Medium& m, const Vec3& origin, const Vec3& dir, float tM
     if (!(tMax > 0.0f)) return true;
     if (m.type == MediumType::kHomogeneous) return visit(0.0f, tMax, m.sigmaA + m.sigmaS, m.sigmaS);
 
+    // Channel grids: one (grey) or three (chromatic), sharing the index transform.
+    const bool rgb = m.chromatic();
     const VdbGrid& vdb = *m.grid;
-    const float bgSigmaT = m.densityScale * vdb.background();
-    const Rgb bgT(bgSigmaT), bgS = m.albedo * bgSigmaT;
+    Rgb bgT(m.densityScale * vdb.background());
+    if (rgb) {
+        bgT.y = m.densityScale * m.gridG->background();
+        bgT.z = m.densityScale * m.gridB->background();
+    }
+    const Rgb bgS = m.albedo * bgT;
 
     // Cell space: t is shared with world space because the direction is not renormalised.
     const Vec3 P = m.worldToCell.point(origin);
     const Vec3 D = m.worldToCell.vector(dir);
-    const nanovdb::CoordBBox& bb = vdb.indexBounds();
-    const int lo[3] = {bb.min()[0], bb.min()[1], bb.min()[2]};
-    const int hi[3] = {bb.max()[0] + 1, bb.max()[1] + 1, bb.max()[2] + 1};  // exclusive
+    const int lo[3] = {m.activeLo[0], m.activeLo[1], m.activeLo[2]};
+    const int hi[3] = {m.activeHi[0] + 1, m.activeHi[1] + 1, m.activeHi[2] + 1};  // exclusive
 
     // Slab test against the cell box [lo, hi).
     float tEnter = 0.0f, tExit = tMax;
@@ -72,6 +77,8 @@ bool forEachPiece(const Medium& m, const Vec3& origin, const Vec3& dir, float tM
     // 3D-DDA (Amanatides & Woo 1987) over voxels inside leaves and over whole 8^3 blocks
     // elsewhere. v is the current voxel; the block containing it is [blockLo, blockLo + dim).
     auto acc = vdb.grid().getAccessor();
+    auto accG = m.channelGrid(1).grid().getAccessor();
+    auto accB = m.channelGrid(2).grid().getAccessor();
     int v[3];
     const float tStart = tEnter;
     for (int a = 0; a < 3; ++a)
@@ -80,10 +87,18 @@ bool forEachPiece(const Medium& m, const Vec3& origin, const Vec3& dir, float tM
     for (;;) {
         const nanovdb::Coord ijk(v[0], v[1], v[2]);
         const auto* leaf = acc.probeLeaf(ijk);
-        const int dim = leaf ? 1 : kLeafDim;
+        Rgb density(leaf ? leaf->getValue(ijk) : acc.getValue(ijk));
+        bool inLeaf = leaf != nullptr;
+        if (rgb) {  // a voxel step wherever any channel has a leaf; elsewhere all are constant
+            const auto* leafG = accG.probeLeaf(ijk);
+            const auto* leafB = accB.probeLeaf(ijk);
+            density.y = leafG ? leafG->getValue(ijk) : accG.getValue(ijk);
+            density.z = leafB ? leafB->getValue(ijk) : accB.getValue(ijk);
+            inLeaf = inLeaf || leafG || leafB;
+        }
+        const int dim = inLeaf ? 1 : kLeafDim;
         int blockLo[3];
-        for (int a = 0; a < 3; ++a) blockLo[a] = leaf ? v[a] : (v[a] & ~(kLeafDim - 1));
-        const float density = leaf ? leaf->getValue(ijk) : acc.getValue(ijk);
+        for (int a = 0; a < 3; ++a) blockLo[a] = inLeaf ? v[a] : (v[a] & ~(kLeafDim - 1));
 
         float tNext = tExit;
         int axis = -1;
@@ -98,8 +113,8 @@ bool forEachPiece(const Medium& m, const Vec3& origin, const Vec3& dir, float tM
         }
         tNext = std::max(tNext, t);
         if (tNext > t) {
-            const float sigmaT = m.densityScale * density;
-            if (!visit(t, tNext, Rgb(sigmaT), m.albedo * sigmaT)) return false;
+            const Rgb sigmaT = density * m.densityScale;
+            if (!visit(t, tNext, sigmaT, m.albedo * sigmaT)) return false;
         }
         if (axis < 0) break;  // reached tExit inside this block
         t = tNext;
@@ -131,6 +146,28 @@ Medium Medium::homogeneous(const Rgb& sigmaA, const Rgb& sigmaS, float g, const 
     return m;
 }
 
+namespace {
+
+/// World bounds of the cell box [lo, hi + 1) (inclusive voxel bounds).
+Bounds3 cellBoxBounds(const Transform& cellToWorld, const int lo[3], const int hi[3]) {
+    Bounds3 b;
+    for (int c = 0; c < 8; ++c) {
+        Vec3 corner(float(c & 1 ? hi[0] + 1 : lo[0]), float(c & 2 ? hi[1] + 1 : lo[1]),
+                    float(c & 4 ? hi[2] + 1 : lo[2]));
+        b.extend(cellToWorld.point(corner));
+    }
+    return b;
+}
+
+bool sameTransform(const Transform& a, const Transform& b) {
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c)
+            if (a.m[r][c] != b.m[r][c]) return false;
+    return true;
+}
+
+}  // namespace
+
 Medium Medium::heterogeneous(std::shared_ptr<const VdbGrid> grid, float densityScale,
                              const Rgb& albedo, float g, const Transform& localToWorld) {
     if (!grid) throw std::invalid_argument("grid medium: no grid");
@@ -151,24 +188,48 @@ Medium Medium::heterogeneous(std::shared_ptr<const VdbGrid> grid, float densityS
     m.localToWorld = localToWorld;
     m.worldToCell = cellToWorld.inverse();
     const nanovdb::CoordBBox& bb = m.grid->indexBounds();
-    for (int c = 0; c < 8; ++c) {
-        Vec3 corner(float(c & 1 ? bb.max()[0] + 1 : bb.min()[0]),
-                    float(c & 2 ? bb.max()[1] + 1 : bb.min()[1]),
-                    float(c & 4 ? bb.max()[2] + 1 : bb.min()[2]));
-        m.worldBounds.extend(cellToWorld.point(corner));
-    }
     for (int a = 0; a < 3; ++a) {
-        m.domainLo[a] = bb.min()[a];
-        m.domainHi[a] = bb.max()[a];
+        m.domainLo[a] = m.activeLo[a] = bb.min()[a];
+        m.domainHi[a] = m.activeHi[a] = bb.max()[a];
     }
+    m.worldBounds = cellBoxBounds(cellToWorld, m.activeLo, m.activeHi);
     return m;
 }
 
 Medium Medium::heterogeneous(std::shared_ptr<const VdbGrid> grid, float densityScale,
                              const Rgb& albedo, float g, const Transform& localToWorld,
                              const GridMediumOptions& options) {
-    Medium m = heterogeneous(std::move(grid), densityScale, albedo, g, localToWorld);
+    std::shared_ptr<const VdbGrid> channels[3] = {grid, grid, grid};
+    return heterogeneousRgb(channels, densityScale, albedo, g, localToWorld, options);
+}
+
+Medium Medium::heterogeneousRgb(const std::shared_ptr<const VdbGrid> channels[3],
+                                float densityScale, const Rgb& albedo, float g,
+                                const Transform& localToWorld, const GridMediumOptions& options) {
+    for (int c = 0; c < 3; ++c)
+        if (!channels[c]) throw std::invalid_argument("grid medium: no grid");
+    Medium m = heterogeneous(channels[0], densityScale, albedo, g, localToWorld);
     m.filter = options.filter;
+    if (channels[1] != channels[0] || channels[2] != channels[0]) {
+        for (int c = 1; c < 3; ++c)
+            if (!sameTransform(channels[c]->indexToLocal(), channels[0]->indexToLocal()))
+                throw std::invalid_argument(
+                    "grid medium: the sigma_t channels have different voxel transforms");
+        m.gridG = channels[1];
+        m.gridB = channels[2];
+        for (int c = 1; c < 3; ++c) {
+            const nanovdb::CoordBBox& bb = channels[c]->indexBounds();
+            for (int a = 0; a < 3; ++a) {
+                m.activeLo[a] = std::min(m.activeLo[a], bb.min()[a]);
+                m.activeHi[a] = std::max(m.activeHi[a], bb.max()[a]);
+            }
+        }
+        for (int a = 0; a < 3; ++a) {
+            m.domainLo[a] = m.activeLo[a];
+            m.domainHi[a] = m.activeHi[a];
+        }
+        m.worldBounds = cellBoxBounds(m.worldToCell.inverse(), m.activeLo, m.activeHi);
+    }
     const bool given = options.domainLo[0] <= options.domainHi[0] ||
                        options.domainLo[1] <= options.domainHi[1] ||
                        options.domainLo[2] <= options.domainHi[2];
@@ -179,14 +240,7 @@ Medium Medium::heterogeneous(std::shared_ptr<const VdbGrid> grid, float densityS
             m.domainLo[a] = options.domainLo[a];
             m.domainHi[a] = options.domainHi[a];
         }
-        Transform cellToWorld = m.worldToCell.inverse();
-        m.worldBounds = Bounds3();
-        for (int c = 0; c < 8; ++c) {
-            Vec3 corner(float(c & 1 ? m.domainHi[0] + 1 : m.domainLo[0]),
-                        float(c & 2 ? m.domainHi[1] + 1 : m.domainLo[1]),
-                        float(c & 4 ? m.domainHi[2] + 1 : m.domainLo[2]));
-            m.worldBounds.extend(cellToWorld.point(corner));
-        }
+        m.worldBounds = cellBoxBounds(m.worldToCell.inverse(), m.domainLo, m.domainHi);
     }
     return m;
 }
@@ -194,9 +248,11 @@ Medium Medium::heterogeneous(std::shared_ptr<const VdbGrid> grid, float densityS
 MediumCoefficients mediumCoefficientsAt(const Medium& m, const Vec3& p) {
     MediumCoefficients c;
     if (m.type == MediumType::kGrid && m.filter == GridFilter::kTrilinear) {
-        const float sigmaT = m.densityScale * trilinearDensityAt(m, p);
-        c.sigmaT = Rgb(sigmaT);
-        c.sigmaS = mediumAlbedoAt(m, p) * sigmaT;
+        Rgb density(trilinearDensityAt(m, p, 0));
+        if (m.chromatic())
+            density = Rgb(density.x, trilinearDensityAt(m, p, 1), trilinearDensityAt(m, p, 2));
+        c.sigmaT = density * m.densityScale;
+        c.sigmaS = mediumAlbedoAt(m, p) * c.sigmaT;
         c.sigmaA = c.sigmaT - c.sigmaS;
         c.Le = Rgb(0.0f);
         return c;
@@ -209,13 +265,19 @@ MediumCoefficients mediumCoefficientsAt(const Medium& m, const Vec3& p) {
         return c;
     }
     const Vec3 q = m.worldToCell.point(p);
-    const nanovdb::CoordBBox& bb = m.grid->indexBounds();
-    const nanovdb::Coord ijk(int(std::floor(q.x)), int(std::floor(q.y)), int(std::floor(q.z)));
-    const float density =
-        bb.isInside(ijk) ? m.grid->grid().getAccessor().getValue(ijk) : m.grid->background();
-    const float sigmaT = m.densityScale * density;
-    c.sigmaT = Rgb(sigmaT);
-    c.sigmaS = mediumAlbedoAt(m, p) * sigmaT;
+    const int ijkv[3] = {int(std::floor(q.x)), int(std::floor(q.y)), int(std::floor(q.z))};
+    bool inside = true;
+    for (int a = 0; a < 3; ++a)
+        inside = inside && ijkv[a] >= m.activeLo[a] && ijkv[a] <= m.activeHi[a];
+    const nanovdb::Coord ijk(ijkv[0], ijkv[1], ijkv[2]);
+    Rgb density;
+    for (int ch = 0; ch < (m.chromatic() ? 3 : 1); ++ch) {
+        const VdbGrid& grid = m.channelGrid(ch);
+        density[ch] = inside ? grid.grid().getAccessor().getValue(ijk) : grid.background();
+    }
+    if (!m.chromatic()) density = Rgb(density.x);
+    c.sigmaT = density * m.densityScale;
+    c.sigmaS = mediumAlbedoAt(m, p) * c.sigmaT;
     c.sigmaA = c.sigmaT - c.sigmaS;
     c.Le = Rgb(0.0f);
     return c;
@@ -223,7 +285,8 @@ MediumCoefficients mediumCoefficientsAt(const Medium& m, const Vec3& p) {
 
 bool gridPieces(const Medium& m, const Vec3& origin, const Vec3& dir, float length,
                 const std::function<void(float, float, float)>& visit) {
-    if (m.type != MediumType::kGrid || m.filter == GridFilter::kTrilinear) return false;
+    if (m.type != MediumType::kGrid || m.filter == GridFilter::kTrilinear || m.chromatic())
+        return false;
     forEachPiece(m, origin, dir, length, [&](float ta, float tb, const Rgb& sigmaT, const Rgb&) {
         visit(ta, tb, sigmaT.x);  // grid extinction is grey (density x scale)
         return true;

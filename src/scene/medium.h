@@ -4,7 +4,9 @@
 // Coefficients are per unit world length, RGB. sigma_t = sigma_a + sigma_s.
 //  * Homogeneous: sigma_a, sigma_s, optional emitted radiance Le (the source
 //    term of the RTE is sigma_a * Le, as in pbrt-v4), HG g.
-//  * Grid: sigma_t(x) = densityScale * density(x) (grey), sigma_s(x) =
+//  * Grid: sigma_t(x) = densityScale * density(x) (grey), or per channel
+//    sigma_t,c(x) = densityScale * density_c(x) with one grid per channel
+//    (chromatic extinction, Mitsuba's 3-channel sigma_t volumes), sigma_s(x) =
 //    albedo(x) * sigma_t(x), HG g, no emission. albedo(x) is the constant RGB
 //    `albedo`, or an optional albedo grid (scene/albedo_grid.h, Mitsuba's
 //    heterogeneous medium with a volume albedo) looked up only where a collision
@@ -37,7 +39,10 @@
 //   pdfScatterL(t) = (1/3) sum_c sigma_t,c(t) T_c(0, t)     (per unit length)
 //   probPass       = (1/3) sum_c T_c(0, tMax)               (a probability)
 // and the throughput weights are T sigma_s / pdfScatterL and T / probPass,
-// which makes every channel's estimate unbiased.
+// which makes every channel's estimate unbiased. Chromatic grids use the same
+// combination: each piece of regular tracking has an RGB sigma_t (the walk
+// descends into a voxel wherever any channel has a leaf), so tracking stays
+// exact and the pdfs are those above.
 //
 // Directions: `dir` is a unit world-space direction; t is distance along it.
 // For bidirectional MIS both directions of a segment x0 -> x1 are needed: the
@@ -95,7 +100,9 @@ struct Medium {
     Rgb Le{0.0f};  ///< emitted radiance (source term sigma_a * Le)
 
     // Grid.
-    std::shared_ptr<const VdbGrid> grid;
+    std::shared_ptr<const VdbGrid> grid;  ///< the density; channel R of a chromatic medium
+    /// Chromatic extinction: the density of channels G and B (null: grey, `grid` for all).
+    std::shared_ptr<const VdbGrid> gridG, gridB;
     float densityScale = 1.0f;  ///< sigma_t = densityScale * density
     Rgb albedo{1.0f};           ///< sigma_s / sigma_t, each channel in [0, 1]
     /// Spatially varying albedo replacing `albedo` where set (null: the constant albedo).
@@ -106,6 +113,16 @@ struct Medium {
     Bounds3 worldBounds;    ///< world bounds of the grid's active voxels (background outside)
     GridFilter filter = GridFilter::kNearest;
     int domainLo[3] = {0, 0, 0}, domainHi[3] = {-1, -1, -1};  ///< set by heterogeneous()
+    /// Union of the channels' active voxel bounds, inclusive (set by heterogeneous()):
+    /// background outside.
+    int activeLo[3] = {0, 0, 0}, activeHi[3] = {-1, -1, -1};
+
+    /// Whether sigma_t differs between channels as a function of position (3 grids).
+    bool chromatic() const { return gridG != nullptr; }
+    /// The density grid of channel c (0, 1, 2).
+    const VdbGrid& channelGrid(int c) const {
+        return c == 1 && gridG ? *gridG : (c == 2 && gridB ? *gridB : *grid);
+    }
 
     /// Throws std::invalid_argument on negative or non-finite coefficients or |g| >= 1.
     static Medium homogeneous(const Rgb& sigmaA, const Rgb& sigmaS, float g,
@@ -120,6 +137,13 @@ struct Medium {
     static Medium heterogeneous(std::shared_ptr<const VdbGrid> grid, float densityScale,
                                 const Rgb& albedo, float g, const Transform& localToWorld,
                                 const GridMediumOptions& options);
+    /// Chromatic extinction: one density grid per channel (R, G, B), all with the same index
+    /// transform (a grey medium when the three are the same grid). Throws
+    /// std::invalid_argument also on a null channel or differing transforms.
+    static Medium heterogeneousRgb(const std::shared_ptr<const VdbGrid> channels[3],
+                                   float densityScale, const Rgb& albedo, float g,
+                                   const Transform& localToWorld,
+                                   const GridMediumOptions& options = GridMediumOptions());
 
     bool hasEmission() const { return !isBlack(Le) && !isBlack(sigmaA); }
 };
@@ -159,7 +183,8 @@ MediumSegment evalMediumSegment(const Medium& m, const Vec3& origin, const Vec3&
 /// The pieces of constant extinction of a grid medium along [0, length] of a ray, in order
 /// (regular tracking, the walk evalMediumSegment makes): visit(ta, tb, sigmaT) per piece.
 /// Returns false, visiting nothing, for media that are not piecewise constant along rays
-/// (homogeneous media, where one closed form serves every length, and trilinear grids).
+/// or not grey (homogeneous media, where one closed form serves every length, trilinear
+/// grids and chromatic grids).
 bool gridPieces(const Medium& m, const Vec3& origin, const Vec3& dir, float length,
                 const std::function<void(float, float, float)>& visit);
 /// Transmittance only (the cheaper query, for shadow rays and photon beams).

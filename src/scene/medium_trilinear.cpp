@@ -20,10 +20,12 @@ struct Cubic {
     }
 };
 
+/// The voxels of one channel's density grid, clamped to the domain.
 struct DualGrid {
     const Medium& m;
     nanovdb::DefaultReadAccessor<float> acc;
-    explicit DualGrid(const Medium& med) : m(med), acc(med.grid->grid().getAccessor()) {}
+    DualGrid(const Medium& med, int channel)
+        : m(med), acc(med.channelGrid(channel).grid().getAccessor()) {}
     float voxel(int i, int j, int k) {
         i = std::clamp(i, m.domainLo[0], m.domainHi[0]);
         j = std::clamp(j, m.domainLo[1], m.domainHi[1]);
@@ -31,6 +33,11 @@ struct DualGrid {
         return acc.getValue(nanovdb::Coord(i, j, k));
     }
 };
+
+/// Number of density channels: 1 (grey) or 3 (chromatic).
+int channelCount(const Medium& m) {
+    return m.chromatic() ? 3 : 1;
+}
 
 /// Product of linear polynomials a0 + a1 s.
 void mulLinear(const double* p, int deg, double a0, double a1, double* out) {
@@ -73,8 +80,9 @@ Cubic cellCubic(DualGrid& g, const int k[3], const double q0[3], const double D[
     return c;
 }
 
-/// Calls visit(t0, t1, cubic) for consecutive pieces covering [0, tMax] (zero density
-/// outside the domain box) until visit returns false.
+/// Calls visit(t0, t1, cubics) for consecutive pieces covering [0, tMax] (zero density
+/// outside the domain box) until visit returns false; cubics[c] is channel c's density for
+/// c < channelCount(m).
 template <typename Visit>
 void forEachCubic(const Medium& m, const Vec3& origin, const Vec3& dir, float tMax, Visit&& visit) {
     if (!(tMax > 0.0f)) return;
@@ -97,13 +105,15 @@ void forEachCubic(const Medium& m, const Vec3& origin, const Vec3& dir, float tM
         tEnter = std::max(tEnter, t0);
         tExit = std::min(tExit, t1);
     }
-    const Cubic zero;
+    const Cubic zero[3];
     if (!(tEnter < tExit)) {
         visit(0.0, double(tMax), zero);
         return;
     }
     if (tEnter > 0.0 && !visit(0.0, tEnter, zero)) return;
-    DualGrid g(m);
+    const int nc = channelCount(m);
+    DualGrid g[3] = {DualGrid(m, 0), DualGrid(m, nc > 1 ? 1 : 0), DualGrid(m, nc > 1 ? 2 : 0)};
+    Cubic cubics[3];
     double t = tEnter;
     while (t < tExit) {
         // Cell containing the midpoint of the next step: robust against round-off at planes.
@@ -122,7 +132,8 @@ void forEachCubic(const Medium& m, const Vec3& origin, const Vec3& dir, float tM
         if (!(tNext > t)) tNext = std::min(tExit, t + 1e-9 * std::max(1.0, std::fabs(t)));
         double q0[3];
         for (int a = 0; a < 3; ++a) q0[a] = P[a] + D[a] * t;
-        if (!visit(t, tNext, cellCubic(g, k, q0, D))) return;
+        for (int c = 0; c < nc; ++c) cubics[c] = cellCubic(g[c], k, q0, D);
+        if (!visit(t, tNext, cubics)) return;
         t = tNext;
     }
     if (tExit < tMax) visit(tExit, double(tMax), zero);
@@ -154,7 +165,7 @@ double invertCubic(const Cubic& c, double scale, double L, double target) {
 
 }  // namespace
 
-float trilinearDensityAt(const Medium& m, const Vec3& p) {
+float trilinearDensityAt(const Medium& m, const Vec3& p, int channel) {
     const Vec3 q = m.worldToCell.point(p);
     double qd[3], zeroD[3] = {0, 0, 0};
     int k[3];
@@ -163,74 +174,116 @@ float trilinearDensityAt(const Medium& m, const Vec3& p) {
         if (qd[a] < m.domainLo[a] - 0.5 || qd[a] >= m.domainHi[a] + 0.5) return 0.0f;
         k[a] = std::clamp(int(std::floor(qd[a])), m.domainLo[a] - 1, m.domainHi[a]);
     }
-    DualGrid g(m);
+    DualGrid g(m, m.chromatic() ? channel : 0);
     return float(std::max(0.0, cellCubic(g, k, qd, zeroD).c[0]));
 }
 
+namespace {
+
+/// The density of every channel at p (grey: replicated).
+Rgb densityRgbAt(const Medium& m, const Vec3& p) {
+    if (!m.chromatic()) return Rgb(trilinearDensityAt(m, p, 0));
+    return Rgb(trilinearDensityAt(m, p, 0), trilinearDensityAt(m, p, 1),
+               trilinearDensityAt(m, p, 2));
+}
+
+/// sigma_t = densityScale * max(0, density) per channel (grey: channel 0 replicated).
+Rgb sigmaFromDensity(const Medium& m, const double d[3]) {
+    const double s = m.densityScale;
+    if (!m.chromatic()) return Rgb(float(s * std::max(0.0, d[0])));
+    return Rgb(float(s * std::max(0.0, d[0])), float(s * std::max(0.0, d[1])),
+               float(s * std::max(0.0, d[2])));
+}
+
+/// exp(-tau) per channel from optical depths (grey: channel 0 replicated).
+Rgb transmittanceFromTau(const Medium& m, const double tau[3]) {
+    if (!m.chromatic()) return expNeg(Rgb(float(std::max(0.0, tau[0]))));
+    return expNeg(Rgb(float(std::max(0.0, tau[0])), float(std::max(0.0, tau[1])),
+                      float(std::max(0.0, tau[2]))));
+}
+
+}  // namespace
+
 Rgb trilinearTransmittance(const Medium& m, const Vec3& origin, const Vec3& dir, float length) {
-    double tau = 0.0;
-    forEachCubic(m, origin, dir, length, [&](double t0, double t1, const Cubic& c) {
-        tau += c.integral(t1 - t0);
+    const int nc = channelCount(m);
+    double tau[3] = {0, 0, 0};
+    forEachCubic(m, origin, dir, length, [&](double t0, double t1, const Cubic* c) {
+        for (int ch = 0; ch < nc; ++ch) tau[ch] += m.densityScale * c[ch].integral(t1 - t0);
         return true;
     });
-    return expNeg(Rgb(float(m.densityScale * std::max(0.0, tau))));
+    return transmittanceFromTau(m, tau);
 }
 
 MediumSegment trilinearSegment(const Medium& m, const Vec3& origin, const Vec3& dir, float length) {
+    const int nc = channelCount(m);
     MediumSegment seg;
     seg.length = length;
-    double tau = 0.0, d0 = 0.0, d1 = 0.0;
+    double tau[3] = {0, 0, 0}, d0[3] = {0, 0, 0}, d1[3] = {0, 0, 0};
     bool first = true;
-    forEachCubic(m, origin, dir, length, [&](double t0, double t1, const Cubic& c) {
-        if (first) d0 = c.eval(0.0);
+    forEachCubic(m, origin, dir, length, [&](double t0, double t1, const Cubic* c) {
+        for (int ch = 0; ch < nc; ++ch) {
+            if (first) d0[ch] = c[ch].eval(0.0);
+            d1[ch] = c[ch].eval(t1 - t0);
+            tau[ch] += m.densityScale * c[ch].integral(t1 - t0);
+        }
         first = false;
-        d1 = c.eval(t1 - t0);
-        tau += c.integral(t1 - t0);
         return true;
     });
-    if (first) d0 = d1 = trilinearDensityAt(m, origin);
-    seg.sigmaT0 = Rgb(float(m.densityScale * std::max(0.0, d0)));
-    seg.sigmaT1 = Rgb(float(m.densityScale * std::max(0.0, d1)));
+    if (first) {
+        const Rgb d = densityRgbAt(m, origin);
+        for (int ch = 0; ch < 3; ++ch) d0[ch] = d1[ch] = d[ch];
+    }
+    seg.sigmaT0 = sigmaFromDensity(m, d0);
+    seg.sigmaT1 = sigmaFromDensity(m, d1);
     seg.sigmaS1 = mediumAlbedoAt(m, origin + dir * length) * seg.sigmaT1;
-    seg.transmittance = expNeg(Rgb(float(m.densityScale * std::max(0.0, tau))));
+    seg.transmittance = transmittanceFromTau(m, tau);
     return seg;
 }
 
 FreeFlightSample trilinearFreeFlight(const Medium& m, const Vec3& origin, const Vec3& dir,
                                      float tMax, float uChannel, float uDistance) {
-    // sigma_t is grey: every channel has the same optical depth, so the channel choice does
-    // not change the distance (uChannel is accepted for the common interface).
-    (void)uChannel;
+    // Spectral MIS (scene/medium.h): the distance is sampled in channel c; a grey sigma_t has
+    // the same optical depth in every channel, so there the choice changes nothing.
+    const int nc = channelCount(m);
+    const int cs = nc == 1 ? 0 : std::min(2, int(uChannel * 3.0f));
     const double target = -std::log1p(-double(uDistance));
     const double scale = m.densityScale;
     FreeFlightSample s;
-    double tau = 0.0, d0 = 0.0, d1 = 0.0, t = tMax;
+    double tau[3] = {0, 0, 0}, d0[3] = {0, 0, 0}, d1[3] = {0, 0, 0}, t = tMax;
     bool first = true, scattered = false;
-    forEachCubic(m, origin, dir, tMax, [&](double t0, double t1, const Cubic& c) {
-        if (first) d0 = c.eval(0.0);
+    forEachCubic(m, origin, dir, tMax, [&](double t0, double t1, const Cubic* c) {
+        if (first)
+            for (int ch = 0; ch < nc; ++ch) d0[ch] = c[ch].eval(0.0);
         first = false;
-        const double L = t1 - t0, piece = scale * c.integral(L);
-        if (scale > 0 && tau + piece >= target) {
-            double sLocal = invertCubic(c, scale, L, target - tau);
+        const double L = t1 - t0, piece = scale * c[cs].integral(L);
+        if (scale > 0 && tau[cs] + piece >= target) {
+            const double sLocal = invertCubic(c[cs], scale, L, target - tau[cs]);
             t = t0 + sLocal;
-            tau = target;
-            d1 = c.eval(sLocal);
+            for (int ch = 0; ch < nc; ++ch) {
+                tau[ch] = ch == cs ? target : tau[ch] + scale * c[ch].integral(sLocal);
+                d1[ch] = c[ch].eval(sLocal);
+            }
             scattered = t < double(tMax);
             return false;
         }
-        tau += piece;
-        d1 = c.eval(L);
+        for (int ch = 0; ch < nc; ++ch) {
+            tau[ch] += ch == cs ? piece : scale * c[ch].integral(L);
+            d1[ch] = c[ch].eval(L);
+        }
         return true;
     });
-    if (first) d0 = d1 = trilinearDensityAt(m, origin);
+    if (first) {
+        const Rgb d = densityRgbAt(m, origin);
+        for (int ch = 0; ch < 3; ++ch) d0[ch] = d1[ch] = d[ch];
+    }
     MediumSegment& seg = s.segment;
     s.scattered = scattered;
     s.t = scattered ? float(t) : tMax;
     seg.length = s.t;
-    seg.sigmaT0 = Rgb(float(scale * std::max(0.0, d0)));
-    seg.sigmaT1 = Rgb(float(scale * std::max(0.0, d1)));
+    seg.sigmaT0 = sigmaFromDensity(m, d0);
+    seg.sigmaT1 = sigmaFromDensity(m, d1);
     seg.sigmaS1 = mediumAlbedoAt(m, origin + dir * s.t) * seg.sigmaT1;
-    seg.transmittance = expNeg(Rgb(float(std::max(0.0, tau))));
+    seg.transmittance = transmittanceFromTau(m, tau);
     s.pdf = s.scattered ? seg.pdfScatterFwdL() : seg.probPass();
     if (s.pdf > 0.0f)
         s.weight =

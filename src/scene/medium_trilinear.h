@@ -19,8 +19,9 @@
 
 namespace ub {
 
-/// Interpolated density (before densityScale) at world point p.
-float trilinearDensityAt(const Medium& m, const Vec3& p);
+/// Interpolated density (before densityScale) of channel `channel` (0, 1, 2; grey media
+/// have one) at world point p.
+float trilinearDensityAt(const Medium& m, const Vec3& p, int channel = 0);
 Rgb trilinearTransmittance(const Medium& m, const Vec3& origin, const Vec3& dir, float length);
 MediumSegment trilinearSegment(const Medium& m, const Vec3& origin, const Vec3& dir, float length);
 FreeFlightSample trilinearFreeFlight(const Medium& m, const Vec3& origin, const Vec3& dir,

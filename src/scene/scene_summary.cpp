@@ -159,8 +159,9 @@ std::string describeScene(const Scene& scene) {
             if (m.type == MediumType::kHomogeneous)
                 os << "homogeneous, sigma_a " << vec(m.sigmaA) << ", sigma_s " << vec(m.sigmaS);
             else
-                os << "heterogeneous, grid '" << (m.grid ? m.grid->name() : "")
-                   << "', density scale " << num(m.densityScale) << ", albedo "
+                os << "heterogeneous, grid '" << (m.grid ? m.grid->name() : "") << "'"
+                   << (m.chromatic() ? " (chromatic sigma_t, 3 channels)" : "")
+                   << ", density scale " << num(m.densityScale) << ", albedo "
                    << (m.albedoGrid ? albedoGridSummary(*m.albedoGrid) : vec(m.albedo));
             os << ", g " << num(m.g) << "\n";
         }

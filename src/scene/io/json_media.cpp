@@ -3,6 +3,7 @@
 // coefficients and heterogeneous media whose density comes from a .vdb file,
 // with a constant albedo or an albedo grid (a float or vec3 grid of a .vdb).
 #include <filesystem>
+#include <limits>
 #include <map>
 
 #include "scene/albedo_grid.h"
@@ -127,11 +128,15 @@ void readHeterogeneous(JsonReader& r, const Json& v, const std::string& ptr, Jso
     if (v.contains("grid")) gridName = r.getString(v, ptr, "grid", Presence::Optional);
     std::string file = r.getString(v, ptr, "file", Presence::Required);
     const std::string filePtr = jsonPointerChild(ptr, "file");
-    std::shared_ptr<const VdbGrid> grid;
+    // A float grid (grey extinction) or a vec3 grid (chromatic: one density per channel).
+    std::vector<std::shared_ptr<const VdbGrid>> channels;
     if (!file.empty() && !gridName.empty())
         loadVdbFile(r, parts, file, filePtr,
                     v.contains("grid") ? jsonPointerChild(ptr, "grid") : filePtr,
-                    [&](const std::string& path) { grid = VdbGrid::load(path, gridName); });
+                    [&](const std::string& path) {
+                        channels = VdbGrid::loadChannels(path, gridName, "density",
+                                                         std::numeric_limits<float>::infinity());
+                    });
 
     // Albedo grid: "albedo_grid" (default "albedo") in "albedo_file" (default: "file").
     std::vector<std::shared_ptr<const VdbGrid>> albedoChannels;
@@ -150,9 +155,12 @@ void readHeterogeneous(JsonReader& r, const Json& v, const std::string& ptr, Jso
                 albedoChannels = loadVdbAlbedoChannels(path, albedoGridName);
             });
     }
-    if (r.errorCount() != before || !grid) return;
+    if (r.errorCount() != before || channels.empty()) return;
     try {
-        med = Medium::heterogeneous(grid, densityScale, albedo, g, toWorld);
+        if (channels.size() == 3)
+            med = Medium::heterogeneousRgb(channels.data(), densityScale, albedo, g, toWorld);
+        else
+            med = Medium::heterogeneous(channels[0], densityScale, albedo, g, toWorld);
         if (albedoGrid)
             med.albedoGrid =
                 AlbedoGrid::make(albedoChannels, albedoFilter, toWorld, nullptr, nullptr,

@@ -1,11 +1,14 @@
 // Mitsuba <medium> plugins -> unibeam media (docs/mitsuba.md lists the mapping):
 // homogeneous (sigma_t, albedo, scale) and heterogeneous with a gridvolume
-// (.vol or .vdb) or constvolume extinction, a constant albedo or an albedo
+// (.vol or .vdb; 1 channel, or 3 for a chromatic extinction) or constvolume extinction, a
+// constant albedo or an albedo
 // gridvolume (1 or 3 channels, its own to_world and filter; scene/albedo_grid.h),
 // isotropic or HG phase. Mitsuba's gridvolume interpolates trilinearly by default: that maps
 // onto GridFilter::kTrilinear (exact transmittance, scene/medium_trilinear.h);
 // filter_type="nearest" onto the piecewise-constant default.
+#include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <stdexcept>
 
 #include "scene/albedo_grid.h"
@@ -45,7 +48,8 @@ bool readConstant(XmlReader& r, const XmlObject& o, const std::string& name, Rgb
     return true;
 }
 
-/// What a gridvolume holds: the extinction (sigma_t, one channel) or the albedo (1 or 3).
+/// What a gridvolume holds: the extinction (sigma_t) or the albedo; either has 1 channel
+/// (grey) or 3 (RGB: a chromatic extinction, Medium::heterogeneousRgb).
 enum class VolumeRole { kSigmaT, kAlbedo };
 
 struct GridVolume {
@@ -99,17 +103,18 @@ bool readGridVolume(MitsubaBuild& b, const XmlObject& v, VolumeRole role, GridVo
                             ": grid_name applies to .vdb files only (a .vol file holds "
                             "one grid)");
             VolGrid vol = readVolFile(path);
-            if (!albedo && vol.channels != 1) {
-                r.error(fpos, v.label() + ": '" + file + "' has " + std::to_string(vol.channels) +
-                                  " channels; an extinction grid needs 1");
-                return false;
-            }
             out->label = "'" + file + "'";
             for (int c = 0; c < vol.channels; ++c) {
                 DenseFloatGrid dense = volChannelToDense(vol, c);
-                out->grids.push_back(
-                    albedo ? VdbGrid::fromDenseChecked(dense, "albedo", path, "albedo", 1.0f)
-                           : VdbGrid::fromDense(dense, "density", path));
+                const bool zero = std::all_of(dense.values.begin(), dense.values.end(),
+                                              [](float x) { return x == 0.0f; });
+                if (albedo)
+                    out->grids.push_back(
+                        VdbGrid::fromDenseChecked(dense, "albedo", path, "albedo", 1.0f));
+                else if (zero && vol.channels == 3)  // a channel without extinction
+                    out->grids.push_back(VdbGrid::constant(0.0f, path));
+                else
+                    out->grids.push_back(VdbGrid::fromDense(dense, "density", path));
             }
             Transform unit = volCellToUnitCube(vol);
             if (useBbox)
@@ -133,8 +138,9 @@ bool readGridVolume(MitsubaBuild& b, const XmlObject& v, VolumeRole role, GridVo
             out->label = "'" + file + "' grid '" + gridName + "'";
             if (albedo)
                 out->grids = loadVdbAlbedoChannels(path, gridName);
-            else
-                out->grids = {VdbGrid::load(path, gridName)};
+            else  // a float grid (grey) or a vec3 grid (chromatic sigma_t)
+                out->grids = VdbGrid::loadChannels(path, gridName, "sigma_t",
+                                                   std::numeric_limits<float>::infinity());
             out->localToWorld = toWorld;
         } else {
             r.error(fpos, v.label() + ": '" + file + "' is neither a .vol nor a .vdb file");
@@ -174,62 +180,73 @@ bool buildMitsubaMedium(MitsubaBuild& b, const XmlObject& o, Medium* out) {
         const XmlObject* v = r.child(o, "volume", "albedo");
         if (v->type != "gridvolume") {
             r.unsupportedPlugin(*v, {"gridvolume", "constvolume"});
-        } else if (o.type == "homogeneous") {
-            r.error(v->pos, o.label() + ": a spatially varying albedo (" + v->label() +
-                                ") needs a heterogeneous medium; a homogeneous one takes a "
-                                "constant albedo");
         } else if (readGridVolume(b, *v, VolumeRole::kAlbedo, &albedoGrid)) {
             albedoVol = v;
         }
     }
-    if (o.type == "homogeneous") {
-        Rgb sigmaT(1.0f);
-        if (!readConstant(r, o, "sigma_t", Rgb(1.0f), ColorUse::Unbounded, &sigmaT)) {
-            const XmlObject* v = r.child(o, "volume", "sigma_t");
-            r.error(v->pos, o.label() + ": sigma_t must be constant in a homogeneous medium");
-        }
-        checkGrey(sigmaT);
-        r.checkUnused(o);
-        if (r.errorCount() != before) return false;
-        const Rgb st = sigmaT * scale, ss = albedo * st;
-        *out = Medium::homogeneous(vmax(st - ss, Rgb(0.0f)), ss, g);
-        return true;
-    }
-    if (o.type != "heterogeneous") {
-        r.unsupportedPlugin(o, {"homogeneous", "heterogeneous"});
-        return false;
-    }
-    const XmlObject* vol = r.child(o, "volume", "sigma_t");
+    const XmlObject* vol = nullptr;
     GridVolume gv;
     bool ok = true;
     Rgb constSigmaT(1.0f);
-    if (!vol) {
-        ok = readConstant(r, o, "sigma_t", Rgb(1.0f), ColorUse::Unbounded, &constSigmaT);
-    } else if (vol->type == "constvolume") {
-        ok = readConstant(r, o, "sigma_t", Rgb(1.0f), ColorUse::Unbounded, &constSigmaT);
-        vol = nullptr;
-    } else if (vol->type == "gridvolume") {
-        ok = readGridVolume(b, *vol, VolumeRole::kSigmaT, &gv);
-    } else {
-        r.unsupportedPlugin(*vol, {"gridvolume", "constvolume"});
-        ok = false;
+    if (o.type == "homogeneous") {
+        if (!readConstant(r, o, "sigma_t", Rgb(1.0f), ColorUse::Unbounded, &constSigmaT)) {
+            const XmlObject* v = r.child(o, "volume", "sigma_t");
+            r.error(v->pos, o.label() + ": sigma_t must be constant in a homogeneous medium");
+        }
+        checkGrey(constSigmaT);
+        r.checkUnused(o);
+        if (r.errorCount() != before) return false;
+        if (!albedoVol) {
+            const Rgb st = constSigmaT * scale, ss = albedo * st;
+            *out = Medium::homogeneous(vmax(st - ss, Rgb(0.0f)), ss, g);
+            return true;
+        }
+        // Mitsuba's homogeneous medium takes an albedo volume too, looked up at each
+        // collision: a grid medium of constant density with that albedo grid (below).
+    } else if (o.type != "heterogeneous") {
+        r.unsupportedPlugin(o, {"homogeneous", "heterogeneous"});
+        return false;
+    } else {  // heterogeneous
+        vol = r.child(o, "volume", "sigma_t");
+        if (!vol) {
+            ok = readConstant(r, o, "sigma_t", Rgb(1.0f), ColorUse::Unbounded, &constSigmaT);
+        } else if (vol->type == "constvolume") {
+            ok = readConstant(r, o, "sigma_t", Rgb(1.0f), ColorUse::Unbounded, &constSigmaT);
+            vol = nullptr;
+        } else if (vol->type == "gridvolume") {
+            ok = readGridVolume(b, *vol, VolumeRole::kSigmaT, &gv);
+        } else {
+            r.unsupportedPlugin(*vol, {"gridvolume", "constvolume"});
+            ok = false;
+        }
+        if (!vol && ok) checkGrey(constSigmaT);
+        if (vol && ok && gv.grids.size() == 3 && spectralHint && !spectralExtinction)
+            r.error(spectralHint->pos,
+                    o.label() +
+                        ": has_spectral_extinction = false with a 3-channel sigma_t grid "
+                        "(Mitsuba would track the first channel only); give a 1-channel grid "
+                        "or remove the parameter");
+        r.checkUnused(o);
+        if (!ok || r.errorCount() != before) return false;
     }
-    if (!vol && ok) checkGrey(constSigmaT);
-    if (albedoVol && !vol && ok &&
-        !(constSigmaT.x == constSigmaT.y && constSigmaT.y == constSigmaT.z))
-        r.error(albedoVol->pos,
-                o.label() + ": a spatially varying albedo (" + albedoVol->label() +
-                    ") with a spectrally varying constant sigma_t is not supported (grid media "
-                    "have grey extinction); give a grey sigma_t");
-    r.checkUnused(o);
-    if (!ok || r.errorCount() != before) return false;
     try {
-        if (!vol && albedoVol) {  // constant extinction, varying albedo: a constant grid
-            *out = Medium::heterogeneous(VdbGrid::constant(1.0f, "constant sigma_t"),
-                                         constSigmaT.x * scale, albedo, g, Transform());
+        if (!vol && albedoVol) {  // constant extinction, varying albedo: constant grids
+            const bool grey = constSigmaT.x == constSigmaT.y && constSigmaT.y == constSigmaT.z;
+            if (grey) {
+                *out = Medium::heterogeneous(VdbGrid::constant(1.0f, "constant sigma_t"),
+                                             constSigmaT.x * scale, albedo, g, Transform());
+            } else {  // one constant grid per channel: a chromatic extinction
+                std::shared_ptr<const VdbGrid> channels[3];
+                for (int c = 0; c < 3; ++c)
+                    channels[c] = VdbGrid::constant(constSigmaT[c], "constant sigma_t");
+                *out = Medium::heterogeneousRgb(channels, scale, albedo, g, Transform());
+            }
         } else if (!vol) {  // a constant extinction: the same as homogeneous
             const Rgb st = constSigmaT * scale, ss = albedo * st;
             *out = Medium::homogeneous(vmax(st - ss, Rgb(0.0f)), ss, g);
+        } else if (gv.grids.size() == 3) {  // chromatic extinction
+            *out = Medium::heterogeneousRgb(gv.grids.data(), scale, albedo, g, gv.localToWorld,
+                                            gv.options);
         } else {
             *out =
                 Medium::heterogeneous(gv.grids[0], scale, albedo, g, gv.localToWorld, gv.options);
