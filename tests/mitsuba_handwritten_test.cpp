@@ -65,6 +65,9 @@ std::string caseName(const ::testing::TestParamInfo<HandCase>& info) {
 // pixels Mitsuba does not renormalise (PixelFilterBorder::kPartitionOfUnity; with the
 // renormalised filter lt is 15-20% brighter than the reference along the left and right
 // edges, |z| up to 8); pt samples the same convention.
+// normalmap.xml (normalmap and bumpmap wrappers on rectangles, a sphere and a cube): pt, bpt
+// and lt, whose light subpaths see the perturbed normals through the adjoint BSDF (Veach's
+// shading-normal factor, the light-side rule on dirFix).
 const HandCase kCases[] = {
     {"surfaces", "pt", 512},
     {"surfaces", "bpt", 256},
@@ -91,6 +94,9 @@ const HandCase kCases[] = {
     {"conductor", "bpt", 256},
     {"conductor", "vcm", 256},
     {"conductor", "upbp", 128},
+    {"normalmap", "pt", 512},
+    {"normalmap", "bpt", 256},
+    {"normalmap", "lt", 512},
 };
 
 class MitsubaHandWritten : public ::testing::TestWithParam<HandCase> {};
@@ -191,4 +197,27 @@ TEST(MitsubaHandWrittenPower, InstanceTransformIsDistinguished) {
     const test::ReferenceCheck check =
         checkAgainst("instancing", *scene, "pt", 512, "instancing pt, instance not mirrored");
     EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the mirroring";
+}
+
+// Power of the normalmap/bumpmap check: the same scene without the perturbations (the wrapped
+// BSDFs alone), and with the shadow-terminator factor off where Mitsuba applies it, fail.
+TEST(MitsubaHandWrittenPower, NormalAndBumpMapsAreDistinguished) {
+    std::unique_ptr<Scene> scene = loadMitsubaScene(kDir + "/normalmap.xml", {{"res", "48"}});
+    int perturbed = 0;
+    for (Material& m : scene->materials)
+        if (m.perturbation != NormalPerturbation::kNone) {
+            m.perturbation = NormalPerturbation::kNone;
+            ++perturbed;
+        }
+    ASSERT_EQ(perturbed, 4);  // floor, back wall, sphere, cube
+    test::ReferenceCheck check =
+        checkAgainst("normalmap", *scene, "pt", 512, "normalmap pt without the perturbations");
+    EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the normal maps";
+
+    scene = loadMitsubaScene(kDir + "/normalmap.xml", {{"res", "48"}});
+    for (Material& m : scene->materials) m.shadowTerminator = false;
+    check = checkAgainst("normalmap", *scene, "pt", 512, "normalmap pt without the terminator");
+    EXPECT_FALSE(check.perPixel.passed && std::fabs(check.meanZ[0]) < kMeanZBound &&
+                 std::fabs(check.meanZ[1]) < kMeanZBound && std::fabs(check.meanZ[2]) < kMeanZBound)
+        << "the reference test cannot see the shadow-terminator factor";
 }
