@@ -209,7 +209,7 @@ TEST(MitsubaHandWrittenPower, NormalAndBumpMapsAreDistinguished) {
             m.perturbation = NormalPerturbation::kNone;
             ++perturbed;
         }
-    ASSERT_EQ(perturbed, 4);  // floor, back wall, sphere, cube
+    ASSERT_EQ(perturbed, 4);  // floor, back wall, sphere, panel
     test::ReferenceCheck check =
         checkAgainst("normalmap", *scene, "pt", 512, "normalmap pt without the perturbations");
     EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the normal maps";
