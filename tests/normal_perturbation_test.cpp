@@ -345,7 +345,7 @@ TEST(NormalPerturbation, LoaderErrorsNameFileAndPosition) {
     std::string e =
         errorsOf(sceneWith("<bsdf type=\"normalmap\"><bsdf type=\"diffuse\"/></bsdf>\n"));
     EXPECT_TRUE(contains(e,
-                         "scene.xml:5:1: error: <bsdf type='normalmap'>: needs a <texture "
+                         "scene.xml:5:1: error: <bsdf type=\"normalmap\">: needs a <texture "
                          "name=\"normalmap\">"))
         << e;
     e =
