@@ -216,7 +216,8 @@ TEST(MitsubaHandWrittenPower, NormalAndBumpMapsAreDistinguished) {
 
     scene = loadMitsubaScene(kDir + "/normalmap.xml", {{"res", "48"}});
     for (Material& m : scene->materials) m.shadowTerminator = false;
-    check = checkAgainst("normalmap", *scene, "pt", 512, "normalmap pt without the terminator");
+    // The factor is ~0.6% of the image (at 512 iterations the image-mean |z| is 3.0-3.7).
+    check = checkAgainst("normalmap", *scene, "pt", 2048, "normalmap pt without the terminator");
     EXPECT_FALSE(check.perPixel.passed && std::fabs(check.meanZ[0]) < kMeanZBound &&
                  std::fabs(check.meanZ[1]) < kMeanZBound && std::fabs(check.meanZ[2]) < kMeanZBound)
         << "the reference test cannot see the shadow-terminator factor";
