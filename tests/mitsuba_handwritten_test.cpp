@@ -65,9 +65,10 @@ std::string caseName(const ::testing::TestParamInfo<HandCase>& info) {
 // pixels Mitsuba does not renormalise (PixelFilterBorder::kPartitionOfUnity; with the
 // renormalised filter lt is 15-20% brighter than the reference along the left and right
 // edges, |z| up to 8); pt samples the same convention.
-// normalmap.xml (normalmap and bumpmap wrappers on rectangles, a sphere and a cube): pt, bpt
-// and lt, whose light subpaths see the perturbed normals through the adjoint BSDF (Veach's
-// shading-normal factor, the light-side rule on dirFix).
+// normalmap.xml (normalmap and bumpmap wrappers on rectangles, a sphere and an OBJ panel): pt,
+// bpt and lt, whose light subpaths see the perturbed normals through the adjoint BSDF (Veach's
+// shading-normal factor, the light-side rule on dirFix), and vcm and upbp (merging at
+// perturbed camera vertices: the rule on the photon's direction).
 const HandCase kCases[] = {
     {"surfaces", "pt", 512},
     {"surfaces", "bpt", 256},
@@ -97,6 +98,8 @@ const HandCase kCases[] = {
     {"normalmap", "pt", 512},
     {"normalmap", "bpt", 256},
     {"normalmap", "lt", 512},
+    {"normalmap", "vcm", 256},
+    {"normalmap", "upbp", 128},
 };
 
 class MitsubaHandWritten : public ::testing::TestWithParam<HandCase> {};
