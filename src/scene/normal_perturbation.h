@@ -43,7 +43,7 @@ Vec3 bumpMapNormal(const Vec2& heightGradient, const Vec3& n, const Vec3& dpdu, 
 
 /// The shading normal of material m at a point (uv, unit shading normal n, unit geometric
 /// normal ng, tangents dpdu/dpdv): perturbed by its normal or bump map, on ng's side; n itself
-/// without a perturbation. textureOf(m.perturbationTexture) must be valid.
+/// without a perturbation. `texture` is Scene::textures[m.perturbationTexture].
 Vec3 perturbedShadingNormal(const Material& m, const Texture& texture, const Vec2& uv,
                             const Vec3& n, const Vec3& ng, const Vec3& dpdu, const Vec3& dpdv);
 
