@@ -67,6 +67,10 @@ std::string caseName(const ::testing::TestParamInfo<HandCase>& info) {
 // pixels Mitsuba does not renormalise (PixelFilterBorder::kPartitionOfUnity; with the
 // renormalised filter lt is 15-20% brighter than the reference along the left and right
 // edges, |z| up to 8); pt samples the same convention.
+// normalmap.xml (normalmap and bumpmap wrappers on rectangles, a sphere and an OBJ panel): pt,
+// bpt and lt, whose light subpaths see the perturbed normals through the adjoint BSDF (Veach's
+// shading-normal factor, the light-side rule on dirFix), and vcm and upbp (merging at
+// perturbed camera vertices: the rule on the photon's direction).
 const HandCase kCases[] = {
     {"surfaces", "pt", 512},
     {"surfaces", "bpt", 256},
@@ -96,6 +100,11 @@ const HandCase kCases[] = {
     {"chromatic", "vpt", 256},
     {"chromatic", "vbpt", 128},
     {"chromatic", "upbp", 64},
+    {"normalmap", "pt", 512},
+    {"normalmap", "bpt", 256},
+    {"normalmap", "lt", 512},
+    {"normalmap", "vcm", 256},
+    {"normalmap", "upbp", 128},
 };
 
 class MitsubaHandWritten : public ::testing::TestWithParam<HandCase> {};
@@ -212,4 +221,28 @@ TEST(MitsubaHandWrittenPower, GreyExtinctionIsDistinguishedFromChromatic) {
     const test::ReferenceCheck check =
         checkAgainst("chromatic", *scene, "vpt", 256, "chromatic vpt with a grey sigma_t");
     EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see chromatic extinction";
+}
+
+// Power of the normalmap/bumpmap check: the same scene without the perturbations (the wrapped
+// BSDFs alone), and with the shadow-terminator factor off where Mitsuba applies it, fail.
+TEST(MitsubaHandWrittenPower, NormalAndBumpMapsAreDistinguished) {
+    std::unique_ptr<Scene> scene = loadMitsubaScene(kDir + "/normalmap.xml", {{"res", "48"}});
+    int perturbed = 0;
+    for (Material& m : scene->materials)
+        if (m.perturbation != NormalPerturbation::kNone) {
+            m.perturbation = NormalPerturbation::kNone;
+            ++perturbed;
+        }
+    ASSERT_EQ(perturbed, 4);  // floor, back wall, sphere, panel
+    test::ReferenceCheck check =
+        checkAgainst("normalmap", *scene, "pt", 512, "normalmap pt without the perturbations");
+    EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the normal maps";
+
+    scene = loadMitsubaScene(kDir + "/normalmap.xml", {{"res", "48"}});
+    for (Material& m : scene->materials) m.shadowTerminator = false;
+    // The factor is ~0.6% of the image (at 512 iterations the image-mean |z| is 3.0-3.7).
+    check = checkAgainst("normalmap", *scene, "pt", 2048, "normalmap pt without the terminator");
+    EXPECT_FALSE(check.perPixel.passed && std::fabs(check.meanZ[0]) < kMeanZBound &&
+                 std::fabs(check.meanZ[1]) < kMeanZBound && std::fabs(check.meanZ[2]) < kMeanZBound)
+        << "the reference test cannot see the shadow-terminator factor";
 }

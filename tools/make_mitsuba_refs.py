@@ -7,8 +7,9 @@ SCENE_ref_var.exr (per-sample variance, estimated from the spread of batch means
 var_sample = B * var(batch means of B samples)), 48x48, Mitsuba's `scalar_rgb` variant,
 and SCENE_ref.json with the Mitsuba version, sample count and batches.
 
-The scenes' inputs (textures/tiles.png, textures/stripes.jpg, volumes/density.vol,
-volumes/albedo.vol, volumes/chromatic.vol) are written by --make-inputs, with Mitsuba's own
+The scenes' inputs (textures/tiles.png, stripes.jpg, normalmap.png, heights.png,
+volumes/density.vol, volumes/albedo.vol, volumes/chromatic.vol) are written by
+--make-inputs, with Mitsuba's own
 writers.
 
 Usage (not run by the tests; the outputs are committed):
@@ -52,6 +53,25 @@ def make_jpeg(folder):
         str(folder / "textures" / "stripes.jpg"), quality=95)
 
 
+def make_perturbation_maps(folder):
+    """normalmap.xml's inputs, 32x32, read raw: a normal map of domes and dents (the
+    tangent-space normals n of the height (0.6 / 2 pi) sin(2 pi u) sin(2 pi v), slopes up to
+    0.6, stored as (n + 1) / 2) and a grey height field of bumps in [0, 1]."""
+    c = (np.arange(32) + 0.5) / 32  # pixel centres; row y is v = c[y]
+    U, V = np.meshgrid(c, c)
+    a = 0.6
+    n = np.stack([-a * np.cos(2 * np.pi * U) * np.sin(2 * np.pi * V),
+                  -a * np.sin(2 * np.pi * U) * np.cos(2 * np.pi * V), np.ones_like(U)], -1)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    rgb = np.round((n + 1) / 2 * 255).astype(np.uint8)
+    mi.Bitmap(rgb, pixel_format=mi.Bitmap.PixelFormat.RGB).write(
+        str(folder / "textures" / "normalmap.png"))
+    h = 0.5 + 0.5 * np.sin(4 * np.pi * U) * np.cos(4 * np.pi * V)
+    grey = np.round(np.repeat(h[..., None], 3, -1) * 255).astype(np.uint8)
+    mi.Bitmap(grey, pixel_format=mi.Bitmap.PixelFormat.RGB).write(
+        str(folder / "textures" / "heights.png"))
+
+
 def make_inputs(folder):
     """A 16x16 sRGB texture and a 12^3 density grid with a 3-channel albedo grid."""
     (folder / "textures").mkdir(exist_ok=True)
@@ -63,6 +83,7 @@ def make_inputs(folder):
     mi.Bitmap((img * 255).astype(np.uint8), pixel_format=mi.Bitmap.PixelFormat.RGB).write(
         str(folder / "textures" / "tiles.png"))
     make_jpeg(folder)
+    make_perturbation_maps(folder)
     n = 12
     c = (np.arange(n) + 0.5) / n
     Z, Yv, Xv = np.meshgrid(c, c, c, indexing="ij")  # VolumeGrid data is [z][y][x][channel]

@@ -50,6 +50,7 @@
 #define UB_BSDF_SEPARABLE 8u       /* separable Smith G2 for GGX reflection (Material) */
 #define UB_BSDF_BECKMANN 16u       /* Beckmann microfacets instead of GGX */
 #define UB_BSDF_REFRACT 32u        /* multi-lobe: has the refraction lobe */
+#define UB_BSDF_PERTURBED 64u      /* normal- or bump-mapped shading normal: light-side rule */
 
 /* Smallest microfacet roughness used (alpha -> 0 is a delta lobe floats cannot represent). */
 #define UB_MIN_GGX_ALPHA 1e-4f
@@ -77,11 +78,12 @@ typedef struct {
     float probDiffuse;
     float k[3];
     float probGlossy;
-    float plasticBase[3]; /* plastics: rho / (1 - Fint) per channel (ub_plastic.h) */
-    float fresnelFix;     /* smooth interface's Fresnel reflectance seen from dirFix */
-    float specularWeight; /* plastics: mean(specular) / (mean(diffuse) + mean(specular)) */
-    ub_uint tableIndex;   /* rough plastic: the material whose coating table applies */
-    float pad0, pad1;
+    float plasticBase[3];   /* plastics: rho / (1 - Fint) per channel (ub_plastic.h) */
+    float fresnelFix;       /* smooth interface's Fresnel reflectance seen from dirFix */
+    float specularWeight;   /* plastics: mean(specular) / (mean(diffuse) + mean(specular)) */
+    ub_uint tableIndex;     /* rough plastic: the material whose coating table applies */
+    float terminatorAlpha2; /* perturbed normals: a^2 of the shadow-terminator factor (0: off) */
+    float pad1;
 } ub_bsdf;
 
 /* The microfacet distribution of b (UB_MF_*). */
@@ -112,6 +114,25 @@ UB_INLINE int ub_bsdf_geometric_side_ok(UB_PRIVATE const ub_bsdf* b, float local
     int shadingReflect = localGenZ * b->localFix[2] > 0.0f;
     int geometricReflect = cosGeoGen * b->cosGeoFix > 0.0f;
     return shadingReflect == geometricReflect;
+}
+
+/* Perturbed shading normals (Mitsuba 3's normalmap and bumpmap wrappers, bsdf.h): the
+ * light-side direction (dirGen on a camera subpath, dirFix on a light subpath) must lie on the
+ * same side of the geometric surface as of the shading normal, and f is scaled by the
+ * shadow-terminator factor of Estevez et al., "A Microfacet-Based Shadowing Function to Solve
+ * the Bump Terminator Problem" (Ray Tracing Gems, 2019): G = 2 / (1 + sqrt(1 + a^2 tan^2)),
+ * with tan the tangent of the light-side direction's angle to the geometric normal and a^2 =
+ * terminatorAlpha2. Returns G, 0 where the side rule fails, 1 without a perturbation. */
+UB_INLINE float ub_bsdf_perturbed_factor(UB_PRIVATE const ub_bsdf* b, float localGenZ,
+                                         float cosGeoGen) {
+    if (!(b->flags & UB_BSDF_PERTURBED)) return 1.0f;
+    int fromLight = (b->flags & UB_BSDF_FROM_LIGHT) != 0u;
+    float shadingCos = fromLight ? b->localFix[2] : localGenZ;
+    float geoCos = fromLight ? b->cosGeoFix : cosGeoGen;
+    if (!(shadingCos * geoCos > 0.0f)) return 0.0f;
+    float cos2 = geoCos * geoCos;
+    float tan2 = ub_fmax(0.0f, 1.0f - cos2) / cos2;
+    return 2.0f / (1.0f + ub_sqrt(1.0f + b->terminatorAlpha2 * tan2));
 }
 
 /* Probability of picking a plastic's specular lobe seen from a direction with |cos| =
@@ -326,8 +347,9 @@ UB_INLINE ub_float3 ub_bsdf_eval_rough_plastic(UB_PRIVATE const ub_bsdf* b,
 }
 
 /* f_s(dirFix, dirGen) and both pdfs for dirGen given in the shading frame; cosGeoGen =
- * dot(dirGen, geoNormal). Applies the geometric guard and, for light subpaths, the
- * shading-normal factor. coating: the rough plastic's coating table (else unused). */
+ * dot(dirGen, geoNormal). Applies the geometric guard, the perturbed-normal rule and factor,
+ * and, for light subpaths, the shading-normal factor. coating: the rough plastic's coating table
+ * (else unused). */
 UB_INLINE ub_float3 ub_bsdf_eval_local(UB_PRIVATE const ub_bsdf* b, UB_GLOBAL const float* coating,
                                        ub_float3 gen, float cosGeoGen, UB_PRIVATE float* directPdfW,
                                        UB_PRIVATE float* reversePdfW) {
@@ -335,6 +357,8 @@ UB_INLINE ub_float3 ub_bsdf_eval_local(UB_PRIVATE const ub_bsdf* b, UB_GLOBAL co
     *directPdfW = 0.0f;
     *reversePdfW = 0.0f;
     if (ub_fabs(gen.z) < UB_EPS_COSINE || !ub_bsdf_geometric_side_ok(b, gen.z, cosGeoGen)) return f;
+    float perturbed = ub_bsdf_perturbed_factor(b, gen.z, cosGeoGen);
+    if (!(perturbed > 0.0f)) return f;
     switch (b->type) {
         case UB_MATERIAL_DIFFUSE:
         case UB_MATERIAL_PHONG:
@@ -358,7 +382,7 @@ UB_INLINE ub_float3 ub_bsdf_eval_local(UB_PRIVATE const ub_bsdf* b, UB_GLOBAL co
         default:
             break;
     }
-    return ub_f3_scale(f, ub_bsdf_shading_factor(b, ub_fabs(gen.z), cosGeoGen));
+    return ub_f3_scale(f, ub_bsdf_shading_factor(b, ub_fabs(gen.z), cosGeoGen) * perturbed);
 }
 
 /* The same for a world-space unit dirGen; *cosThetaGen = |cos| to the shading normal. */

@@ -48,6 +48,18 @@
 // so that f_s cos_s(dirGen) is the correct importance throughput; it is exactly 1
 // when Ns == Ng.
 //
+// Perturbed shading normals (Mitsuba 3's normalmap / bumpmap; scene/normal_perturbation.h):
+// the shading normal given to setup() is already the perturbed one (Scene::intersect), so the
+// lobes and the adjoint factor above use it. Like Mitsuba's wrappers, f(camera side, light
+// side) is also zero unless the light-side direction lies on the same side of the
+// unperturbed surface as of the perturbed one, and is scaled by the shadow-terminator factor
+// of Estevez et al. 2019 for the light-side direction (Mitsuba's use_shadowing_function).
+// Mitsuba measures both against the unperturbed shading normal; unibeam uses the geometric
+// normal, which is the same on spheres and on meshes without vertex normals. On a camera
+// subpath the light side is dirGen (a per-direction factor), on a light subpath it is dirFix
+// (one factor for the vertex; black when its side rule fails), so all algorithms use the
+// same f. Pdfs are zero where the rule fails (no sample lands there).
+//
 // Russian roulette (continuationProb): max over RGB of the albedo estimate,
 // clamped to [0,1] as SmallVCM: diffuse (+ glossy); mirror `specular`; dielectrics
 // `specular` (1 for clear glass; refraction weights may exceed 1 for radiance, RR
@@ -60,6 +72,7 @@
 #include "kernels/shared/ub_microfacet.h"
 #include "kernels/shared/ub_phong.h"
 #include "scene/microfacet_sampling.h"
+#include "scene/normal_perturbation.h"
 
 namespace ub {
 
@@ -118,6 +131,8 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
                mat.type == MaterialType::ThinDielectric;
 
     Vec3 ns = shadingNormal, ng = geoNormal;
+    perturbed_ = mat.perturbation != NormalPerturbation::kNone;
+    terminatorAlpha2_ = perturbed_ && mat.shadowTerminator ? shadowTerminatorAlpha2(ns, ng) : 0.0f;
     if (!keepsNormalSide(mat) && dot(dirFix, ns) < 0.0f) {
         if (mat.twoSided) {
             ns = -ns;
@@ -182,6 +197,9 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
             setupMultiLobe();
             break;
     }
+    // Perturbed normal (normal/bump map): on a light subpath dirFix is the light-side
+    // direction, which must lie on the same side of the geometric and the shading surface.
+    if (perturbed_ && fromLight && !(localDirFix_.z * cosGeoFix_ > 0.0f)) black_ = true;
     if (black_) contProb_ = 0.0f;
     contProb_ = clamp01(contProb_);
     valid_ = true;
@@ -225,7 +243,8 @@ void Bsdf::packShared() {
               (fromLight_ ? UB_BSDF_FROM_LIGHT : 0u) |
               (geometricGuard_ ? UB_BSDF_GEOMETRIC_GUARD : 0u) |
               (m.separableMasking ? UB_BSDF_SEPARABLE : 0u) |
-              (m.distribution == MicrofacetDistribution::kBeckmann ? UB_BSDF_BECKMANN : 0u);
+              (m.distribution == MicrofacetDistribution::kBeckmann ? UB_BSDF_BECKMANN : 0u) |
+              (perturbed_ ? UB_BSDF_PERTURBED : 0u);
     b.cosGeoFix = cosGeoFix_;
     b.exponent = m.exponent;
     b.alpha = m.alpha;
@@ -237,7 +256,8 @@ void Bsdf::packShared() {
     b.fresnelFix = fresnelFix_;
     b.specularWeight = specularWeight_;
     b.tableIndex = 0;  // the surface-merging pass sets the material's index
-    b.pad0 = b.pad1 = 0.0f;
+    b.terminatorAlpha2 = terminatorAlpha2_;
+    b.pad1 = 0.0f;
     coating_ = m.type == MaterialType::RoughPlastic ? m.coatingTransmittance.data() : nullptr;
 }
 
@@ -450,15 +470,16 @@ Rgb Bsdf::sampleDelta(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThet
     const Vec3 world = frame_.toWorld(gen);
     const float cosGen = std::fabs(gen.z);
     const float cosGeoGen = dot(world, geoNormal_);
+    const float perturbed = ub_bsdf_perturbed_factor(&shared_, gen.z, cosGeoGen);
     if (!(prob > 0.0f) || cosGen < kEpsCosine ||
-        !ub_bsdf_geometric_side_ok(&shared_, gen.z, cosGeoGen))
+        !ub_bsdf_geometric_side_ok(&shared_, gen.z, cosGeoGen) || !(perturbed > 0.0f))
         return Rgb(0.0f);
     *dirGen = world;
     *pdfW = prob;
     if (cosThetaGen) *cosThetaGen = cosGen;
     if (sampledEvent) *sampledEvent = event;
     // Pre-divided by the cosine the caller multiplies with (SmallVCM convention).
-    return weight * (ub_bsdf_shading_factor(&shared_, cosGen, cosGeoGen) / cosGen);
+    return weight * (ub_bsdf_shading_factor(&shared_, cosGen, cosGeoGen) * perturbed / cosGen);
 }
 
 }  // namespace ub

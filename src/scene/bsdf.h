@@ -150,7 +150,9 @@ class Bsdf {
     Vec3 geoNormal_;          ///< geometric normal, same side convention as frame_.n
     float cosGeoFix_ = 0.0f;  ///< dot(dirFix, geoNormal_)
     bool fromLight_ = false;
-    bool geometricGuard_ = true;  ///< see the banner
+    bool geometricGuard_ = true;     ///< see the banner
+    bool perturbed_ = false;         ///< normal- or bump-mapped material (bsdf.cpp's banner)
+    float terminatorAlpha2_ = 0.0f;  ///< its shadow-terminator a^2 (0: no factor)
     bool valid_ = false;
     bool isDelta_ = false;
     bool black_ = false;  ///< back side of a one-sided material, or all-black lobes

@@ -37,6 +37,14 @@ struct MaterialTextures {
     int transmittance = -1;  ///< replaces Material::transmittance
 };
 
+/// Mitsuba 3's `normalmap` and `bumpmap` wrappers: the shading normal of a hit perturbed by a
+/// texture (scene/normal_perturbation.h; Scene::intersect applies it).
+enum class NormalPerturbation : uint32_t {
+    kNone = 0,
+    kNormalMap = 1,  ///< RGB texel c -> tangent-space normal 2 c - 1 in the frame (dpdu, n)
+    kBumpMap = 2,    ///< height field: `bumpScale` x the uv gradient of the texel luminance
+};
+
 /// Microfacet normal distribution of the rough materials (kernels/shared/ub_microfacet.h).
 enum class MicrofacetDistribution : uint32_t {
     kGgx = 0,       ///< GGX / Trowbridge-Reitz (unibeam's default)
@@ -79,6 +87,14 @@ struct Material {
     /// scattering sum, darker and more saturated colours); false keeps texture colours.
     bool nonlinear = false;
     MaterialTextures textures;  ///< textured parameters (Scene::setupBsdf looks them up)
+    /// Shading-normal perturbation (Mitsuba's normalmap / bumpmap wrapping this material) and
+    /// its texture in Scene::textures; `bumpScale` multiplies the height gradient.
+    NormalPerturbation perturbation = NormalPerturbation::kNone;
+    int perturbationTexture = -1;
+    float bumpScale = 1.0f;
+    /// Perturbed normals: Mitsuba's `use_shadowing_function`, the shadow-terminator factor of
+    /// Estevez et al. 2019 on the light-side direction (scene/normal_perturbation.h).
+    bool shadowTerminator = true;
 
     // ---- derived data, filled by prepareMaterial() (scene/bsdf.h) ----
     /// Plastic: Fdr of the coating seen from inside (fit); RoughPlastic: Mitsuba 3's

@@ -45,6 +45,7 @@
 
 #include "core/error.h"
 #include "scene/bsdf.h"
+#include "scene/normal_perturbation.h"
 
 namespace ub {
 
@@ -259,6 +260,10 @@ int Scene::addMaterial(const Material& m) {
             throw std::logic_error("Scene::addMaterial: material '" + m.name +
                                    "' refers to texture " + std::to_string(t) +
                                    ", which was not added");
+    if (m.perturbation != NormalPerturbation::kNone &&
+        (m.perturbationTexture < 0 || m.perturbationTexture >= int(textures.size())))
+        throw std::logic_error("Scene::addMaterial: material '" + m.name +
+                               "' has a normal or bump map without a texture");
     materials.push_back(m);
     prepareMaterial(materials.back());  // plastic tables (scene/bsdf.h)
     return int(materials.size()) - 1;
@@ -531,6 +536,17 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
         if (phi < 0.0) phi += 2.0 * kPiD;
         double theta = std::acos(std::max(-1.0, std::min(1.0, nz)));
         hit->uv = Vec2(float(phi / (2.0 * kPiD)), float(theta / kPiD));
+        if (perturbs(hit->materialId)) {
+            // Derivatives of c + r (sin v' cos u', sin v' sin u', cos v'), u' = 2 pi u,
+            // v' = pi v.
+            const double sinTheta = std::sqrt(std::max(0.0, 1.0 - nz * nz));
+            const double cosPhi = sinTheta > 0.0 ? nx / sinTheta : 1.0;
+            const double sinPhi = sinTheta > 0.0 ? ny / sinTheta : 0.0;
+            const Vec3 dpdu(float(-2.0 * kPiD * r * ny), float(2.0 * kPiD * r * nx), 0.0f);
+            const Vec3 dpdv(float(kPiD * r * nz * cosPhi), float(kPiD * r * nz * sinPhi),
+                            float(-kPiD * r * sinTheta));
+            perturbShadingNormal(hit, dpdu, dpdv);
+        }
         return true;
     }
 
@@ -559,7 +575,38 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
     } else {
         hit->uv = Vec2(b1, b2);  // barycentrics when the mesh has no uvs
     }
+    if (perturbs(hit->materialId)) {
+        // Tangents of the uv parameterisation (scene/normal_perturbation.h).
+        const Vec3 e1 = p1 - p0, e2 = p2 - p0;
+        Vec3 dpdu = e1, dpdv = e2;
+        if (!g.uvs.empty()) {
+            const Vec2 &t0 = g.uvs[tri[0]], &t1 = g.uvs[tri[1]], &t2 = g.uvs[tri[2]];
+            const float du1 = t1.x - t0.x, dv1 = t1.y - t0.y;
+            const float du2 = t2.x - t0.x, dv2 = t2.y - t0.y;
+            const float det = du1 * dv2 - dv1 * du2;
+            if (det != 0.0f && std::isfinite(1.0f / det)) {
+                dpdu = (dv2 * e1 - dv1 * e2) / det;
+                dpdv = (du1 * e2 - du2 * e1) / det;
+            } else {
+                const Frame f(hit->geoNormal);
+                dpdu = f.s;
+                dpdv = f.t;
+            }
+        }
+        perturbShadingNormal(hit, dpdu, dpdv);
+    }
     return true;
+}
+
+bool Scene::perturbs(int materialId) const {
+    return materialId >= 0 && size_t(materialId) < materials.size() &&
+           materials[size_t(materialId)].perturbation != NormalPerturbation::kNone;
+}
+
+void Scene::perturbShadingNormal(Hit* hit, const Vec3& dpdu, const Vec3& dpdv) const {
+    const Material& m = materials[size_t(hit->materialId)];
+    hit->shadingNormal = perturbedShadingNormal(m, textures[size_t(m.perturbationTexture)], hit->uv,
+                                                hit->shadingNormal, hit->geoNormal, dpdu, dpdv);
 }
 
 namespace {

@@ -38,7 +38,8 @@ struct Hit {
     float dist = kInf;  ///< ray parameter of the hit (ray.dir is unit: distance)
     Vec3 pos;
     Vec3 geoNormal;      ///< unit geometric normal as defined by the shape (front side)
-    Vec3 shadingNormal;  ///< unit shading normal, in the same hemisphere as geoNormal
+    Vec3 shadingNormal;  ///< unit shading normal, in the same hemisphere as geoNormal (with
+                         ///< the material's normal or bump map applied)
     Vec2 uv;
     uint32_t shapeId = 0;
     uint32_t primId = 0;
@@ -235,6 +236,10 @@ class Scene {
 
   private:
     MediumStack mediumStackAtShapeSides(const Vec3& p) const;
+    /// True if material materialId has a normal or bump map (Material::perturbation).
+    bool perturbs(int materialId) const;
+    /// Replaces hit->shadingNormal by its material's perturbed normal (tangents dpdu, dpdv).
+    void perturbShadingNormal(Hit* hit, const Vec3& dpdu, const Vec3& dpdv) const;
 
     struct Impl;
     std::unique_ptr<Impl> impl_;

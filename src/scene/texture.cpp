@@ -102,6 +102,34 @@ Rgb Texture::eval(const Vec2& uvSurface) const {
     return bilinear(*image, u, v);
 }
 
+Vec2 Texture::luminanceGradient(const Vec2& uvSurface) const {
+    if (type != TextureType::Bitmap || filter != TextureFilter::Bilinear || !image)
+        return Vec2(0.0f, 0.0f);
+    const Vec2 uv = toUv.apply(uvSurface);
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return Vec2(0.0f, 0.0f);
+    const Image& img = *image;
+    // The cell of lookup()'s bilinear interpolation: f(x, y) = sum of the four corner values
+    // times (1 - wx or wx)(1 - wy or wy); its slopes in continuous pixel coordinates.
+    const float kLimit = 16777216.0f;
+    const float qx = std::clamp(uv.x * float(img.width), -kLimit, kLimit) - 0.5f;
+    const float qy = std::clamp(uv.y * float(img.height), -kLimit, kLimit) - 0.5f;
+    const float fx = std::floor(qx), fy = std::floor(qy);
+    const float wx = qx - fx, wy = qy - fy;
+    const int x0 = wrapIndexMode(int(fx), img.width, wrap);
+    const int y0 = wrapIndexMode(int(fy), img.height, wrap);
+    const int x1 = wrapIndexMode(int(fx) + 1, img.width, wrap);
+    const int y1 = wrapIndexMode(int(fy) + 1, img.height, wrap);
+    const float f00 = luminance(img.at(x0, y0)), f10 = luminance(img.at(x1, y0));
+    const float f01 = luminance(img.at(x0, y1)), f11 = luminance(img.at(x1, y1));
+    const float dx = (1.0f - wy) * (f10 - f00) + wy * (f11 - f01);
+    const float dy = (1.0f - wx) * (f01 - f00) + wx * (f11 - f10);
+    // Chain rule through uv' = A uv + b (A^T times the slopes), then Mitsuba's scaling of
+    // each component by the resolution (exact for a diagonal A).
+    const float du = toUv.m[0][0] * dx + toUv.m[1][0] * dy;
+    const float dv = toUv.m[0][1] * dx + toUv.m[1][1] * dy;
+    return Vec2(float(img.width) * du, float(img.height) * dv);
+}
+
 Rgb Texture::mean() const {
     switch (type) {
         case TextureType::Constant:

@@ -72,6 +72,12 @@ struct Texture {
 
     /// Value at the surface uv (before toUv). Non-finite uv gives black.
     Rgb eval(const Vec2& uv) const;
+    /// Gradient d/d(u, v) of the luminance of eval() (Rec. 709 weights, luminance()) at the
+    /// surface uv, as Mitsuba 3's `eval_1_grad`: a bilinear bitmap differentiates its
+    /// interpolation in the cell of uv' (pixel-space slopes, times the transpose of toUv's
+    /// linear part, then per component times the resolution W, H); nearest lookups and
+    /// constants give 0. Checkerboards have no gradient (the loader refuses them; 0 here).
+    Vec2 luminanceGradient(const Vec2& uv) const;
     /// Average over the texture's domain (Checkerboard: (color0 + color1) / 2; Bitmap:
     /// the pixel mean).
     Rgb mean() const;

@@ -13,8 +13,8 @@ namespace ub {
 namespace {
 
 const std::vector<std::string> kBsdfs = {
-    "diffuse",        "conductor", "roughconductor", "dielectric", "roughdielectric",
-    "thindielectric", "plastic",   "roughplastic",   "null",       "twosided"};
+    "diffuse", "conductor",    "roughconductor", "dielectric", "roughdielectric", "thindielectric",
+    "plastic", "roughplastic", "null",           "twosided",   "normalmap",       "bumpmap"};
 const std::vector<std::string> kTextures = {"checkerboard", "bitmap"};
 
 constexpr float kAirIor = 1.000277f;        // Mitsuba's default ext_ior ("air")
@@ -180,6 +180,73 @@ bool readConductorIor(MitsubaBuild& b, const XmlObject& o, Material& m) {
     return true;
 }
 
+/// `normalmap` / `bumpmap`: the nested BSDF's material with its shading normal perturbed by
+/// a texture (scene/normal_perturbation.h). Returns false on an error (reported).
+bool readPerturbation(MitsubaBuild& b, const XmlObject& o, Material* m) {
+    XmlReader& r = b.r;
+    const bool normalMap = o.type == "normalmap";
+    // The texture: attached as "normalmap", or the only nested texture of a bumpmap.
+    const XmlObject* texture = nullptr;
+    if (normalMap) {
+        texture = r.child(o, "texture", "normalmap");
+        if (!texture) {
+            r.error(o.pos, o.label() +
+                               ": needs a <texture name=\"normalmap\"> (RGB texture of "
+                               "tangent-space normals)");
+        }
+    } else {
+        std::vector<const XmlObject*> textures = r.children(o, "texture");
+        if (textures.size() != 1)
+            r.error(o.pos, o.label() +
+                               ": expected exactly one nested <texture> (the height "
+                               "field), got " +
+                               std::to_string(textures.size()));
+        else
+            texture = textures[0];
+        if (texture && texture->type != "bitmap")
+            r.error(texture->pos, o.label() +
+                                      ": the height field must be a 'bitmap' texture "
+                                      "(a '" +
+                                      texture->type + "' has no uv gradient)");
+    }
+    const float scale = normalMap ? 1.0f : r.getFloat(o, "scale", 1.0f);
+    if (!std::isfinite(scale)) r.error(o.find("scale")->pos, o.label() + ": scale is not finite");
+    // Mitsuba flips the tangential part of a normal that faces away from the camera-side
+    // direction; that rule depends on which direction is the camera's, so unibeam (one f for
+    // all algorithms) reads the flag and does not apply it (docs/mitsuba.md).
+    r.getBool(o, "flip_invalid_normals", true);
+    const bool terminator = r.getBool(o, "use_shadowing_function", true);
+
+    std::vector<const XmlObject*> inner = r.children(o, "bsdf");
+    if (inner.size() != 1) {
+        r.error(o.pos, o.label() + ": expected exactly one nested <bsdf>, got " +
+                           std::to_string(inner.size()));
+        return false;
+    }
+    if (inner[0]->type == "null" || inner[0]->type == "normalmap" || inner[0]->type == "bumpmap") {
+        r.error(inner[0]->pos, o.label() + ": cannot wrap a '" + inner[0]->type + "' BSDF");
+        return false;
+    }
+    if (inner[0]->type == "twosided") {
+        // twosided(X) is X with twoSided set: look through it for a second perturbation.
+        for (const XmlChild& c : inner[0]->children)
+            if (c.object && (c.object->type == "normalmap" || c.object->type == "bumpmap")) {
+                r.error(c.pos, o.label() + ": cannot wrap a second '" + c.object->type + "'");
+                return false;
+            }
+    }
+    const int textureId = texture ? buildTexture(b, *texture) : -1;
+    const int innerId = buildMitsubaBsdf(b, *inner[0]);
+    if (innerId < 0 || textureId < 0) return false;
+    *m = b.scene.materials[size_t(innerId)];
+    m->perturbation = normalMap ? NormalPerturbation::kNormalMap : NormalPerturbation::kBumpMap;
+    m->perturbationTexture = textureId;
+    m->bumpScale = scale;
+    m->shadowTerminator = terminator;
+    if (!o.id.empty()) m->name = o.id;
+    return true;
+}
+
 }  // namespace
 
 int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
@@ -214,6 +281,8 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
                 if (!o.id.empty()) m.name = o.id;
             }
         }
+    } else if (o.type == "normalmap" || o.type == "bumpmap") {
+        readPerturbation(b, o, &m);
     } else if (o.type == "diffuse") {
         m.type = MaterialType::Diffuse;
         readReflectance(b, o, "reflectance", Rgb(0.5f), &m.diffuse, &m.textures.diffuse);
