@@ -84,9 +84,9 @@ struct MitsubaBuild {
     std::map<const XmlObject*, int> materialIds;  ///< bsdf object -> material id
     std::map<const XmlObject*, int> textureIds;   ///< texture object -> texture id
     std::map<const XmlObject*, int> mediumIds;    ///< medium object -> Scene::media index
-    int nullPassId = -1;  ///< the pass-through material of masks and null emitters (or -1)
     /// Media (volscene's Scene::media is not in main yet): objects seen, for messages.
     bool cameraSet = false;
+    int nullPassId = -1;  ///< the pass-through material of masks and null emitters (or -1)
 
     /// Resolves a file name property through the search path; reports an error and returns
     /// "" if not found.
