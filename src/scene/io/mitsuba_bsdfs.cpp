@@ -2,6 +2,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <utility>
 
 #include "core/image.h"
 #include "scene/io/mitsuba_build.h"
@@ -107,6 +108,16 @@ void readWeight(MitsubaBuild& b, const XmlObject& o, const std::string& name, fl
                 float* value, int* texture) {
     if (const XmlObject* tex = b.r.child(o, "texture", name)) {
         *texture = buildTexture(b, *tex);
+        // Mitsuba 3's checkerboard evaluates as a float texture with the opposite parity of
+        // its colour evaluation (src/textures/checkerboard.cpp in 3.9.1: eval_1 takes
+        // color0 where exactly one of frac(u), frac(v) exceeds 1/2, eval where both or
+        // neither do), so a float use sees the colours swapped; measured against Mitsuba
+        // on tests/data/mitsuba/blend.xml.
+        if (*texture >= 0 && b.scene.textures[size_t(*texture)].type == TextureType::Checkerboard) {
+            Texture swapped = b.scene.textures[size_t(*texture)];
+            std::swap(swapped.color0, swapped.color1);
+            *texture = b.scene.addTexture(swapped);
+        }
         return;
     }
     *value = b.r.getFloatIn(o, name, def, 0.0f, 1.0f);
