@@ -18,6 +18,8 @@
 #include <sstream>
 #include <string>
 
+#include "core/error.h"
+#include "render/integrator.h"
 #include "scene/io/mitsuba_loader.h"
 #include "tests/support/reference_render.h"
 
@@ -71,7 +73,15 @@ std::string caseName(const ::testing::TestParamInfo<HandCase>& info) {
 // bpt and lt, whose light subpaths see the perturbed normals through the adjoint BSDF (Veach's
 // shading-normal factor, the light-side rule on dirFix), and vcm and upbp (merging at
 // perturbed camera vertices: the rule on the photon's direction).
+// blend.xml (blendbsdf with a constant and a textured weight, mask with a constant and a
+// cut-out opacity, a null-BSDF emitter seen through): pt, bpt and vcm (merging on blends,
+// VertexCM::mergeVerticesBlend). Mitsuba's volpath sends shadow rays through null surfaces;
+// unibeam's block there and the light is found by sampling the pass-through lobe instead (same
+// expectation). upbp's batch surface merging refuses blends (BlendIsRefusedByUpbpSurf).
 const HandCase kCases[] = {
+    {"blend", "pt", 512},
+    {"blend", "bpt", 256},
+    {"blend", "vcm", 256},
     {"surfaces", "pt", 512},
     {"surfaces", "bpt", 256},
     {"lights", "pt", 512},
@@ -245,4 +255,38 @@ TEST(MitsubaHandWrittenPower, NormalAndBumpMapsAreDistinguished) {
     EXPECT_FALSE(check.perPixel.passed && std::fabs(check.meanZ[0]) < kMeanZBound &&
                  std::fabs(check.meanZ[1]) < kMeanZBound && std::fabs(check.meanZ[2]) < kMeanZBound)
         << "the reference test cannot see the shadow-terminator factor";
+}
+
+// Power of the blend check: the constant-opacity mask rendered opaque (opacity 1) fails.
+TEST(MitsubaHandWrittenPower, MaskOpacityIsDistinguished) {
+    std::unique_ptr<Scene> scene = loadEdited("blend", R"(<float name="opacity" value="0.5"/>)",
+                                              R"(<float name="opacity" value="1"/>)");
+    const test::ReferenceCheck check =
+        checkAgainst("blend", *scene, "pt", 512, "blend pt, mask opaque");
+    EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the mask's opacity";
+}
+
+// Power of the null-emitter check: the emitter made opaque and black behind its emission (what
+// the loader did before) fails.
+TEST(MitsubaHandWrittenPower, NullEmitterPassingIsDistinguished) {
+    std::unique_ptr<Scene> scene =
+        loadEdited("blend", R"(<bsdf type="null"/>)",
+                   R"(<bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf>)");
+    const test::ReferenceCheck check =
+        checkAgainst("blend", *scene, "pt", 512, "blend pt, null emitter opaque");
+    EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see through the emitter";
+}
+
+// upbp's surface merging runs on recorded kernel-side BSDF state, which has no blends: refused
+// with a message naming the material.
+TEST(MitsubaHandWrittenPower, BlendIsRefusedByUpbpSurf) {
+    std::unique_ptr<Scene> scene = loadMitsubaScene(kDir + "/blend.xml", {{"res", "48"}});
+    RenderOptions options;
+    options.algorithm = "upbp";
+    try {
+        makeIntegrator(*scene, options);
+        FAIL() << "upbp accepted a blend";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("is a blend"), std::string::npos) << e.what();
+    }
 }

@@ -501,3 +501,79 @@ TEST(MitsubaXml, OutOfRangeMessageShowsTheBounds) {
                          "(expected a value in (0, 1e+30])"))
         << e;
 }
+
+// blendbsdf and mask (scene/bsdf.cpp, "Blend"): the parts in document order, a mask's null
+// part first; weight / opacity as a float or a texture; twosided reaches the parts.
+TEST(MitsubaBsdfs, BlendAndMaskBuildBlendMaterials) {
+    std::unique_ptr<Scene> s = load(scene(std::string(kLight) + R"(
+<shape type="sphere"><bsdf type="blendbsdf"><float name="weight" value="0.25"/>
+  <bsdf type="diffuse"/><bsdf type="conductor"/></bsdf></shape>
+<shape type="rectangle"><bsdf type="twosided"><bsdf type="mask" id="leaf">
+  <texture type="checkerboard" name="opacity"><float name="color0" value="1"/>
+    <float name="color1" value="0"/></texture>
+  <bsdf type="diffuse"/></bsdf></bsdf></shape>
+)"));
+    const Material& blend = s->materials[size_t(s->shapes[0].materialId)];
+    ASSERT_EQ(blend.type, MaterialType::Blend);
+    EXPECT_FLOAT_EQ(blend.blendWeight, 0.25f);
+    EXPECT_EQ(s->materials[size_t(blend.blendParts[0])].type, MaterialType::Diffuse);
+    EXPECT_EQ(s->materials[size_t(blend.blendParts[1])].type, MaterialType::Mirror);
+    const Material& mask = s->materials[size_t(s->shapes[1].materialId)];
+    ASSERT_EQ(mask.type, MaterialType::Blend);
+    EXPECT_GE(mask.textures.weight, 0);
+    const Material& pass = s->materials[size_t(mask.blendParts[0])];
+    EXPECT_EQ(pass.type, MaterialType::ThinDielectric);
+    EXPECT_EQ(pass.ior, 1.0f);
+    const Material& leaf = s->materials[size_t(mask.blendParts[1])];
+    EXPECT_EQ(leaf.type, MaterialType::Diffuse);
+    EXPECT_TRUE(leaf.twoSided);  // twosided around the mask reaches the masked BSDF
+}
+
+// A null BSDF on an emitter: the shape emits and lets rays pass (the pass-through material);
+// with a medium it is refused.
+TEST(MitsubaBsdfs, NullBsdfEmitterPassesRays) {
+    std::unique_ptr<Scene> s = load(scene(R"(
+<shape type="rectangle"><bsdf type="null"/>
+  <emitter type="area"><rgb name="radiance" value="2"/></emitter></shape>
+)"));
+    ASSERT_EQ(s->shapes.size(), 1u);
+    EXPECT_GE(s->shapes[0].lightId, 0);
+    const Material& m = s->materials[size_t(s->shapes[0].materialId)];
+    EXPECT_EQ(m.type, MaterialType::ThinDielectric);
+    EXPECT_EQ(m.ior, 1.0f);
+    EXPECT_FALSE(s->shapes[0].isMediumBoundary);
+    const std::string e = errorsOf(scene(R"(<medium type="homogeneous" id="fog"/>
+<shape type="sphere"><bsdf type="null"/><ref id="fog" name="interior"/>
+  <emitter type="area"/></shape>
+)"));
+    EXPECT_NE(e.find("null BSDF and a medium cannot emit"), std::string::npos) << e;
+    EXPECT_NE(e.find("scene.xml:"), std::string::npos) << e;
+}
+
+TEST(MitsubaBsdfs, BadBlendsAreErrorsWithPosition) {
+    auto errorOf = [](const std::string& bsdf) {
+        return errorsOf(
+            scene(std::string(kLight) + "<shape type=\"sphere\">\n" + bsdf + "</shape>\n"));
+    };
+    std::string e = errorOf("<bsdf type=\"blendbsdf\"><bsdf type=\"diffuse\"/></bsdf>\n");
+    EXPECT_NE(e.find("expected exactly 2 nested <bsdf>s, got 1"), std::string::npos) << e;
+    EXPECT_NE(e.find("scene.xml:"), std::string::npos) << e;
+    e = errorOf("<bsdf type=\"mask\"><bsdf type=\"diffuse\"/><bsdf type=\"diffuse\"/></bsdf>\n");
+    EXPECT_NE(e.find("expected exactly 1 nested <bsdf>, got 2"), std::string::npos) << e;
+    e = errorOf(
+        "<bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"1.5\"/>\n"
+        "<bsdf type=\"diffuse\"/><bsdf type=\"diffuse\"/></bsdf>\n");
+    EXPECT_NE(e.find("weight"), std::string::npos) << e;
+    e = errorOf(
+        "<bsdf type=\"mask\"><float name=\"opacity\" value=\"-0.1\"/>"
+        "<bsdf type=\"diffuse\"/></bsdf>\n");
+    EXPECT_NE(e.find("opacity"), std::string::npos) << e;
+    e = errorOf(
+        "<bsdf type=\"blendbsdf\"><bsdf type=\"dielectric\"/><bsdf type=\"diffuse\"/>"
+        "</bsdf>\n");
+    EXPECT_NE(e.find("cannot hold a 'dielectric'"), std::string::npos) << e;
+    e = errorOf(
+        "<bsdf type=\"mask\"><rgb name=\"tint\" value=\"1\"/><bsdf type=\"diffuse\"/>"
+        "</bsdf>\n");
+    EXPECT_NE(e.find("tint"), std::string::npos) << e;
+}

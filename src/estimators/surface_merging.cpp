@@ -56,6 +56,7 @@ std::vector<float> coatingTables(const Scene& scene) {
 }
 
 Rgb VertexCM::mergeVertices(const SubPath& state, const Hit& hit, const Bsdf& bsdf) const {
+    if (bsdf.isBlend()) return mergeVerticesBlend(state, hit, bsdf);
     const ub_surface_query q =
         makeSurfaceQuery(bsdf, hit.pos, state.pathLength, Rgb(1.0f), 0, state.mis.dVCM,
                          state.mis.dVM, vcmContinuationProb(bsdf), hit.materialId);
@@ -66,6 +67,37 @@ Rgb VertexCM::mergeVertices(const SubPath& state, const Hit& hit, const Bsdf& bs
             mis_, &lightVertices_[index], &q, bsdf.coatingTable(), radiusSqr,
             ub_uint(options_.minPathLength), ub_uint(options_.maxPathLength), ppm_ ? 1u : 0u);
         sum += Rgb(c.x, c.y, c.z);
+    });
+    return sum * vmNormalization_;
+}
+
+// The same per-pair estimate as ub_surf_contribution, with the BSDF evaluated through
+// Bsdf::evaluate: a Blend (Mitsuba's blendbsdf, mask) has no kernel-side state.
+Rgb VertexCM::mergeVerticesBlend(const SubPath& state, const Hit& hit, const Bsdf& bsdf) const {
+    const float radiusSqr = grid_.radius() * grid_.radius();
+    const float contProb = vcmContinuationProb(bsdf);
+    const ub_mis_partials camera = ub_mis_merge_partials(state.mis.dVCM, state.mis.dVM);
+    Rgb sum(0.0f);
+    grid_.query(hit.pos, lightVertices_, &LightVertex::position, [&](uint32_t index) {
+        const LightVertex& lv = lightVertices_[index];
+        if (lv.flags & UB_LIGHT_VERTEX_IN_MEDIUM) return;
+        if (lengthSqr(loadF3(lv.position) - hit.pos) > radiusSqr) return;
+        const int length = int(lv.pathLength) + state.pathLength;
+        if (length > options_.maxPathLength || length < options_.minPathLength) return;
+        float cosGen = 0.0f, dirPdfW = 0.0f, revPdfW = 0.0f;
+        const Rgb f = bsdf.evaluate(lv.dirFix3(), &cosGen, &dirPdfW, &revPdfW);
+        if (isBlack(f)) return;
+        float weight = 1.0f;
+        if (!ppm_) {
+            ub_mis_partials light;
+            light.dVCM = lv.dVCM;
+            light.dVC = lv.dVC;
+            light.dVM = lv.dVM;
+            light.dOut = 0.0f;
+            weight =
+                ub_mis_weight_merge(mis_, light, camera, dirPdfW * contProb, revPdfW * lv.contProb);
+        }
+        sum += f * lv.throughput3() * weight;
     });
     return sum * vmNormalization_;
 }

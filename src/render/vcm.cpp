@@ -94,7 +94,18 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
             break;
     }
     surfBatch_ = algorithm_ == Algorithm::Upbp && upbp_.surf;
-    if (surfBatch_) coatingTables_ = coatingTables(scene);
+    if (surfBatch_) {
+        // The batch pass (and its OpenCL kernel) evaluates the recorded kernel-side BSDF
+        // state (kernels/shared/ub_bsdf.h), which has no blends.
+        for (const Material& m : scene.materials)
+            if (m.type == MaterialType::Blend)
+                throw InputError(scene.sourceFile,
+                                 "material '" + m.name +
+                                     "' is a blend (Mitsuba's blendbsdf or mask), which upbp's "
+                                     "surface merging (surf) does not support; use vcm on a "
+                                     "scene without media, bpt, pt, or upbp without surf");
+        coatingTables_ = coatingTables(scene);
+    }
     if (algorithm_ == Algorithm::Upbp) {
         const float radii[4] = {options.radiusPP3D, options.radiusPB2D, options.radiusBP2D,
                                 options.radiusBB1D};
@@ -593,6 +604,12 @@ ub_mis_partials VertexCM::misAtHit(const SubPath& state, const PathVertex& v, fl
 }
 
 float vcmContinuationProb(const Bsdf& bsdf) {
+    if (bsdf.isBlend()) {
+        // The parts' bounds mixed by the blend weight (direction-independent if theirs are).
+        const float w = bsdf.blendWeight();
+        return std::min(1.0f, (1.0f - w) * vcmContinuationProb(bsdf.blendPart(0)) +
+                                  w * vcmContinuationProb(bsdf.blendPart(1)));
+    }
     const float q = std::min(1.0f, std::max(0.0f, bsdf.continuationProb()));
     const Material* mat = bsdf.material();
     if (q > 0.0f && mat && mat->type == MaterialType::RoughConductor)

@@ -200,6 +200,8 @@ class VertexCM : public Integrator {
     Rgb connectVertices(const LightVertex& lv, const SubPath& state, const PathVertex& v,
                         const VertexScatter& scatter) const;
     Rgb mergeVertices(const SubPath& state, const Hit& hit, const Bsdf& bsdf) const;
+    /// mergeVertices for a Blend (no kernel-side BSDF state; surface_merging.cpp).
+    Rgb mergeVerticesBlend(const SubPath& state, const Hit& hit, const Bsdf& bsdf) const;
     /// upbp's surface-merging pass (estimators/surface_merging.cpp) over the recorded surface
     /// queries: adds each query's estimate to its pixel of out and of layer, in query order.
     void estimateSurfaceQueries(Image& out, Image* layer);

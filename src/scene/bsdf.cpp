@@ -28,6 +28,18 @@
 //                   f_radiance(a, b) = f_importance(b, a).
 //  Plastic, RoughPlastic, ThinDielectric: Mitsuba 3's coated-diffuse and thin-sheet
 //                   models, in bsdf_plastic.cpp (banner there).
+//  Blend            Mitsuba 3's `blendbsdf` (its documentation: "linear combination of two
+//                   BSDFs", f = (1 - w) f_a + w f_b): evaluate() and both pdfs are the
+//                   weighted sums of the parts' non-delta values, so the pdf of a direction
+//                   is the mixture pdf (1 - w) p_a + w p_b in both transport directions and
+//                   MIS stays exact. sample() picks part a with probability 1 - w (b with w),
+//                   samples it, and for a non-delta direction returns the full mixture
+//                   evaluate() there; a delta lobe of the picked part keeps its weight and
+//                   gets pdf (selection probability) x (its discrete probability), so
+//                   f cos / pdf is the part's throughput (coinciding delta lobes of both
+//                   parts are then counted once each, which is unbiased: the expected weight
+//                   is (1 - w) W_a + w W_b). A `mask` is a Blend of a null part (ThinDielectric
+//                   of ior 1: straight transmission, tint 1) and the masked BSDF, w = opacity.
 // RGB parameters come from SurfaceColors (colors_): the Material's constants, or its
 // textures looked up at the hit by Scene::setupBsdf.
 //
@@ -66,6 +78,8 @@
 // uses the tint only); rough conductor and mirror `specular` * F_conductor(cos_fix) (the
 // mirror's F is 1 without conductorFresnel).
 #include "scene/bsdf.h"
+
+#include <stdexcept>
 
 #include "core/sampling.h"
 #include "kernels/shared/ub_fresnel.h"
@@ -127,6 +141,8 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
     specularWeight_ = 0.0f;
     probReflect_ = 0.0f;
     plasticBase_ = Rgb(0.0f);
+    blend_.reset();
+    blendWeight_ = 0.0f;
     isDelta_ = mat.type == MaterialType::Mirror || mat.type == MaterialType::Dielectric ||
                mat.type == MaterialType::ThinDielectric;
 
@@ -196,6 +212,10 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
         case MaterialType::MultiLobe:
             setupMultiLobe();
             break;
+        case MaterialType::Blend:
+            // The parts come from Scene::setupBsdf (setupBlend); alone it is not evaluable.
+            packShared();
+            return false;
     }
     // Perturbed normal (normal/bump map): on a light subpath dirFix is the light-side
     // direction, which must lie on the same side of the geometric and the shading surface.
@@ -261,8 +281,57 @@ void Bsdf::packShared() {
     coating_ = m.type == MaterialType::RoughPlastic ? m.coatingTransmittance.data() : nullptr;
 }
 
+struct Bsdf::BlendParts {
+    Bsdf part[2];
+};
+
+bool Bsdf::setupBlend(const Material& mat, float weight, const Bsdf& a, const Bsdf& b) {
+    // Frame, dirFix and flags from part b (the masked BSDF of a mask): both parts share the
+    // hit, so |cos| values agree; which side a part flips its normal to is its own business.
+    *this = b;
+    mat_ = &mat;
+    blend_ = std::make_shared<const BlendParts>(BlendParts{{a, b}});
+    blendWeight_ = clamp01(weight);
+    valid_ = a.valid_ && b.valid_;
+    isDelta_ = a.isDelta_ && b.isDelta_;
+    black_ = false;
+    const float wa = 1.0f - blendWeight_, wb = blendWeight_;
+    contProb_ = valid_ ? clamp01(wa * a.contProb_ + wb * b.contProb_) : 0.0f;
+    probDiffuse_ = probGlossy_ = probReflect_ = 0.0f;
+    shared_ = ub_bsdf{};  // not evaluable by the kernels' ub_bsdf_evaluate
+    shared_.flags =
+        (fromLight_ ? UB_BSDF_FROM_LIGHT : 0u) | (geometricGuard_ ? UB_BSDF_GEOMETRIC_GUARD : 0u);
+    shared_.type = UB_MATERIAL_DIFFUSE;
+    coating_ = nullptr;
+    return valid_;
+}
+
+const Bsdf& Bsdf::blendPart(int i) const {
+    if (!blend_) throw std::logic_error("Bsdf::blendPart: not a blend");
+    return blend_->part[i == 0 ? 0 : 1];
+}
+
 Rgb Bsdf::evaluate(const Vec3& dirGen, float* cosThetaGen, float* directPdfW,
                    float* reversePdfW) const {
+    if (blend_) {
+        // Mixture of the parts' non-delta lobes (banner: Blend).
+        const float w[2] = {1.0f - blendWeight_, blendWeight_};
+        Rgb f(0.0f);
+        float cosGen = 0.0f, pd = 0.0f, pr = 0.0f;
+        for (int i = 0; i < 2; ++i) {
+            if (!(w[i] > 0.0f)) continue;
+            float c = 0.0f, d = 0.0f, r = 0.0f;
+            const Rgb fi = blend_->part[i].evaluate(dirGen, &c, &d, &r);
+            f += fi * w[i];
+            pd += w[i] * d;
+            pr += w[i] * r;
+            cosGen = std::max(cosGen, c);
+        }
+        if (cosThetaGen) *cosThetaGen = cosGen > 0.0f ? cosGen : std::fabs(dot(dirGen, frame_.n));
+        if (directPdfW) *directPdfW = pd;
+        if (reversePdfW) *reversePdfW = pr;
+        return f;
+    }
     float cosGen = 0.0f, pd = 0.0f, pr = 0.0f;
     const ub_float3 f = ub_bsdf_evaluate(
         &shared_, coating_, ub_make_float3(dirGen.x, dirGen.y, dirGen.z), &cosGen, &pd, &pr);
@@ -284,6 +353,7 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
     if (cosThetaGen) *cosThetaGen = 0.0f;
     if (sampledEvent) *sampledEvent = kEventNone;
     if (!valid_ || black_) return Rgb(0.0f);
+    if (blend_) return sampleBlend(rnd, dirGen, pdfW, cosThetaGen, sampledEvent);
     if (isDelta_) return sampleDelta(rnd, dirGen, pdfW, cosThetaGen, sampledEvent);
 
     const Vec3& fix = localDirFix_;
@@ -405,7 +475,41 @@ Rgb Bsdf::mirrorReflectance() const {
     return fresnelConductor(std::fabs(localDirFix_.z), mat_->eta, mat_->k);
 }
 
+Rgb Bsdf::sampleBlend(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
+                      uint32_t* sampledEvent) const {
+    // Part a with probability 1 - w, b with w; rnd.z rescaled to [0, 1) for the part.
+    const float wa = 1.0f - blendWeight_, wb = blendWeight_;
+    const int i = (rnd.z < wa || !(wb > 0.0f)) ? 0 : 1;
+    const float select = i == 0 ? wa : wb;
+    if (!(select > 0.0f)) return Rgb(0.0f);
+    const float z = std::min(i == 0 ? rnd.z / wa : (rnd.z - wa) / wb, 0x1.fffffep-1f);
+    const Bsdf& part = blend_->part[i];
+    Vec3 dir;
+    float pdf = 0.0f, cosGen = 0.0f;
+    uint32_t event = kEventNone;
+    const Rgb fPart = part.sample(Vec3(rnd.x, rnd.y, z), &dir, &pdf, &cosGen, &event);
+    if (!(pdf > 0.0f) || isBlack(fPart)) return Rgb(0.0f);
+    if (event & kEventSpecular) {
+        // A delta lobe of the picked part: the other part has no density there.
+        *dirGen = dir;
+        *pdfW = select * pdf;
+        if (cosThetaGen) *cosThetaGen = cosGen;
+        if (sampledEvent) *sampledEvent = event | (part.isNullEvent(event) ? kEventNull : 0u);
+        return fPart * select;
+    }
+    // A non-delta direction: the mixture's value and pdf there (as evaluate()).
+    float pd = 0.0f, cosMix = 0.0f;
+    const Rgb f = evaluate(dir, &cosMix, &pd, nullptr);
+    if (!(pd > 0.0f)) return Rgb(0.0f);
+    *dirGen = dir;
+    *pdfW = pd;
+    if (cosThetaGen) *cosThetaGen = cosMix;
+    if (sampledEvent) *sampledEvent = event;
+    return f;
+}
+
 bool Bsdf::hasNullLobe() const {
+    if (blend_) return blend_->part[0].hasNullLobe() || blend_->part[1].hasNullLobe();
     return mat_ && mat_->type == MaterialType::ThinDielectric;
 }
 

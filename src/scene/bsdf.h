@@ -33,6 +33,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 
 #include "core/vec.h"
 #include "kernels/shared/ub_bsdf.h"
@@ -65,6 +66,9 @@ enum BsdfEvent : uint32_t {
     kEventReflect = 4,  ///< specular (delta) reflection
     kEventRefract = 8,  ///< specular (delta) refraction
     kEventSpecular = kEventReflect | kEventRefract,
+    /// Set with kEventRefract by a Blend whose part sampled its null lobe (a thin sheet's or a
+    /// mask's straight transmission): Bsdf::isNullEvent then tells it from a refraction.
+    kEventNull = 16,
 };
 
 class Bsdf {
@@ -85,6 +89,15 @@ class Bsdf {
     /// Any of the out pointers may be null.
     Rgb evaluate(const Vec3& dirGen, float* cosThetaGen, float* directPdfW,
                  float* reversePdfW) const;
+    /// Blend (MaterialType::Blend): this BSDF becomes (1 - w) a + w b of two BSDFs set up at
+    /// the same hit with the same dirFix, normals and fromLight (Scene::setupBsdf builds the
+    /// parts). Valid if both parts are. Definitions in bsdf.cpp ("Blend").
+    bool setupBlend(const Material& mat, float weight, const Bsdf& a, const Bsdf& b);
+    bool isBlend() const { return blend_ != nullptr; }
+    /// Blend: part i (0: weight 1 - w, 1: weight w) and w.
+    const Bsdf& blendPart(int i) const;
+    float blendWeight() const { return blendWeight_; }
+
     /// Samples dirGen from rnd in [0,1)^3 and returns f_s for it. *pdfW is the solid-angle
     /// pdf including lobe selection. For a delta lobe *pdfW is the discrete lobe probability
     /// and the returned value is the lobe weight / |cos|, so f_s * cosThetaGen / pdfW is the
@@ -105,7 +118,10 @@ class Bsdf {
     /// does not count as a vertex.
     bool hasNullLobe() const;
     /// True if sample() reported `event` for that lobe.
-    bool isNullEvent(uint32_t event) const { return hasNullLobe() && (event & kEventRefract); }
+    bool isNullEvent(uint32_t event) const {
+        if (event & kEventNull) return true;
+        return !blend_ && hasNullLobe() && (event & kEventRefract);
+    }
     /// Russian-roulette continuation probability: max over RGB of the albedo
     /// estimate, clamped to [0,1] (SmallVCM's mContinuationProb).
     float continuationProb() const { return contProb_; }
@@ -122,8 +138,10 @@ class Bsdf {
     bool geometricGuard() const { return geometricGuard_; }
 
     /// The evaluation state shared with the kernels (kernels/shared/ub_bsdf.h), filled by
-    /// setup(); the surface-merging pass records it. coatingTable(): the rough plastic's
-    /// coating transmittance table that evaluation reads (null for other materials).
+    /// setup(); the surface-merging pass records it. A Blend has none (not evaluable there:
+    /// VertexCM::mergeVertices evaluates it through evaluate(), upbp refuses it). coatingTable():
+    /// the rough plastic's coating transmittance table that evaluation reads (null for other
+    /// materials).
     const ub_bsdf& shared() const { return shared_; }
     const float* coatingTable() const { return coating_; }
 
@@ -137,6 +155,8 @@ class Bsdf {
     float plasticSpecularProb(float cosTheta) const;
     /// Coating transmittance of a (rough) plastic for |cos| = cosTheta.
     float plasticTransmittance(float cosTheta) const;
+    Rgb sampleBlend(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
+                    uint32_t* sampledEvent) const;
     Rgb sampleDelta(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
                     uint32_t* sampledEvent) const;
     /// Mirror: the conductor Fresnel reflectance at dirFix's angle (1 without
@@ -171,6 +191,10 @@ class Bsdf {
     // What evaluate() reads (ub_bsdf_evaluate): the fields above in the shared layout.
     ub_bsdf shared_{};
     const float* coating_ = nullptr;
+    // Blend: the two parts (shared: copying a Bsdf stays cheap) and the weight of part 1.
+    struct BlendParts;
+    std::shared_ptr<const BlendParts> blend_;
+    float blendWeight_ = 0.0f;
 };
 
 }  // namespace ub

@@ -27,6 +27,9 @@ enum class MaterialType : uint32_t {
     MultiLobe = 9,  ///< SmallUPBP's sum of lobes: Lambert `diffuse` + Phong `glossy`/`exponent` +
                     ///< mirror `specular` (Fresnel-weighted with `refract`) + smooth untinted
                     ///< refraction with `ior` when `refract` (scene/bsdf.cpp)
+    Blend = 10,     ///< Mitsuba 3 `blendbsdf` (and `mask`): (1 - w) f_a + w f_b of the materials
+                    ///< `blendParts`, w = `blendWeight` or the texture `textures.weight`
+                    ///< (scene/bsdf.cpp; not on the OpenCL device nor in upbp's batch pass)
 };
 
 /// Textured RGB parameters of a material, in Scene::textures (-1: the constant is used).
@@ -35,6 +38,7 @@ struct MaterialTextures {
     int glossy = -1;         ///< replaces Material::glossy
     int specular = -1;       ///< replaces Material::specular
     int transmittance = -1;  ///< replaces Material::transmittance
+    int weight = -1;         ///< Blend: replaces Material::blendWeight (the texture's luminance)
 };
 
 /// Mitsuba 3's `normalmap` and `bumpmap` wrappers: the shading normal of a hit perturbed by a
@@ -86,6 +90,11 @@ struct Material {
     /// Plastic, RoughPlastic: Mitsuba's `nonlinear` (base albedo inside the internal
     /// scattering sum, darker and more saturated colours); false keeps texture colours.
     bool nonlinear = false;
+    /// Blend: the material ids of the two components (f = (1 - w) f_a + w f_b), and the
+    /// weight w in [0, 1] of the second one. A mask is a blend of a null (pass-through)
+    /// material and the masked one, with w = opacity.
+    int blendParts[2] = {-1, -1};
+    float blendWeight = 0.5f;
     MaterialTextures textures;  ///< textured parameters (Scene::setupBsdf looks them up)
     /// Shading-normal perturbation (Mitsuba's normalmap / bumpmap wrapping this material) and
     /// its texture in Scene::textures; `bumpScale` multiplies the height gradient.

@@ -254,8 +254,8 @@ Scene::Scene() : impl_(std::make_unique<Impl>()) {
 Scene::~Scene() = default;
 
 int Scene::addMaterial(const Material& m) {
-    for (int t :
-         {m.textures.diffuse, m.textures.glossy, m.textures.specular, m.textures.transmittance})
+    for (int t : {m.textures.diffuse, m.textures.glossy, m.textures.specular,
+                  m.textures.transmittance, m.textures.weight})
         if (t >= int(textures.size()))
             throw std::logic_error("Scene::addMaterial: material '" + m.name +
                                    "' refers to texture " + std::to_string(t) +
@@ -264,6 +264,13 @@ int Scene::addMaterial(const Material& m) {
         (m.perturbationTexture < 0 || m.perturbationTexture >= int(textures.size())))
         throw std::logic_error("Scene::addMaterial: material '" + m.name +
                                "' has a normal or bump map without a texture");
+    // A blend's parts are added before it, so no blend contains itself (nesting is finite).
+    if (m.type == MaterialType::Blend)
+        for (int part : m.blendParts)
+            if (part < 0 || part >= int(materials.size()))
+                throw std::logic_error("Scene::addMaterial: blend '" + m.name +
+                                       "' refers to material " + std::to_string(part) +
+                                       ", which was not added");
     materials.push_back(m);
     prepareMaterial(materials.back());  // plastic tables (scene/bsdf.h)
     return int(materials.size()) - 1;

@@ -30,6 +30,8 @@ const char* materialTypeName(MaterialType t) {
             return "thin_dielectric";
         case MaterialType::MultiLobe:
             return "multi_lobe";
+        case MaterialType::Blend:
+            return "blend";
     }
     return "unknown";
 }

@@ -34,6 +34,17 @@ bool Scene::setupBsdf(Bsdf* bsdf, int materialId, const Vec2& uv, const Vec3& di
     }
     const Material& m = materials[size_t(materialId)];
     bsdf->setGeometricGuard(settings.shadingNormals == ShadingNormals::kGeometricGuard);
+    if (m.type == MaterialType::Blend) {
+        // The parts at the same point (Scene::addMaterial checked that they precede m), and
+        // the weight: the constant, or the weight texture's luminance at uv (Mitsuba reads a
+        // float texture; its grey value is the luminance of an RGB one).
+        Bsdf parts[2];
+        for (int i = 0; i < 2; ++i)
+            setupBsdf(&parts[i], m.blendParts[i], uv, dirFix, geoNormal, shadingNormal, fromLight);
+        float w = m.blendWeight;
+        if (m.textures.weight >= 0) w = luminance(textures[size_t(m.textures.weight)].eval(uv));
+        return bsdf->setupBlend(m, w, parts[0], parts[1]);
+    }
     return bsdf->setup(m, surfaceColors(m, uv), dirFix, geoNormal, shadingNormal, fromLight);
 }
 

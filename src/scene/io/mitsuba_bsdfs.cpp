@@ -2,6 +2,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <utility>
 
 #include "core/image.h"
 #include "scene/io/mitsuba_build.h"
@@ -13,8 +14,9 @@ namespace ub {
 namespace {
 
 const std::vector<std::string> kBsdfs = {
-    "diffuse", "conductor",    "roughconductor", "dielectric", "roughdielectric", "thindielectric",
-    "plastic", "roughplastic", "null",           "twosided",   "normalmap",       "bumpmap"};
+    "diffuse",        "conductor", "roughconductor", "dielectric", "roughdielectric",
+    "thindielectric", "plastic",   "roughplastic",   "null",       "twosided",
+    "normalmap",      "bumpmap",   "blendbsdf",      "mask"};
 const std::vector<std::string> kTextures = {"checkerboard", "bitmap"};
 
 constexpr float kAirIor = 1.000277f;        // Mitsuba's default ext_ior ("air")
@@ -99,6 +101,37 @@ void readReflectance(MitsubaBuild& b, const XmlObject& o, const std::string& nam
         return;
     }
     *value = b.r.getColor(o, name, def, ColorUse::Reflectance);
+}
+
+/// A [0, 1] weight given as a float or as a nested/referenced texture (Mitsuba's float
+/// textures: unibeam uses the texture's luminance).
+void readWeight(MitsubaBuild& b, const XmlObject& o, const std::string& name, float def,
+                float* value, int* texture) {
+    if (const XmlObject* tex = b.r.child(o, "texture", name)) {
+        *texture = buildTexture(b, *tex);
+        // Mitsuba 3's checkerboard evaluates as a float texture with the opposite parity of
+        // its colour evaluation (src/textures/checkerboard.cpp in 3.9.1: eval_1 takes
+        // color0 where exactly one of frac(u), frac(v) exceeds 1/2, eval where both or
+        // neither do), so a float use sees the colours swapped; measured against Mitsuba
+        // on tests/data/mitsuba/blend.xml.
+        if (*texture >= 0 && b.scene.textures[size_t(*texture)].type == TextureType::Checkerboard) {
+            Texture swapped = b.scene.textures[size_t(*texture)];
+            std::swap(swapped.color0, swapped.color1);
+            *texture = b.scene.addTexture(swapped);
+        }
+        return;
+    }
+    *value = b.r.getFloatIn(o, name, def, 0.0f, 1.0f);
+}
+
+/// A two-sided copy of material id (a Blend: a blend of two-sided copies of its parts, so
+/// that `twosided` around `blendbsdf` or `mask` reaches the lobes); -2 on an error.
+int twoSidedCopy(MitsubaBuild& b, int id) {
+    Material m = b.scene.materials[size_t(id)];
+    if (m.type == MaterialType::Blend)
+        for (int& part : m.blendParts) part = twoSidedCopy(b, part);
+    m.twoSided = true;
+    return b.scene.addMaterial(m);
 }
 
 /// Reads a microfacet roughness: `alpha`, or `alpha_u` = `alpha_v` (anisotropy is not
@@ -249,6 +282,21 @@ bool readPerturbation(MitsubaBuild& b, const XmlObject& o, Material* m) {
 
 }  // namespace
 
+int nullPassMaterial(MitsubaBuild& b) {
+    if (b.nullPassId >= 0) return b.nullPassId;
+    // Mitsuba's null BSDF as a surface: straight transmission of weight 1, no reflection.
+    // ThinDielectric with ior 1 is exactly that (reflectance 2r / (1 + r) = 0); its
+    // transmission is a null lobe (Bsdf::hasNullLobe), not counted as a vertex by max_depth.
+    Material m;
+    m.name = "null";
+    m.type = MaterialType::ThinDielectric;
+    m.ior = 1.0f;
+    m.specular = Rgb(0.0f);
+    m.transmittance = Rgb(1.0f);
+    b.nullPassId = b.scene.addMaterial(m);
+    return b.nullPassId;
+}
+
 int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
     auto cached = b.materialIds.find(&o);
     if (cached != b.materialIds.end()) return cached->second;
@@ -277,12 +325,43 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
             int innerId = buildMitsubaBsdf(b, *inner[0]);
             if (innerId >= 0) {
                 m = b.scene.materials[size_t(innerId)];
+                if (m.type == MaterialType::Blend)
+                    for (int& part : m.blendParts) part = twoSidedCopy(b, part);
                 m.twoSided = true;
                 if (!o.id.empty()) m.name = o.id;
             }
         }
     } else if (o.type == "normalmap" || o.type == "bumpmap") {
         readPerturbation(b, o, &m);
+    } else if (o.type == "blendbsdf" || o.type == "mask") {
+        // Mitsuba 3's blendbsdf: (1 - weight) f_0 + weight f_1 of its two nested BSDFs in
+        // document order, weight a float or texture in [0, 1] (default 0.5). Its mask: a
+        // blend of a null interface (straight pass-through) and the nested BSDF with weight
+        // `opacity` (default 0.5). Both: scene/bsdf.cpp, "Blend".
+        const bool mask = o.type == "mask";
+        const char* weightName = mask ? "opacity" : "weight";
+        m.type = MaterialType::Blend;
+        readWeight(b, o, weightName, 0.5f, &m.blendWeight, &m.textures.weight);
+        std::vector<const XmlObject*> inner = r.children(o, "bsdf");
+        const size_t expected = mask ? 1 : 2;
+        if (inner.size() != expected) {
+            r.error(o.pos, o.label() + ": expected exactly " + std::to_string(expected) +
+                               " nested <bsdf>" + (mask ? "" : "s") + ", got " +
+                               std::to_string(inner.size()));
+        } else {
+            std::vector<int> ids;
+            if (mask) ids.push_back(nullPassMaterial(b));
+            for (const XmlObject* part : inner) {
+                if (part->type == "dielectric" || part->type == "roughdielectric")
+                    r.error(part->pos, o.label() + ": cannot hold a '" + part->type +
+                                           "' BSDF (a blend of a medium interface; not "
+                                           "supported)");
+                const int id = buildMitsubaBsdf(b, *part);
+                ids.push_back(id == -1 ? nullPassMaterial(b) : id);
+            }
+            m.blendParts[0] = ids[0];
+            m.blendParts[1] = ids[1];
+        }
     } else if (o.type == "diffuse") {
         m.type = MaterialType::Diffuse;
         readReflectance(b, o, "reflectance", Rgb(0.5f), &m.diffuse, &m.textures.diffuse);

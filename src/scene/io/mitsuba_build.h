@@ -86,6 +86,7 @@ struct MitsubaBuild {
     std::map<const XmlObject*, int> mediumIds;    ///< medium object -> Scene::media index
     /// Media (volscene's Scene::media is not in main yet): objects seen, for messages.
     bool cameraSet = false;
+    int nullPassId = -1;  ///< the pass-through material of masks and null emitters (or -1)
 
     /// Resolves a file name property through the search path; reports an error and returns
     /// "" if not found.
@@ -95,6 +96,11 @@ struct MitsubaBuild {
 /// Builds a material from a <bsdf>. Returns the material id (cached per object), -1 for a
 /// `null` BSDF, or -2 on an error (already reported). *oneSidedEmit is unused here.
 int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& bsdf);
+
+/// The material of a surface that lets rays pass straight through (Mitsuba's null BSDF where
+/// it must be a surface: the transparent part of a `mask`, a `null` BSDF on an emitter),
+/// added once per scene.
+int nullPassMaterial(MitsubaBuild& b);
 
 /// Builds a medium from a <medium>; false on an error (already reported).
 bool buildMitsubaMedium(MitsubaBuild& b, const XmlObject& medium, Medium* out);

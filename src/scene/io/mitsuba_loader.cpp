@@ -545,18 +545,20 @@ void Builder::readShape(const XmlObject& o) {
                               "invisible and is left out");
         return;
     }
-    // A null BSDF on an emitter: Mitsuba lets rays pass through it; unibeam's area lights
-    // are opaque, so the surface is black (documented in docs/mitsuba.md).
+    // A null BSDF on an emitter: Mitsuba lets rays pass through the shape, which still emits.
+    // unibeam gives it the pass-through material (nullPassMaterial: a straight delta
+    // transmission), so paths pick up the emission where they cross it and continue; light
+    // sampling reaches it as any area light (docs/mitsuba.md).
     if (materialId == -1 && em) {
-        r_.warning(o.pos, o.label() + " '" + name +
-                              "': a null BSDF on an emitter makes an opaque black emitting "
-                              "surface (Mitsuba lets rays pass through it; unibeam's area "
-                              "lights are opaque)");
-        materialId = blackMaterial();
+        if (boundary) {
+            r_.error(em->pos, o.label() + " '" + name +
+                                  "': a shape with a null BSDF and a medium cannot emit (not "
+                                  "supported)");
+            return;
+        }
+        materialId = nullPassMaterial(b_);
     }
     const bool imaginary = materialId == -1;  // null BSDF + medium: an index-matched boundary
-    if (imaginary && em)
-        r_.error(em->pos, o.label() + ": a shape with a null BSDF and a medium cannot emit");
     if (em) {
         try {
             lightId = b_.scene.addLight(std::move(light));
