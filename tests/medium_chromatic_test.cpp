@@ -91,6 +91,18 @@ GridMediumOptions trilinearOptions() {
     return options;
 }
 
+// A segment between two uniform points of a box a little larger than the fixture's grids
+// (false when it is too short to have a direction).
+bool randomSegment(Rng& rng, Vec3* p0, Vec3* dir, float* len) {
+    const Vec3 lo(-0.1f, -0.3f, -0.2f);
+    *p0 = lo + rng.uniform3() * 1.6f;
+    const Vec3 p1 = lo + rng.uniform3() * 1.6f;
+    *len = length(p1 - *p0);
+    if (*len < 1e-3f) return false;
+    *dir = (p1 - *p0) / *len;
+    return true;
+}
+
 struct ChromaticFixture {
     DenseFloatGrid dense[3];
     std::shared_ptr<const VdbGrid> grids[3];
@@ -114,11 +126,9 @@ TEST(MediumChromatic, NearestTransmittanceMatchesReferencePerChannel) {
     ASSERT_TRUE(m.chromatic());
     Rng rng(5, 0);
     for (int i = 0; i < 500; ++i) {
-        const Vec3 p0 = Vec3(-0.1f, -0.3f, -0.2f) + rng.uniform3() * 1.6f;
-        const Vec3 p1 = Vec3(-0.1f, -0.3f, -0.2f) + rng.uniform3() * 1.6f;
-        const float len = length(p1 - p0);
-        if (len < 1e-3f) continue;
-        const Vec3 dir = (p1 - p0) / len;
+        Vec3 p0, dir;
+        float len = 0.0f;
+        if (!randomSegment(rng, &p0, &dir, &len)) continue;
         const MediumSegment seg = evalMediumSegment(m, p0, dir, len);
         const Rgb T = transmittance(m, p0, dir, len);
         for (int c = 0; c < 3; ++c) {
@@ -186,11 +196,9 @@ TEST(MediumChromatic, TrilinearChannelsMatchTheirGreyMedia) {
         single[c] = Medium::heterogeneous(f.grids[c], 1.5f, Rgb(0.8f), 0.0f, Transform(), options);
     Rng rng(13, 0);
     for (int i = 0; i < 300; ++i) {
-        const Vec3 p0 = Vec3(-0.1f, -0.3f, -0.2f) + rng.uniform3() * 1.6f;
-        const Vec3 p1 = Vec3(-0.1f, -0.3f, -0.2f) + rng.uniform3() * 1.6f;
-        const float len = length(p1 - p0);
-        if (len < 1e-3f) continue;
-        const Vec3 dir = (p1 - p0) / len;
+        Vec3 p0, dir;
+        float len = 0.0f;
+        if (!randomSegment(rng, &p0, &dir, &len)) continue;
         const MediumSegment s = evalMediumSegment(rgb, p0, dir, len);
         const MediumCoefficients co = mediumCoefficientsAt(rgb, p0);
         for (int c = 0; c < 3; ++c) {
@@ -225,22 +233,7 @@ double chromaticChi2(const Medium& m, const Vec3& o, const Vec3& dir, float tMax
         expected[b] =
             samples * (avgT(double(tMax) * b / nBins) - avgT(double(tMax) * (b + 1) / nBins));
     expected[nBins] = samples * avgT(tMax);
-    double stat = 0, pooledE = 0, pooledO = 0;
-    int dof = 0;
-    for (int b = 0; b <= nBins; ++b) {
-        if (expected[b] < 5) {
-            pooledE += expected[b];
-            pooledO += observed[b];
-            continue;
-        }
-        stat += (observed[b] - expected[b]) * (observed[b] - expected[b]) / expected[b];
-        ++dof;
-    }
-    if (pooledE > 0) {
-        stat += (pooledO - pooledE) * (pooledO - pooledE) / pooledE;
-        ++dof;
-    }
-    return test::gammaQ(0.5 * (dof - 1), 0.5 * stat);
+    return test::chi2PooledPValue(observed, expected);
 }
 
 // Two chi-square tests in this file share an overall significance of 1% (Sidak).

@@ -228,22 +228,7 @@ double freeFlightChi2(const Medium& m, const Vec3& o, const Vec3& dir, float tMa
         expected[b] =
             samples * (avgT(double(tMax) * b / nBins) - avgT(double(tMax) * (b + 1) / nBins));
     expected[nBins] = samples * avgT(tMax);
-    double stat = 0, pooledE = 0, pooledO = 0;
-    int dof = 0;
-    for (int b = 0; b <= nBins; ++b) {
-        if (expected[b] < 5) {  // pool sparse cells (none expected with these settings)
-            pooledE += expected[b];
-            pooledO += observed[b];
-            continue;
-        }
-        stat += (observed[b] - expected[b]) * (observed[b] - expected[b]) / expected[b];
-        ++dof;
-    }
-    if (pooledE > 0) {
-        stat += (pooledO - pooledE) * (pooledO - pooledE) / pooledE;
-        ++dof;
-    }
-    return test::gammaQ(0.5 * (dof - 1), 0.5 * stat);
+    return test::chi2PooledPValue(observed, expected);
 }
 
 // Three chi-square tests in this file share an overall significance of 1% (Sidak).

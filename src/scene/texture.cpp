@@ -47,6 +47,25 @@ int wrapIndexMode(int i, int n, TextureWrap wrap) {
     return 0;
 }
 
+/// The four texels of a bilinear lookup at continuous pixel coordinates (px, py) (texel
+/// centres at half-integers) and the weights wx, wy of the +1 corners.
+struct BilinearCell {
+    int x0, y0, x1, y1;
+    float wx, wy;
+};
+BilinearCell bilinearCell(const Image& img, float px, float py, TextureWrap wrap) {
+    const float qx = px - 0.5f, qy = py - 0.5f;
+    const float fx = std::floor(qx), fy = std::floor(qy);
+    BilinearCell c;
+    c.wx = qx - fx;
+    c.wy = qy - fy;
+    c.x0 = wrapIndexMode(int(fx), img.width, wrap);
+    c.y0 = wrapIndexMode(int(fy), img.height, wrap);
+    c.x1 = wrapIndexMode(int(fx) + 1, img.width, wrap);
+    c.y1 = wrapIndexMode(int(fy) + 1, img.height, wrap);
+    return c;
+}
+
 /// Lookup at unwrapped uv' for any filter and wrap mode. Coordinates are clamped to
 /// +-2^24 texels first (beyond that float has no fraction and int would overflow).
 Rgb lookup(const Image& img, float u, float v, TextureFilter filter, TextureWrap wrap) {
@@ -56,15 +75,9 @@ Rgb lookup(const Image& img, float u, float v, TextureFilter filter, TextureWrap
     if (filter == TextureFilter::Nearest)
         return img.at(wrapIndexMode(int(std::floor(px)), img.width, wrap),
                       wrapIndexMode(int(std::floor(py)), img.height, wrap));
-    const float qx = px - 0.5f, qy = py - 0.5f;
-    const float fx = std::floor(qx), fy = std::floor(qy);
-    const float wx = qx - fx, wy = qy - fy;
-    const int x0 = wrapIndexMode(int(fx), img.width, wrap);
-    const int y0 = wrapIndexMode(int(fy), img.height, wrap);
-    const int x1 = wrapIndexMode(int(fx) + 1, img.width, wrap);
-    const int y1 = wrapIndexMode(int(fy) + 1, img.height, wrap);
-    return (img.at(x0, y0) * (1.0f - wx) + img.at(x1, y0) * wx) * (1.0f - wy) +
-           (img.at(x0, y1) * (1.0f - wx) + img.at(x1, y1) * wx) * wy;
+    const BilinearCell c = bilinearCell(img, px, py, wrap);
+    return (img.at(c.x0, c.y0) * (1.0f - c.wx) + img.at(c.x1, c.y0) * c.wx) * (1.0f - c.wy) +
+           (img.at(c.x0, c.y1) * (1.0f - c.wx) + img.at(c.x1, c.y1) * c.wx) * c.wy;
 }
 
 [[noreturn]] void throwTextureError(const Texture& t, const std::string& message) {
@@ -111,18 +124,13 @@ Vec2 Texture::luminanceGradient(const Vec2& uvSurface) const {
     // The cell of lookup()'s bilinear interpolation: f(x, y) = sum of the four corner values
     // times (1 - wx or wx)(1 - wy or wy); its slopes in continuous pixel coordinates.
     const float kLimit = 16777216.0f;
-    const float qx = std::clamp(uv.x * float(img.width), -kLimit, kLimit) - 0.5f;
-    const float qy = std::clamp(uv.y * float(img.height), -kLimit, kLimit) - 0.5f;
-    const float fx = std::floor(qx), fy = std::floor(qy);
-    const float wx = qx - fx, wy = qy - fy;
-    const int x0 = wrapIndexMode(int(fx), img.width, wrap);
-    const int y0 = wrapIndexMode(int(fy), img.height, wrap);
-    const int x1 = wrapIndexMode(int(fx) + 1, img.width, wrap);
-    const int y1 = wrapIndexMode(int(fy) + 1, img.height, wrap);
-    const float f00 = luminance(img.at(x0, y0)), f10 = luminance(img.at(x1, y0));
-    const float f01 = luminance(img.at(x0, y1)), f11 = luminance(img.at(x1, y1));
-    const float dx = (1.0f - wy) * (f10 - f00) + wy * (f11 - f01);
-    const float dy = (1.0f - wx) * (f01 - f00) + wx * (f11 - f10);
+    const BilinearCell c =
+        bilinearCell(img, std::clamp(uv.x * float(img.width), -kLimit, kLimit),
+                     std::clamp(uv.y * float(img.height), -kLimit, kLimit), wrap);
+    const float f00 = luminance(img.at(c.x0, c.y0)), f10 = luminance(img.at(c.x1, c.y0));
+    const float f01 = luminance(img.at(c.x0, c.y1)), f11 = luminance(img.at(c.x1, c.y1));
+    const float dx = (1.0f - c.wy) * (f10 - f00) + c.wy * (f11 - f01);
+    const float dy = (1.0f - c.wx) * (f01 - f00) + c.wx * (f11 - f10);
     // Chain rule through uv' = A uv + b (A^T times the slopes), then Mitsuba's scaling of
     // each component by the resolution (exact for a diagonal A).
     const float du = toUv.m[0][0] * dx + toUv.m[1][0] * dy;

@@ -128,6 +128,28 @@ inline Chi2Result chi2TestSphere(const std::function<Vec3()>& sample,
     return res;
 }
 
+/// p-value of binned counts against their expectations: cells expected below 5 are pooled
+/// into one; dof = cells - 1 (the total is fixed by the sample count).
+inline double chi2PooledPValue(const std::vector<double>& observed,
+                               const std::vector<double>& expected) {
+    double stat = 0, pooledE = 0, pooledO = 0;
+    int cells = 0;
+    for (size_t b = 0; b < expected.size(); ++b) {
+        if (expected[b] < 5) {
+            pooledE += expected[b];
+            pooledO += observed[b];
+            continue;
+        }
+        stat += (observed[b] - expected[b]) * (observed[b] - expected[b]) / expected[b];
+        ++cells;
+    }
+    if (pooledE > 0) {
+        stat += (pooledO - pooledE) * (pooledO - pooledE) / pooledE;
+        ++cells;
+    }
+    return gammaQ(0.5 * (cells - 1), 0.5 * stat);
+}
+
 /// Significance level for one of `testCount` independent tests at overall level alpha
 /// (Šidák correction).
 inline double sidak(double alpha, int testCount) {
