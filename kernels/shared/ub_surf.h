@@ -37,6 +37,43 @@ UB_INLINE float ub_surf_normalization(float lightPathCount, float radius) {
     return 1.0f / (UB_PI * radius * radius * lightPathCount);
 }
 
+/* Whether photon lv and a camera vertex at pos (pathLength segments) make a surf pair:
+ * a surface photon inside the disk of radius^2 radiusSqr, the merged path length in
+ * [minLength, maxLength]. */
+UB_INLINE int ub_surf_pair(UB_PRIVATE const ub_light_vertex* lv, const float* pos,
+                           ub_uint pathLength, float radiusSqr, ub_uint minLength,
+                           ub_uint maxLength) {
+    if (lv->flags & UB_LIGHT_VERTEX_IN_MEDIUM) return 0; /* merged by pp3d and pb2d */
+    float dx = lv->position[0] - pos[0], dy = lv->position[1] - pos[1],
+          dz = lv->position[2] - pos[2];
+    if (dx * dx + dy * dy + dz * dz > radiusSqr) return 0;
+    ub_uint length = lv->pathLength + pathLength;
+    return length <= maxLength && length >= minLength;
+}
+
+/* f Phi_y w of a pair, from the camera BSDF value f towards the photon's incoming direction
+ * and its pdfs (forward cameraDirPdfW, reverse cameraRevPdfW), the camera partials
+ * (dVCM, dVM) and continuation probability. noMis: PPM, every weight 1. */
+UB_INLINE ub_float3 ub_surf_weighted(ub_mis_constants c, UB_PRIVATE const ub_light_vertex* lv,
+                                     ub_float3 f, float cameraDirPdfW, float cameraRevPdfW,
+                                     float cameraDVCM, float cameraDVM, float cameraContProb,
+                                     ub_uint noMis) {
+    float weight = 1.0f;
+    if (!noMis) {
+        ub_mis_partials light, camera;
+        light.dVCM = lv->dVCM;
+        light.dVC = lv->dVC;
+        light.dVM = lv->dVM;
+        light.dOut = 0.0f;
+        camera = ub_mis_merge_partials(cameraDVCM, cameraDVM);
+        /* the reverse direction would be sampled by the light subpath: its roulette */
+        weight = ub_mis_weight_merge(c, light, camera, cameraDirPdfW * cameraContProb,
+                                     cameraRevPdfW * lv->contProb); /* [TR (37)-(39)] */
+    }
+    return ub_make_float3(f.x * lv->throughput[0] * weight, f.y * lv->throughput[1] * weight,
+                          f.z * lv->throughput[2] * weight);
+}
+
 /* f_s Phi_y w for one photon (no camera throughput, no normalisation); zero outside the
  * disk, for medium vertices and for path lengths outside [minLength, maxLength].
  * coating: the query material's rough-plastic coating table (else unused). noMis: PPM, every
@@ -46,31 +83,15 @@ UB_INLINE ub_float3 ub_surf_contribution(ub_mis_constants c, UB_PRIVATE const ub
                                          UB_GLOBAL const float* coating, float radiusSqr,
                                          ub_uint minLength, ub_uint maxLength, ub_uint noMis) {
     ub_float3 zero = ub_make_float3(0.0f, 0.0f, 0.0f);
-    if (lv->flags & UB_LIGHT_VERTEX_IN_MEDIUM) return zero; /* merged by pp3d and pb2d */
-    float dx = lv->position[0] - q->pos[0], dy = lv->position[1] - q->pos[1],
-          dz = lv->position[2] - q->pos[2];
-    if (dx * dx + dy * dy + dz * dz > radiusSqr) return zero;
-    ub_uint length = lv->pathLength + q->pathLength;
-    if (length > maxLength || length < minLength) return zero;
+    float pos[3] = {q->pos[0], q->pos[1], q->pos[2]};
+    if (!ub_surf_pair(lv, pos, q->pathLength, radiusSqr, minLength, maxLength)) return zero;
     float cosGen, cameraDirPdfW, cameraRevPdfW;
     /* the camera BSDF towards the photon's incoming direction */
     ub_float3 f = ub_bsdf_evaluate(&q->bsdf, coating, ub_f3_from(lv->dirFix), &cosGen,
                                    &cameraDirPdfW, &cameraRevPdfW);
     if (f.x == 0.0f && f.y == 0.0f && f.z == 0.0f) return zero;
-    float weight = 1.0f;
-    if (!noMis) {
-        ub_mis_partials light, camera;
-        light.dVCM = lv->dVCM;
-        light.dVC = lv->dVC;
-        light.dVM = lv->dVM;
-        light.dOut = 0.0f;
-        camera = ub_mis_merge_partials(q->dVCM, q->dVM);
-        /* the reverse direction would be sampled by the light subpath: its roulette */
-        weight = ub_mis_weight_merge(c, light, camera, cameraDirPdfW * q->contProb,
-                                     cameraRevPdfW * lv->contProb); /* [TR (37)-(39)] */
-    }
-    return ub_make_float3(f.x * lv->throughput[0] * weight, f.y * lv->throughput[1] * weight,
-                          f.z * lv->throughput[2] * weight);
+    return ub_surf_weighted(c, lv, f, cameraDirPdfW, cameraRevPdfW, q->dVCM, q->dVM, q->contProb,
+                            noMis);
 }
 
 #ifndef __OPENCL_C_VERSION__

@@ -71,33 +71,26 @@ Rgb VertexCM::mergeVertices(const SubPath& state, const Hit& hit, const Bsdf& bs
     return sum * vmNormalization_;
 }
 
-// The same per-pair estimate as ub_surf_contribution, with the BSDF evaluated through
-// Bsdf::evaluate: a Blend (Mitsuba's blendbsdf, mask) has no kernel-side state.
+// The per-pair estimate of ub_surf_contribution with the BSDF evaluated through
+// Bsdf::evaluate: a Blend (Mitsuba's blendbsdf, mask) has no kernel-side state. The pair
+// test and the weighting are the shared ones (kernels/shared/ub_surf.h).
 Rgb VertexCM::mergeVerticesBlend(const SubPath& state, const Hit& hit, const Bsdf& bsdf) const {
     const float radiusSqr = grid_.radius() * grid_.radius();
     const float contProb = vcmContinuationProb(bsdf);
-    const ub_mis_partials camera = ub_mis_merge_partials(state.mis.dVCM, state.mis.dVM);
+    const float pos[3] = {hit.pos.x, hit.pos.y, hit.pos.z};
     Rgb sum(0.0f);
     grid_.query(hit.pos, lightVertices_, &LightVertex::position, [&](uint32_t index) {
         const LightVertex& lv = lightVertices_[index];
-        if (lv.flags & UB_LIGHT_VERTEX_IN_MEDIUM) return;
-        if (lengthSqr(loadF3(lv.position) - hit.pos) > radiusSqr) return;
-        const int length = int(lv.pathLength) + state.pathLength;
-        if (length > options_.maxPathLength || length < options_.minPathLength) return;
+        if (!ub_surf_pair(&lv, pos, ub_uint(state.pathLength), radiusSqr,
+                          ub_uint(options_.minPathLength), ub_uint(options_.maxPathLength)))
+            return;
         float cosGen = 0.0f, dirPdfW = 0.0f, revPdfW = 0.0f;
         const Rgb f = bsdf.evaluate(lv.dirFix3(), &cosGen, &dirPdfW, &revPdfW);
         if (isBlack(f)) return;
-        float weight = 1.0f;
-        if (!ppm_) {
-            ub_mis_partials light;
-            light.dVCM = lv.dVCM;
-            light.dVC = lv.dVC;
-            light.dVM = lv.dVM;
-            light.dOut = 0.0f;
-            weight =
-                ub_mis_weight_merge(mis_, light, camera, dirPdfW * contProb, revPdfW * lv.contProb);
-        }
-        sum += f * lv.throughput3() * weight;
+        const ub_float3 c =
+            ub_surf_weighted(mis_, &lv, ub_make_float3(f.x, f.y, f.z), dirPdfW, revPdfW,
+                             state.mis.dVCM, state.mis.dVM, contProb, ppm_ ? 1u : 0u);
+        sum += Rgb(c.x, c.y, c.z);
     });
     return sum * vmNormalization_;
 }

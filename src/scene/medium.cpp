@@ -248,10 +248,7 @@ Medium Medium::heterogeneousRgb(const std::shared_ptr<const VdbGrid> channels[3]
 MediumCoefficients mediumCoefficientsAt(const Medium& m, const Vec3& p) {
     MediumCoefficients c;
     if (m.type == MediumType::kGrid && m.filter == GridFilter::kTrilinear) {
-        Rgb density(trilinearDensityAt(m, p, 0));
-        if (m.chromatic())
-            density = Rgb(density.x, trilinearDensityAt(m, p, 1), trilinearDensityAt(m, p, 2));
-        c.sigmaT = density * m.densityScale;
+        c.sigmaT = trilinearDensityRgbAt(m, p) * m.densityScale;
         c.sigmaS = mediumAlbedoAt(m, p) * c.sigmaT;
         c.sigmaA = c.sigmaT - c.sigmaS;
         c.Le = Rgb(0.0f);

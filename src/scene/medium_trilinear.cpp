@@ -178,14 +178,13 @@ float trilinearDensityAt(const Medium& m, const Vec3& p, int channel) {
     return float(std::max(0.0, cellCubic(g, k, qd, zeroD).c[0]));
 }
 
-namespace {
-
-/// The density of every channel at p (grey: replicated).
-Rgb densityRgbAt(const Medium& m, const Vec3& p) {
+Rgb trilinearDensityRgbAt(const Medium& m, const Vec3& p) {
     if (!m.chromatic()) return Rgb(trilinearDensityAt(m, p, 0));
     return Rgb(trilinearDensityAt(m, p, 0), trilinearDensityAt(m, p, 1),
                trilinearDensityAt(m, p, 2));
 }
+
+namespace {
 
 /// sigma_t = densityScale * max(0, density) per channel (grey: channel 0 replicated).
 Rgb sigmaFromDensity(const Medium& m, const double d[3]) {
@@ -230,7 +229,7 @@ MediumSegment trilinearSegment(const Medium& m, const Vec3& origin, const Vec3& 
         return true;
     });
     if (first) {
-        const Rgb d = densityRgbAt(m, origin);
+        const Rgb d = trilinearDensityRgbAt(m, origin);
         for (int ch = 0; ch < 3; ++ch) d0[ch] = d1[ch] = d[ch];
     }
     seg.sigmaT0 = sigmaFromDensity(m, d0);
@@ -273,7 +272,7 @@ FreeFlightSample trilinearFreeFlight(const Medium& m, const Vec3& origin, const 
         return true;
     });
     if (first) {
-        const Rgb d = densityRgbAt(m, origin);
+        const Rgb d = trilinearDensityRgbAt(m, origin);
         for (int ch = 0; ch < 3; ++ch) d0[ch] = d1[ch] = d[ch];
     }
     MediumSegment& seg = s.segment;

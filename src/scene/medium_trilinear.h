@@ -22,6 +22,8 @@ namespace ub {
 /// Interpolated density (before densityScale) of channel `channel` (0, 1, 2; grey media
 /// have one) at world point p.
 float trilinearDensityAt(const Medium& m, const Vec3& p, int channel = 0);
+/// The interpolated density of every channel at p (grey media: channel 0 replicated).
+Rgb trilinearDensityRgbAt(const Medium& m, const Vec3& p);
 Rgb trilinearTransmittance(const Medium& m, const Vec3& origin, const Vec3& dir, float length);
 MediumSegment trilinearSegment(const Medium& m, const Vec3& origin, const Vec3& dir, float length);
 FreeFlightSample trilinearFreeFlight(const Medium& m, const Vec3& origin, const Vec3& dir,
