@@ -115,6 +115,10 @@ const HandCase kCases[] = {
     {"normalmap", "lt", 512},
     {"normalmap", "vcm", 256},
     {"normalmap", "upbp", 128},
+    {"projected", "pt", 512},
+    {"projected", "bpt", 256},
+    {"projected", "lt", 512},
+    {"projected", "vcm", 256},
 };
 
 class MitsubaHandWritten : public ::testing::TestWithParam<HandCase> {};
@@ -288,5 +292,33 @@ TEST(MitsubaHandWrittenPower, BlendIsRefusedByUpbpSurf) {
         FAIL() << "upbp accepted a blend";
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("is a blend"), std::string::npos) << e.what();
+    }
+}
+
+// Power of the projected-texture check: the projector's slide mirrored left-right (the sign
+// of Mitsuba's uv.x, a plausible slip) and the spot's texture turned a quarter (frame x and y
+// swapped) each fail.
+TEST(MitsubaHandWrittenPower, ProjectedTextureOrientationIsDistinguished) {
+    for (int variant = 0; variant < 2; ++variant) {
+        std::unique_ptr<Scene> scene = loadMitsubaScene(kDir + "/projected.xml", {{"res", "48"}});
+        int edited = 0;
+        for (Light& l : scene->lights) {
+            if (!l.projTexture || l.projTexture->type != TextureType::Bitmap) continue;
+            if (variant == 0 && l.type == LightType::Projector) {
+                l.frameX = -l.frameX;
+            } else if (variant == 1 && l.type == LightType::Spot) {
+                std::swap(l.frameX, l.frameY);
+            } else {
+                continue;
+            }
+            l.prepare();
+            ++edited;
+        }
+        ASSERT_EQ(edited, 1);
+        const test::ReferenceCheck check = checkAgainst(
+            "projected", *scene, "pt", 512,
+            variant == 0 ? "projected pt, slide mirrored" : "projected pt, spot turned");
+        EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the orientation of "
+                                            << (variant == 0 ? "the slide" : "the spot's texture");
     }
 }

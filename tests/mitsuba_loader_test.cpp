@@ -364,6 +364,68 @@ TEST(MitsubaXml, SpotLightFollowsToWorld) {
     EXPECT_FLOAT_EQ(l.beamWidthDeg, 22.5f);  // Mitsuba's default: 3/4 of the cutoff
 }
 
+// Projected textures: a projector's irradiance bitmap, scale, fov and frame (to_world's x, y,
+// z), its aspect from the bitmap; a constant irradiance; a spot's texture; and the errors
+// (a non-bitmap texture, a scaled to_world, a textured spot's cutoff >= 90).
+TEST(MitsubaXml, ProjectorsAndSpotTexturesLoad) {
+    const std::string tex = std::string(UNIBEAM_TEST_DATA_DIR) + "/mitsuba/textures/slide.png";
+    auto s = load(scene(R"(<emitter type="projector"><float name="fov" value="30"/>
+  <float name="scale" value="7"/>
+  <transform name="to_world"><lookat origin="0, 3, 0" target="0, 0, 0" up="0, 0, 1"/></transform>
+  <texture type="bitmap" name="irradiance"><string name="filename" value=")" +
+                        tex + R"("/></texture>
+</emitter>
+<emitter type="projector"><rgb name="irradiance" value="0.5, 1, 2"/></emitter>
+<emitter type="spot"><float name="cutoff_angle" value="40"/>
+  <texture type="bitmap" name="texture"><string name="filename" value=")" +
+                        tex + R"("/></texture>
+</emitter>
+)"));
+    ASSERT_EQ(s->lights.size(), 3u);
+    const Light& p = s->lights[0];
+    EXPECT_EQ(p.type, LightType::Projector);
+    EXPECT_FLOAT_EQ(p.intensity.x, 7.0f);
+    EXPECT_FLOAT_EQ(p.projFovXDeg, 30.0f);
+    EXPECT_FLOAT_EQ(p.projAspect, 2.0f);  // 24 x 12
+    EXPECT_NEAR(p.direction.y, -1.0f, 1e-6f);
+    EXPECT_NEAR(p.frameY.z, 1.0f, 1e-6f);  // up
+    EXPECT_NEAR(p.frameX.x, 1.0f, 1e-6f);  // Mitsuba's lookat: x = up x direction
+    ASSERT_TRUE(p.projTexture && p.projTexture->type == TextureType::Bitmap);
+    const Light& c = s->lights[1];
+    EXPECT_EQ(c.projTexture->type, TextureType::Constant);
+    EXPECT_FLOAT_EQ(c.projTexture->color0.z, 2.0f);
+    EXPECT_FLOAT_EQ(c.projAspect, 1.0f);
+    // The default focal length, 50 mm on 36 x 24 mm film along the diagonal, at aspect 1.
+    const double diag = 2 * std::atan(std::sqrt(36.0 * 36 + 24 * 24) / 100.0);
+    EXPECT_NEAR(c.projFovXDeg, 2 * std::atan(std::tan(diag / 2) / std::sqrt(2.0)) * 180 / kPi,
+                1e-3);
+    EXPECT_EQ(s->lights[2].type, LightType::Spot);
+    ASSERT_TRUE(s->lights[2].projTexture);
+
+    std::string e = errorsOf(scene(R"(<emitter type="projector">
+  <texture type="checkerboard" name="irradiance"/></emitter>
+)"));
+    EXPECT_NE(e.find("scene.xml:9:3: error: <emitter type=\"projector\">: the projected texture "
+                     "must be a bitmap"),
+              std::string::npos)
+        << e;
+    e = errorsOf(scene(R"(<emitter type="projector"><transform name="to_world"><scale value="2"/>
+  </transform></emitter>
+)"));
+    EXPECT_NE(e.find("scene.xml:8:27: error: <emitter type=\"projector\">: to_world must be a "
+                     "rotation and translation"),
+              std::string::npos)
+        << e;
+    e = errorsOf(scene(R"(<emitter type="spot"><float name="cutoff_angle" value="95"/>
+  <texture type="bitmap" name="texture"><string name="filename" value=")" +
+                       tex + R"("/></texture>
+</emitter>
+)"));
+    EXPECT_NE(e.find("cutoff_angle < 90"), std::string::npos) << e;
+    e = errorsOf(scene("<emitter type=\"spot\"><rgb name=\"texture\" value=\"1\"/></emitter>\n"));
+    EXPECT_NE(e.find("'texture' must be a spatially varying texture"), std::string::npos) << e;
+}
+
 TEST(MitsubaXml, MediaOnShapesBecomeBoundaries) {
     auto s = load(scene(std::string(kLight) + R"(<medium id="fog" type="homogeneous">
   <rgb name="sigma_t" value="1, 2, 3"/><rgb name="albedo" value="0.5"/><float name="scale" value="2"/>

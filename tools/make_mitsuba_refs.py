@@ -7,7 +7,7 @@ SCENE_ref_var.exr (per-sample variance, estimated from the spread of batch means
 var_sample = B * var(batch means of B samples)), 48x48, Mitsuba's `scalar_rgb` variant,
 and SCENE_ref.json with the Mitsuba version, sample count and batches.
 
-The scenes' inputs (textures/tiles.png, stripes.jpg, normalmap.png, heights.png,
+The scenes' inputs (textures/tiles.png, stripes.jpg, normalmap.png, heights.png, slide.png,
 volumes/density.vol, volumes/albedo.vol, volumes/chromatic.vol) are written by
 --make-inputs, with Mitsuba's own
 writers.
@@ -92,6 +92,23 @@ def make_inputs(folder):
     alb = np.stack([0.95 - 0.6 * Xv, 0.4 + 0.5 * Yv, 0.9 * np.ones_like(Xv)], -1)
     mi.VolumeGrid(alb.astype(np.float32)).write(str(folder / "volumes" / "albedo.vol"))
     make_chromatic_volume(folder)
+    make_slide(folder)
+
+
+def make_slide(folder):
+    """projected.xml's projector slide: 24x12 sRGB (non-square, so the projector's aspect
+    ratio matters), colour ramps with a black frame column and black pixel blocks, so that the
+    sampling density must cover the bilinear footprint of lit pixels next to black ones."""
+    x = (np.arange(24) + 0.5) / 24
+    y = (np.arange(12) + 0.5) / 12
+    X, Y = np.meshgrid(x, y)
+    img = np.stack([0.2 + 0.8 * X, 0.9 - 0.7 * Y, 0.5 + 0.5 * np.sin(6 * X) * Y], -1)
+    img[:, 0, :] = 0.0
+    img[3:6, 8:12, :] = 0.0
+    img[8, :, :] = 0.0
+    img[2, 18, :] = 1.0
+    mi.Bitmap(np.round(np.clip(img, 0, 1) * 255).astype(np.uint8),
+              pixel_format=mi.Bitmap.PixelFormat.RGB).write(str(folder / "textures" / "slide.png"))
 
 
 def make_chromatic_volume(folder):

@@ -1,6 +1,6 @@
 // Light sampling and evaluation: SmallVCM's Illuminate / Emit / GetRadiance
 // (Georgiev 2012, "Implementing Vertex Connection and Merging", Sec. 5) for
-// area, point, spot, directional, constant and image-based environment lights.
+// area, point, spot, projector, directional, constant and image-based environment lights.
 //
 // Invariant the bidirectional estimators rely on: for every light and every
 // (point, direction) that illuminate() or emit() can produce, radianceAlong()
@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "kernels/shared/ub_light_pdf.h"
+#include "scene/light_projected.h"
 
 namespace ub {
 
@@ -212,8 +213,12 @@ void Light::prepare() {
             cosCutoff = std::cos(cutoffRad);
             cosBeamWidth = std::cos(beamRad);
             invTransitionRad = cutoffRad > beamRad ? 1.0f / (cutoffRad - beamRad) : 0.0f;
+            prepareProjected(*this);  // the optional texture
             break;
         }
+        case LightType::Projector:
+            prepareProjected(*this);
+            break;
         case LightType::Directional: {
             if (!isFiniteNonNegative(radiance))
                 throwLightError(*this,
@@ -332,14 +337,30 @@ Rgb Light::illuminate(const SceneSphere& sphere, const Vec3& receivingPos, const
             if (!(distSqr > 0)) return Rgb(0);
             float dist = std::sqrt(distSqr);
             Vec3 dir = toLight / dist;
-            float falloff = spotFalloff(dot(direction, -dir));
-            if (!(falloff > 0)) return Rgb(0);
+            Rgb value = projectedIntensity(-dir);  // falloff (and texture)
+            if (isBlack(value)) return Rgb(0);
             *dirToLight = dir;
             *distance = dist;
             *directPdfW = distSqr;  // as a point light: I(dir) / d^2
             if (emissionPdfW) *emissionPdfW = spotConePdfW(*this);
             if (cosAtLight) *cosAtLight = 1.0f;
-            return intensity * falloff;
+            return value;
+        }
+        case LightType::Projector: {
+            Vec3 toLight = position - receivingPos;
+            float distSqr = lengthSqr(toLight);
+            if (!(distSqr > 0)) return Rgb(0);
+            float dist = std::sqrt(distSqr);
+            Vec3 dir = toLight / dist;
+            float pdfW;
+            Rgb value = projectedIntensity(-dir, &pdfW);
+            if (isBlack(value) || !(pdfW > 0)) return Rgb(0);
+            *dirToLight = dir;
+            *distance = dist;
+            *directPdfW = distSqr;
+            if (emissionPdfW) *emissionPdfW = pdfW;
+            if (cosAtLight) *cosAtLight = 1.0f;
+            return value;
         }
         case LightType::Directional:
             *dirToLight = -direction;
@@ -412,7 +433,19 @@ Rgb Light::emit(const SceneSphere& sphere, const Vec2& rndDir, const Vec2& rndPo
             *emissionPdfW = spotConePdfW(*this);
             if (directPdfA) *directPdfA = 1.0f;
             if (cosThetaLight) *cosThetaLight = 1.0f;
-            return intensity * spotFalloff(cosTheta);
+            return projTexture ? projectedIntensity(*directionOut)
+                               : intensity * spotFalloff(cosTheta);
+        }
+        case LightType::Projector: {
+            *positionOut = position;
+            *directionOut = sampleProjectorDirection(*this, rndDir);
+            float pdfW;
+            Rgb value = projectedIntensity(*directionOut, &pdfW);
+            if (isBlack(value) || !(pdfW > 0)) return Rgb(0);
+            *emissionPdfW = pdfW;
+            if (directPdfA) *directPdfA = 1.0f;
+            if (cosThetaLight) *cosThetaLight = 1.0f;
+            return value;
         }
         case LightType::Directional:
             // Parallel rays through the scene-sphere disk on the side the light comes from.
@@ -457,6 +490,7 @@ Rgb Light::radianceAlong(const SceneSphere& sphere, const Vec3& rayDir, const Ve
         }
         case LightType::Point:
         case LightType::Spot:
+        case LightType::Projector:
         case LightType::Directional:
             return Rgb(0);  // delta lights cannot be hit
         case LightType::ConstantEnv:

@@ -50,6 +50,7 @@
 #include "core/sampling.h"
 #include "core/vec.h"
 #include "scene/env_map.h"
+#include "scene/texture.h"
 
 namespace ub {
 
@@ -66,6 +67,7 @@ enum class LightType : uint32_t {
     ConstantEnv = 3,  ///< constant environment radiance
     EnvMap = 4,       ///< lat-long environment map, importance sampled
     Spot = 5,         ///< Mitsuba 3 `spot`: `intensity` [W/sr] at `position`, axis `direction`
+    Projector = 6,    ///< Mitsuba 3 `projector`: a texture projected through a pinhole
 };
 
 struct Light {
@@ -83,6 +85,20 @@ struct Light {
     float beamWidthDeg = 15.0f;    ///< Spot: half-angle of full intensity, in [0, cutoff]
     float cosCutoff = 0.0f, cosBeamWidth = 0.0f;      ///< Spot: set by prepare()
     float cutoffRad = 0.0f, invTransitionRad = 0.0f;  ///< Spot: set by prepare() (0: no ramp)
+
+    // ---- Projected textures (light_projected.cpp): a spot's optional `texture` and a
+    // projector's `irradiance`, looked up at uv of the direction in the light's frame
+    // (frameX, frameY, direction: the unit axes of Mitsuba's to_world, a rigid transform).
+    //   Spot: uv = 1/2 + (x, y) / (2 z tan(cutoff)), intensity * falloff * texture(uv).
+    //   Projector (`intensity` = Mitsuba's `scale`): uv = 1/2 - (x, aspect y) / (2 z t) with
+    //   t = tan(fov_x / 2), inside [0, 1]^2 and z > 0; intensity pi scale E(uv) / cos^3
+    //   (Mitsuba's projector.cpp, so that the irradiance on the plane z = 1 is E(uv)).
+    std::shared_ptr<const Texture> projTexture;  ///< Spot: optional; Projector: required
+    Vec3 frameX{0, 0, 0}, frameY{0, 0, 0};       ///< Spot, Projector: local x, y (0: built)
+    float projFovXDeg = 0.0f;                    ///< Projector: horizontal field of view
+    float projAspect = 1.0f;                     ///< Projector: width / height of the texture
+    float projTan = 0.0f;  ///< set by prepare(): tan(fov_x / 2) or tan(cutoff)
+    std::shared_ptr<const Distribution2D> projDistribution;  ///< Projector: set by prepare()
 
     // ---- Area light geometry (world space) ----
     std::vector<Vec3>
@@ -109,23 +125,24 @@ struct Light {
     /// a missing or invalid env map, or a non-rotation envToWorld.
     void prepare();
 
-    bool isDelta() const {
-        return type == LightType::Point || type == LightType::Directional ||
-               type == LightType::Spot;
+    bool isDelta() const { return isDeltaPosition() || type == LightType::Directional; }
+    /// A single emitting point in free space (point, spot and projector lights): shadow rays
+    /// to it need no offset at the light end.
+    bool isDeltaPosition() const {
+        return type == LightType::Point || type == LightType::Spot || type == LightType::Projector;
     }
-    /// A single emitting point in free space (point and spot lights): shadow rays to it need
-    /// no offset at the light end.
-    bool isDeltaPosition() const { return type == LightType::Point || type == LightType::Spot; }
     /// False for lights at infinity (directional, environment).
-    bool isFinite() const {
-        return type == LightType::Area || type == LightType::Point || type == LightType::Spot;
-    }
+    bool isFinite() const { return type == LightType::Area || isDeltaPosition(); }
     /// Spot: the falloff factor in [0, 1] for cos(theta) to the axis (Mitsuba 3's spot).
     float spotFalloff(float cosTheta) const;
     /// Spot: total emitted power per unit intensity, 2 pi [1 - (sin c - sin b) / (c - b)]
     /// for cutoff c and beam width b in radians (2 pi (1 - cos c) when b = c): the
     /// integral of the falloff over the sphere.
     float spotPowerPerIntensity() const;
+    /// Spot and projector: the intensity towards the unit world direction dirOut (leaving
+    /// the light), falloff and texture included; for a projector also the solid-angle pdf
+    /// with which emit() samples dirOut (light_projected.cpp).
+    Rgb projectedIntensity(const Vec3& dirOut, float* projectorPdfW = nullptr) const;
     bool isEnvironment() const {
         return type == LightType::ConstantEnv || type == LightType::EnvMap;
     }

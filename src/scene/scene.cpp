@@ -468,7 +468,7 @@ void Scene::commit() {
             checkPoint(s.bounds.hi, "shape '" + s.name + "'");
         }
         for (size_t i = 0; i < lights.size(); ++i)
-            if (lights[i].type == LightType::Point || lights[i].type == LightType::Spot)
+            if (lights[i].isDeltaPosition())
                 checkPoint(lights[i].position, "light " + std::to_string(i));
     }
     rtcCommitScene(impl_->scene);

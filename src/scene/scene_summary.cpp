@@ -50,6 +50,8 @@ const char* lightTypeName(LightType t) {
             return "envmap";
         case LightType::Spot:
             return "spot";
+        case LightType::Projector:
+            return "projector";
     }
     return "unknown";
 }
@@ -134,6 +136,12 @@ std::string describeScene(const Scene& scene) {
                 os << ", intensity " << vec(l.intensity) << " at " << vec(l.position) << " towards "
                    << vec(l.direction) << ", cutoff " << num(l.cutoffAngleDeg) << " deg, beam "
                    << num(l.beamWidthDeg) << " deg";
+                if (l.projTexture) os << ", texture '" << l.projTexture->name << "'";
+                break;
+            case LightType::Projector:
+                os << ", scale " << vec(l.intensity) << " at " << vec(l.position) << " towards "
+                   << vec(l.direction) << ", fov " << num(l.projFovXDeg) << " deg, irradiance '"
+                   << l.projTexture->name << "'";
                 break;
             case LightType::Directional:
                 os << ", irradiance " << vec(l.radiance) << " towards " << vec(l.direction);

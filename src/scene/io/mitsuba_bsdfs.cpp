@@ -23,8 +23,9 @@ constexpr float kAirIor = 1.000277f;        // Mitsuba's default ext_ior ("air")
 constexpr float kBk7Ior = 1.5046f;          // Mitsuba's default int_ior ("bk7")
 constexpr float kPolypropyleneIor = 1.49f;  // Mitsuba's default int_ior of plastics
 
-/// A <texture> -> index into Scene::textures (cached per object); -1 on an error.
-int buildTexture(MitsubaBuild& b, const XmlObject& t) {
+}  // namespace
+
+int buildMitsubaTexture(MitsubaBuild& b, const XmlObject& t) {
     auto cached = b.textureIds.find(&t);
     if (cached != b.textureIds.end()) return cached->second;
     XmlReader& r = b.r;
@@ -93,11 +94,13 @@ int buildTexture(MitsubaBuild& b, const XmlObject& t) {
     return id;
 }
 
+namespace {
+
 /// A reflectance given as a colour or as a nested/referenced texture.
 void readReflectance(MitsubaBuild& b, const XmlObject& o, const std::string& name, Rgb def,
                      Rgb* value, int* texture) {
     if (const XmlObject* tex = b.r.child(o, "texture", name)) {
-        *texture = buildTexture(b, *tex);
+        *texture = buildMitsubaTexture(b, *tex);
         return;
     }
     *value = b.r.getColor(o, name, def, ColorUse::Reflectance);
@@ -108,7 +111,7 @@ void readReflectance(MitsubaBuild& b, const XmlObject& o, const std::string& nam
 void readWeight(MitsubaBuild& b, const XmlObject& o, const std::string& name, float def,
                 float* value, int* texture) {
     if (const XmlObject* tex = b.r.child(o, "texture", name)) {
-        *texture = buildTexture(b, *tex);
+        *texture = buildMitsubaTexture(b, *tex);
         // Mitsuba 3's checkerboard evaluates as a float texture with the opposite parity of
         // its colour evaluation (src/textures/checkerboard.cpp in 3.9.1: eval_1 takes
         // color0 where exactly one of frac(u), frac(v) exceeds 1/2, eval where both or
@@ -268,7 +271,7 @@ bool readPerturbation(MitsubaBuild& b, const XmlObject& o, Material* m) {
                 return false;
             }
     }
-    const int textureId = texture ? buildTexture(b, *texture) : -1;
+    const int textureId = texture ? buildMitsubaTexture(b, *texture) : -1;
     const int innerId = buildMitsubaBsdf(b, *inner[0]);
     if (innerId < 0 || textureId < 0) return false;
     *m = b.scene.materials[size_t(innerId)];

@@ -102,6 +102,10 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& bsdf);
 /// added once per scene.
 int nullPassMaterial(MitsubaBuild& b);
 
+/// A <texture> (checkerboard, bitmap) -> index into Scene::textures (cached per object); -1
+/// on an error (already reported).
+int buildMitsubaTexture(MitsubaBuild& b, const XmlObject& t);
+
 /// Builds a medium from a <medium>; false on an error (already reported).
 bool buildMitsubaMedium(MitsubaBuild& b, const XmlObject& medium, Medium* out);
 

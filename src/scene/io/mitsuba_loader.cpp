@@ -19,8 +19,8 @@ namespace {
 
 const std::vector<std::string> kShapes = {"obj",    "ply",  "serialized", "rectangle",  "cube",
                                           "sphere", "disk", "cylinder",   "shapegroup", "instance"};
-const std::vector<std::string> kEmitters = {"area",        "point",    "spot",
-                                            "directional", "constant", "envmap"};
+const std::vector<std::string> kEmitters = {"area",     "point",       "spot",  "projector",
+                                            "constant", "directional", "envmap"};
 const std::vector<std::string> kIntegrators = {"path",   "volpath", "volpathmis",
                                                "direct", "ptracer", "moment"};
 const std::vector<std::string> kRfilters = {"box", "tent", "gaussian"};
@@ -65,12 +65,20 @@ class Builder {
   private:
     void readIntegrator(const XmlObject& o);
     void readSensor(const XmlObject& o);
+    /// The horizontal field of view in degrees of a perspective sensor or a projector
+    /// (Mitsuba's parse_fov: `fov` along `fov_axis`, or `focal_length` on 36 x 24 mm film).
+    float readFovX(const XmlObject& o, float aspect);
     void readFilm(const XmlObject& o, int* w, int* h);
     void readShape(const XmlObject& o);
     void readGeometry(const XmlObject& o, ShapeGeometry* g);
     const ShapeGroupShapes& shapeGroup(const XmlObject& group);
     void readInstance(const XmlObject& o);
     void readEmitter(const XmlObject& o);
+    /// The projected texture of a spot or projector (a bitmap, evaluated as an emission) and
+    /// the light's frame from to_world, which must be a rotation and translation.
+    void readProjectedTexture(const XmlObject& o, const XmlObject& tex, const XmlPos& at,
+                              const Transform& toWorld, Light* light);
+    void setLightFrame(const XmlObject& o, const Transform& toWorld, Light* light);
     int defaultMaterial();
     int blackMaterial();
     int oneSidedDiffuse(float reflectance, const char* name, int* cachedId);
@@ -234,32 +242,7 @@ void Builder::readFilm(const XmlObject& f, int* w, int* h) {
     r_.checkUnused(f);
 }
 
-void Builder::readSensor(const XmlObject& o) {
-    if (o.type != "perspective" && o.type != "thinlens") {
-        r_.unsupportedPlugin(o, {"perspective", "thinlens"});
-        return;
-    }
-    int w = 768, h = 576;
-    if (const XmlObject* film = r_.child(o, "film", "")) readFilm(*film, &w, &h);
-    if (const XmlObject* s = r_.child(o, "sampler", "")) {
-        bool known = false;
-        for (const auto& k : kSamplers) known = known || s->type == k;
-        if (!known) r_.unsupportedPlugin(*s, kSamplers);
-        // unibeam draws independent uniform samples; the count is chosen on the command line.
-        const int count = r_.getInt(*s, "sample_count", 4, 1, 1 << 30);
-        r_.getInt(*s, "seed", 0, 0, 1 << 30);
-        if (s->type != "independent" && s->type != "ldsampler") r_.getBool(*s, "jitter", true);
-        if (s->type == "orthogonal") r_.getInt(*s, "strength", 2, 1, 1 << 20);
-        r_.checkUnused(*s);
-        if (known)
-            r_.warning(s->pos, s->label() +
-                                   ": unibeam uses its own independent sampler; "
-                                   "sample_count " +
-                                   std::to_string(count) +
-                                   " is not used (one sample per pixel per iteration: set "
-                                   "the iterations with `unibeam render -i`)");
-    }
-    const float aspect = float(w) / float(h);
+float Builder::readFovX(const XmlObject& o, float aspect) {
     float fovX = 0.0f;
     if (o.find("fov") && o.find("focal_length"))
         r_.error(o.find("focal_length")->pos,
@@ -298,6 +281,36 @@ void Builder::readSensor(const XmlObject& o) {
         double width = 2.0 * std::tan(0.5 * diag) / std::sqrt(1.0 + 1.0 / (aspect * aspect));
         fovX = float(2.0 * std::atan(0.5 * width) * 180.0 / kPi);
     }
+    return fovX;
+}
+
+void Builder::readSensor(const XmlObject& o) {
+    if (o.type != "perspective" && o.type != "thinlens") {
+        r_.unsupportedPlugin(o, {"perspective", "thinlens"});
+        return;
+    }
+    int w = 768, h = 576;
+    if (const XmlObject* film = r_.child(o, "film", "")) readFilm(*film, &w, &h);
+    if (const XmlObject* s = r_.child(o, "sampler", "")) {
+        bool known = false;
+        for (const auto& k : kSamplers) known = known || s->type == k;
+        if (!known) r_.unsupportedPlugin(*s, kSamplers);
+        // unibeam draws independent uniform samples; the count is chosen on the command line.
+        const int count = r_.getInt(*s, "sample_count", 4, 1, 1 << 30);
+        r_.getInt(*s, "seed", 0, 0, 1 << 30);
+        if (s->type != "independent" && s->type != "ldsampler") r_.getBool(*s, "jitter", true);
+        if (s->type == "orthogonal") r_.getInt(*s, "strength", 2, 1, 1 << 20);
+        r_.checkUnused(*s);
+        if (known)
+            r_.warning(s->pos, s->label() +
+                                   ": unibeam uses its own independent sampler; "
+                                   "sample_count " +
+                                   std::to_string(count) +
+                                   " is not used (one sample per pixel per iteration: set "
+                                   "the iterations with `unibeam render -i`)");
+    }
+    const float aspect = float(w) / float(h);
+    const float fovX = readFovX(o, aspect);
     if (o.find("near_clip") || o.find("far_clip")) {
         r_.getFloatIn(o, "near_clip", 0.01f, 0.0f, kInf, true);
         r_.getFloatIn(o, "far_clip", 1e4f, 0.0f, kInf, true);
@@ -688,6 +701,36 @@ void Builder::readInstance(const XmlObject& o) {
     }
 }
 
+void Builder::setLightFrame(const XmlObject& o, const Transform& toWorld, Light* light) {
+    const Vec3 x = toWorld.vector(Vec3(1, 0, 0)), y = toWorld.vector(Vec3(0, 1, 0)),
+               z = toWorld.vector(Vec3(0, 0, 1));
+    const float s = similarityScale(toWorld);
+    if (!(s > 0) || std::fabs(s - 1.0f) > 1e-3f) {
+        const XmlProperty* tp = o.find("to_world");
+        r_.error(tp ? tp->pos : o.pos, o.label() +
+                                           ": to_world must be a rotation and translation (no "
+                                           "scale or shear) for a projected texture");
+        return;
+    }
+    light->frameX = x;
+    light->frameY = y;
+    light->direction = z;
+}
+
+void Builder::readProjectedTexture(const XmlObject& o, const XmlObject& tex, const XmlPos& at,
+                                   const Transform& toWorld, Light* light) {
+    const int id = buildMitsubaTexture(b_, tex);
+    if (id < 0) return;  // reported
+    const Texture& t = b_.scene.textures[size_t(id)];
+    if (t.type != TextureType::Bitmap) {
+        r_.error(at, o.label() + ": the projected texture must be a bitmap (got " + tex.label() +
+                         "; Mitsuba requires a spatially varying one)");
+        return;
+    }
+    light->projTexture = std::make_shared<Texture>(t);
+    setLightFrame(o, toWorld, light);
+}
+
 void Builder::readEmitter(const XmlObject& o) {
     const size_t before = r_.errorCount();
     Light light;
@@ -709,8 +752,37 @@ void Builder::readEmitter(const XmlObject& o) {
         Transform m = r_.getTransform(o, "to_world");
         light.position = m.point(Vec3(0.0f));
         light.direction = m.vector(Vec3(0, 0, 1));
-        if (o.find("texture") || r_.child(o, "texture", "texture"))
-            r_.error(o.pos, o.label() + ": projected textures are not supported");
+        if (const XmlObject* tex = r_.child(o, "texture", "texture")) {
+            const XmlPos at = r_.lastChildPos();
+            readProjectedTexture(o, *tex, at, m, &light);
+        } else if (o.find("texture")) {
+            // Mitsuba: "The parameter 'texture' must be spatially varying".
+            r_.error(o.find("texture")->pos,
+                     o.label() + ": 'texture' must be a spatially varying texture (a bitmap)");
+        }
+    } else if (o.type == "projector") {
+        light.type = LightType::Projector;
+        light.intensity = Rgb(r_.getFloatIn(o, "scale", 1.0f, 0.0f, kInf));
+        Transform m = r_.getTransform(o, "to_world");
+        light.position = m.point(Vec3(0.0f));
+        light.direction = m.vector(Vec3(0, 0, 1));
+        if (const XmlObject* tex = r_.child(o, "texture", "irradiance")) {
+            const XmlPos at = r_.lastChildPos();
+            readProjectedTexture(o, *tex, at, m, &light);
+        } else {
+            // A constant irradiance: a 1 x 1 texture (Mitsuba's resolution of a constant).
+            Texture t;
+            t.type = TextureType::Constant;
+            t.name = "irradiance";
+            t.color0 = r_.getColor(o, "irradiance", Rgb(1.0f), ColorUse::Emission);
+            light.projTexture = std::make_shared<Texture>(t);
+            setLightFrame(o, m, &light);
+        }
+        if (light.projTexture && light.projTexture->type == TextureType::Bitmap &&
+            light.projTexture->image)
+            light.projAspect =
+                float(light.projTexture->image->width) / float(light.projTexture->image->height);
+        light.projFovXDeg = readFovX(o, light.projAspect);
     } else if (o.type == "directional") {
         light.type = LightType::Directional;
         light.radiance = r_.getColor(o, "irradiance", Rgb(1.0f), ColorUse::Emission);
