@@ -64,6 +64,7 @@ class Builder {
 
   private:
     void readIntegrator(const XmlObject& o);
+    void checkDirect();
     void readSensor(const XmlObject& o);
     /// The horizontal field of view in degrees of a perspective sensor or a projector
     /// (Mitsuba's parse_fov: `fov` along `fov_axis`, or `focal_length` on 36 x 24 mm film).
@@ -87,6 +88,8 @@ class Builder {
     MitsubaBuild& b_;
     XmlReader& r_;
     bool integratorSeen_ = false;
+    const XmlObject* direct_ = nullptr;  ///< the `direct` integrator, if the scene uses it
+    int directEmitterSamples_ = 1, directBsdfSamples_ = 1;
     int defaultMaterial_ = -1;
     int blackMaterial_ = -1;
     const XmlObject* envObject_ = nullptr;
@@ -133,12 +136,62 @@ void Builder::build() {
     if (b_.scene.settings.defaultAlgorithm == "lt")
         b_.scene.settings.pixelFilter =
             b_.scene.settings.pixelFilter.withBorder(PixelFilterBorder::kPartitionOfUnity);
+    checkDirect();
     if (!sensor)
         r_.error(XmlPos{b_.xml.file, 0, 0},
                  "the scene has no <sensor> (expected one "
                  "perspective sensor)");
     if (b_.scene.lights.empty() && r_.errorCount() == 0)
         r_.error(XmlPos{b_.xml.file, 0, 0}, "the scene has no emitter");
+}
+
+namespace {
+
+/// Whether material id (of scene) scatters through a delta lobe: light that only Mitsuba's
+/// BSDF sampling reaches.
+bool hasDeltaLobe(const Scene& scene, int id) {
+    if (id < 0 || size_t(id) >= scene.materials.size()) return false;
+    const Material& m = scene.materials[size_t(id)];
+    switch (m.type) {
+        case MaterialType::Mirror:
+        case MaterialType::Dielectric:
+        case MaterialType::Plastic:
+        case MaterialType::ThinDielectric: return true;
+        case MaterialType::MultiLobe: return m.refract || maxComponent(m.specular) > 0.0f;
+        case MaterialType::Blend:
+            return hasDeltaLobe(scene, m.blendParts[0]) || hasDeltaLobe(scene, m.blendParts[1]);
+        default: return false;
+    }
+}
+
+}  // namespace
+
+void Builder::checkDirect() {
+    if (!direct_) return;
+    if (directEmitterSamples_ == 0 && directBsdfSamples_ > 0) {
+        for (const Light& l : b_.scene.lights)
+            if (l.isDelta()) {
+                r_.error(direct_->find("emitter_samples")->pos,
+                         direct_->label() +
+                             ": emitter_samples = 0 leaves the delta emitter '" + l.name +
+                             "' dark in Mitsuba, which unibeam's estimators do not reproduce "
+                             "(expected emitter_samples >= 1 in a scene with point, spot, "
+                             "projector or directional emitters)");
+                return;
+            }
+    }
+    if (directBsdfSamples_ == 0 && directEmitterSamples_ > 0) {
+        for (const ShapeInfo& shape : b_.scene.shapes)
+            if (const int i = shape.materialId; hasDeltaLobe(b_.scene, i)) {
+                r_.error(direct_->find("bsdf_samples")->pos,
+                         direct_->label() + ": bsdf_samples = 0 leaves light reflected or "
+                                            "refracted by the smooth BSDF '" +
+                             b_.scene.materials[size_t(i)].name +
+                             "' dark in Mitsuba, which unibeam's estimators do not reproduce "
+                             "(expected bsdf_samples >= 1 in a scene with smooth BSDFs)");
+                return;
+            }
+    }
 }
 
 void Builder::readIntegrator(const XmlObject& top) {
@@ -169,13 +222,18 @@ void Builder::readIntegrator(const XmlObject& top) {
     if (o->type == "direct") {
         // Mitsuba's direct: directly visible emitters plus emitter and BSDF sampling at the
         // first hit, combined by MIS. That is a path of at most 2 segments (max_depth 2); the
-        // sample counts change the variance only, but a count of 0 drops a strategy (with no
-        // emitter samples point lights vanish, with no BSDF samples light seen in mirrors),
-        // which unibeam's estimators cannot reproduce.
+        // sample counts change the variance only. A count of 0 drops a strategy: with no
+        // emitter samples delta lights (point, spot, projector, directional) vanish, with no
+        // BSDF samples so does light reflected or refracted by delta lobes. The image keeps
+        // its expectation where the scene has none of those (checked in checkDirect once the
+        // scene is read), and unibeam renders it with its own estimators; with both counts 0
+        // only directly visible emitters remain (1 segment).
         const int shading = r_.getInt(*o, "shading_samples", 1, 1, 1 << 20);
-        r_.getInt(*o, "emitter_samples", shading, 1, 1 << 20);
-        r_.getInt(*o, "bsdf_samples", shading, 1, 1 << 20);
-        b_.scene.settings.maxPathLength = 2;
+        directEmitterSamples_ = r_.getInt(*o, "emitter_samples", shading, 0, 1 << 20);
+        directBsdfSamples_ = r_.getInt(*o, "bsdf_samples", shading, 0, 1 << 20);
+        direct_ = o;
+        b_.scene.settings.maxPathLength =
+            directEmitterSamples_ == 0 && directBsdfSamples_ == 0 ? 1 : 2;
         r_.checkUnused(*o);
         return;
     }
