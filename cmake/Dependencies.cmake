@@ -25,6 +25,8 @@ ub_require(ZLIB_FOUND "zlib" zlib1g-dev)
 
 find_package(JPEG QUIET)
 ub_require(JPEG_FOUND "libjpeg (libjpeg-turbo)" libjpeg62-turbo-dev)
+find_path(UB_STB_INCLUDE stb/stb_image.h)
+ub_require(UB_STB_INCLUDE "stb_image (BMP, TGA, RGBE, PNM textures)" libstb-dev)
 
 find_package(nlohmann_json 3 CONFIG QUIET)
 ub_require(nlohmann_json_FOUND "nlohmann-json" nlohmann-json3-dev)

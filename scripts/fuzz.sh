@@ -17,7 +17,7 @@ cd "$(dirname "$0")/.."
 SECONDS_PER_TARGET="${1:-30}"
 JOBS="${JOBS:-2}"
 FUZZ_TIMEOUT="${FUZZ_TIMEOUT:-10}"
-ALL_TARGETS="fuzz_json_scene fuzz_mitsuba_scene fuzz_smallupbp_scene fuzz_vol_grid fuzz_mesh_obj fuzz_mesh_ply fuzz_serialized_mesh fuzz_exr_image fuzz_png_image fuzz_jpeg_image"
+ALL_TARGETS="fuzz_json_scene fuzz_mitsuba_scene fuzz_smallupbp_scene fuzz_vol_grid fuzz_mesh_obj fuzz_mesh_ply fuzz_serialized_mesh fuzz_exr_image fuzz_png_image fuzz_jpeg_image fuzz_stb_image"
 TARGETS="${FUZZ_TARGETS:-$ALL_TARGETS}"
 
 # clang and its runtime libraries (libFuzzer, sanitizers) from Debian.

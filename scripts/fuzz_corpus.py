@@ -129,6 +129,21 @@ def main():
         put(out, "fuzz_exr_image", p.parent.name + "_" + p.name, p.read_bytes())
     for p in files(["scenes", "tests/data"], {".png"}):
         put(out, "fuzz_png_image", p.parent.name + "_" + p.name, p.read_bytes())
+    # fuzz_stb_image: a format byte (0 bmp, 1 tga, 2 hdr, 3 ppm), then the file; 2x2 each.
+    bmp_rows = b"".join(bytes([0, 0, 255, 128, 128, 128]) + b"\0\0" for _ in range(2))
+    bmp = (b"BM" + struct.pack("<IHHI", 54 + len(bmp_rows), 0, 0, 54) +
+           struct.pack("<IiiHHIIiiII", 40, 2, 2, 1, 24, 0, len(bmp_rows), 2835, 2835, 0, 0) +
+           bmp_rows)
+    put(out, "fuzz_stb_image", "gen_rgb24.bmp", b"\0" + bmp)
+    tga = struct.pack("<BBBHHBHHHHBB", 0, 0, 2, 0, 0, 0, 0, 0, 2, 2, 24, 0) + bytes(12)
+    put(out, "fuzz_stb_image", "gen_rgb24.tga", b"\1" + tga)
+    tga_rle = struct.pack("<BBBHHBHHHHBB", 0, 0, 10, 0, 0, 0, 0, 0, 2, 2, 24, 0) + \
+        bytes([0x83, 10, 20, 30])
+    put(out, "fuzz_stb_image", "gen_rle24.tga", b"\1" + tga_rle)
+    hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 2\n" + bytes([128, 64, 32, 129] * 4)
+    put(out, "fuzz_stb_image", "gen_flat.hdr", b"\2" + hdr)
+    put(out, "fuzz_stb_image", "gen_rgb8.ppm", b"\3" + b"P6\n2 2\n255\n" + bytes(range(12)))
+    put(out, "fuzz_stb_image", "gen_grey8.pgm", b"\3" + b"P5\n2 2\n255\n" + bytes(range(4)))
     # PNG colour types and depths the reader handles (core/image.h), 4x3 each.
     w, h = 4, 3
     put(out, "fuzz_png_image", "gen_grey8.png", png(w, h, 0, 8, lambda y: bytes(range(y, y + w))))

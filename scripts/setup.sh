@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
-  libembree-dev libtbb-dev libopenexr-dev libpng-dev zlib1g-dev libjpeg62-turbo-dev
+  libembree-dev libtbb-dev libopenexr-dev libpng-dev zlib1g-dev libjpeg62-turbo-dev libstb-dev
   libopenvdb-dev libnanovdb-dev libboost-iostreams-dev
   ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd clinfo
   nlohmann-json3-dev libcli11-dev libtinyobjloader-dev libpugixml-dev

@@ -117,6 +117,18 @@ fs::path prepare(const std::string& target, const std::string& data, const fs::p
                 ext + R"("}}}, "shapes": [{"type": "cube", "material": "m"}, )" + light + "]"));
         return dir / "scene.json";
     }
+    if (target == "fuzz_stb_image") {
+        // The target's first byte chooses the extension (% 4: bmp, tga, hdr, ppm).
+        static const char* const kExt[4] = {"bmp", "tga", "hdr", "ppm"};
+        const std::string ext = data.empty() ? "bmp" : kExt[uint8_t(data[0]) % 4];
+        writeFile(dir / ("image." + ext), data.empty() ? data : data.substr(1));
+        writeFile(
+            dir / "scene.json",
+            sceneWith(
+                R"("materials": {"m": {"type": "diffuse", "reflectance": {"type": "bitmap", "file": "image.)" +
+                ext + R"("}}}, "shapes": [{"type": "cube", "material": "m"}, )" + light + "]"));
+        return dir / "scene.json";
+    }
     if (target == "fuzz_serialized_mesh") {
         // The target picks shape index size % 3; a Mitsuba scene does so explicitly.
         writeFile(dir / "mesh.serialized", data);
@@ -246,6 +258,22 @@ const std::vector<Case> kCases = {
      2,
      {"invalid .serialized file: the dictionary gives shape 1 the offset 18446744073709551615, "
       "outside the file's shape data"}},
+    // Heap overflow in stb_image (libstb-dev 0.0~git20220908): a 16-bit grey PNM converted to
+    // 3 channels by stb read past its buffer. readStbImage asks for the file's own channels,
+    // and RGBE data must match the extension: under a .hdr name this is no RGBE file, under
+    // a .ppm name it decodes (a 3 x 525 header with no room for its pixels: truncated).
+    {"fuzz_stb_image",
+     "pnm16-under-hdr-name.bin",
+     2,
+     {"scene.json:3:", "cannot read bitmap 'image.hdr'", "not a Radiance RGBE file"}},
+    {"fuzz_stb_image", "pnm16-to-rgb.bin", 2, {"scene.json:3:", "cannot read bitmap 'image.ppm'"}},
+    // UBSan: stb_image read the PNM height 54444444444444444444444444446 into an int (signed
+    // overflow). Header numbers of more than 9 digits are errors before stb parses them.
+    {"fuzz_stb_image",
+     "pnm-header-int-overflow.bin",
+     2,
+     {"scene.json:3:", "cannot read bitmap 'image.ppm'",
+      "PNM header height has 29 digits (expected at most 9)"}},
     // A seed (tests/data/mitsuba/media.xml with its include): UBSan's alignment check in
     // oneTBB's concurrent_hash_map under OpenVDB (fuzz/ubsan_ignorelist.txt); it loads.
     {"fuzz_mitsuba_scene", "tbb-hash-map-sentinel-downcast.xml", 0, {}},

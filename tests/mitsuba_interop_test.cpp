@@ -98,8 +98,8 @@ TEST(MitsubaInterop, DirectAndPtracerIntegrators) {
     // A strategy dropped by a zero sample count: the image keeps its expectation unless the
     // scene has what only that strategy reaches (delta emitters, delta BSDF lobes).
     auto direct = [](const char* counts, const std::string& rest) {
-        return scene("", std::string("<integrator type=\"direct\">") + counts +
-                             "</integrator>\n" + rest);
+        return scene(
+            "", std::string("<integrator type=\"direct\">") + counts + "</integrator>\n" + rest);
     };
     const std::string sphere = "<shape type=\"sphere\"><bsdf type=\"dielectric\"/></shape>\n";
     const std::string point =
@@ -108,20 +108,23 @@ TEST(MitsubaInterop, DirectAndPtracerIntegrators) {
     EXPECT_EQ(s->settings.maxPathLength, 2);
     s = load(direct("<integer name=\"emitter_samples\" value=\"0\"/>", sphere + kLight));
     EXPECT_EQ(s->settings.maxPathLength, 2);
-    s = load(direct("<integer name=\"emitter_samples\" value=\"0\"/><integer "
+    s =
+        load(direct("<integer name=\"emitter_samples\" value=\"0\"/><integer "
                     "name=\"bsdf_samples\" value=\"0\"/>",
                     sphere + point));
     EXPECT_EQ(s->settings.maxPathLength, 1);  // directly visible emitters only
     std::string e =
         errorsOf(direct("<integer name=\"bsdf_samples\" value=\"0\"/>", sphere + kLight));
     EXPECT_TRUE(contains(e, "scene.xml:6:27:") &&
-                contains(e, "<integrator type=\"direct\">: bsdf_samples = 0 leaves light "
-                            "reflected or refracted by the smooth BSDF"))
+                contains(e,
+                         "<integrator type=\"direct\">: bsdf_samples = 0 leaves light "
+                         "reflected or refracted by the smooth BSDF"))
         << e;
     e = errorsOf(direct("<integer name=\"emitter_samples\" value=\"0\"/>", point + kLight));
     EXPECT_TRUE(contains(e, "scene.xml:6:27:") &&
-                contains(e, "<integrator type=\"direct\">: emitter_samples = 0 leaves the "
-                            "delta emitter"))
+                contains(e,
+                         "<integrator type=\"direct\">: emitter_samples = 0 leaves the "
+                         "delta emitter"))
         << e;
     e = errorsOf(direct("<integer name=\"emitter_samples\" value=\"-1\"/>", kLight));
     EXPECT_TRUE(contains(e, "parameter 'emitter_samples' = -1 is out of range")) << e;

@@ -174,8 +174,9 @@ TEST(JsonLoaderErrors, TextureErrors) {
         << all;
     EXPECT_TRUE(contains(all,
                          "scene.json:5:68: error: at /materials/b/reflectance/file: "
-                         "unsupported bitmap file 'tiles.gif' (expected a .png (sRGB, 8 or "
-                         "16 bit), .jpg/.jpeg (sRGB) or .exr (linear) file)"))
+                         "unsupported bitmap file 'tiles.gif' (expected .png, .jpg/.jpeg, .exr, "
+                         ".bmp, .tga, .hdr/.rgbe or .ppm/.pgm/.pnm; EXR and RGBE are linear, "
+                         "the others sRGB unless raw)"))
         << all;
     EXPECT_TRUE(contains(all,
                          "error: at /materials/c/reflectance/file: cannot read bitmap "

@@ -39,6 +39,19 @@ Image readPng(const std::string& path, bool linearize = true);
 /// decoded like readPng (sRGB unless linearize = false). Corrupt or truncated data is an
 /// error (libjpeg's warnings are not ignored). Throws InputError naming the file.
 Image readJpeg(const std::string& path, bool linearize = true);
+/// Reads a BMP, TGA, PNM (.ppm/.pgm/.pnm) or Radiance RGBE (.hdr/.rgbe) image through
+/// stb_image (core/image_stb.cpp). 8-bit formats are decoded like readPng (sRGB unless
+/// linearize = false); RGBE is linear. Alpha is dropped, grey replicated. Unreadable,
+/// corrupt or truncated data throws InputError naming the file.
+Image readStbImage(const std::string& path, bool linearize = true);
+/// The image formats of the bitmap textures (Mitsuba 3's bitmap reads the same set but PFM).
+inline constexpr const char* kBitmapFormats =
+    ".png, .jpg/.jpeg, .exr, .bmp, .tga, .hdr/.rgbe or .ppm/.pgm/.pnm";
+/// Whether a lower-case extension (".png") names one of kBitmapFormats.
+bool isBitmapExtension(const std::string& extLower);
+/// Reads any of kBitmapFormats by its extension (EXR and RGBE linear, the others sRGB unless
+/// linearize = false). An unknown extension throws InputError.
+Image readBitmapFile(const std::string& path, bool linearize = true);
 /// The sRGB transfer function (IEC 61966-2-1): encoded value in [0,1] -> linear.
 float srgbToLinear(float encoded);
 /// Writes 32-bit float RGB with the given string attributes. Throws std::runtime_error on I/O

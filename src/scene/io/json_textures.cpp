@@ -103,10 +103,9 @@ std::shared_ptr<const Image> loadBitmap(JsonReader& r, const std::string& file, 
                                         const std::string& filePtr, JsonSceneParts& parts) {
     const std::string path = resolveScenePath(parts.baseDir, file);
     const std::string ext = lowerExtension(file);
-    if (ext != ".png" && ext != ".exr" && ext != ".jpg" && ext != ".jpeg") {
-        r.error(filePtr, "unsupported bitmap file '" + file +
-                             "' (expected a .png (sRGB, 8 or 16 bit), .jpg/.jpeg (sRGB) or .exr "
-                             "(linear) file)");
+    if (!isBitmapExtension(ext)) {
+        r.error(filePtr, "unsupported bitmap file '" + file + "' (expected " + kBitmapFormats +
+                             "; EXR and RGBE are linear, the others sRGB unless raw)");
         return nullptr;
     }
     if (!fs::is_regular_file(path)) {
@@ -118,9 +117,7 @@ std::shared_ptr<const Image> loadBitmap(JsonReader& r, const std::string& file, 
     auto it = parts.bitmapCache.find(key);
     if (it != parts.bitmapCache.end()) return it->second;
     try {
-        auto img = std::make_shared<const Image>(ext == ".png"   ? readPng(path, !raw)
-                                                 : ext == ".exr" ? readExr(path)
-                                                                 : readJpeg(path, !raw));
+        auto img = std::make_shared<const Image>(readBitmapFile(path, !raw));
         parts.bitmapCache[key] = img;
         return img;
     } catch (const InputError& e) {

@@ -60,15 +60,12 @@ int buildMitsubaTexture(MitsubaBuild& b, const XmlObject& t) {
             std::string ext = std::filesystem::path(path).extension().string();
             for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
             try {
-                if (ext == ".exr")
-                    tex.image = std::make_shared<Image>(readExr(path));
-                else if (ext == ".png")
-                    tex.image = std::make_shared<Image>(readPng(path, !raw));
-                else if (ext == ".jpg" || ext == ".jpeg")
-                    tex.image = std::make_shared<Image>(readJpeg(path, !raw));
+                if (isBitmapExtension(ext))
+                    tex.image = std::make_shared<Image>(readBitmapFile(path, !raw));
                 else
-                    r.error(t.find("filename")->pos,
-                            t.label() + ": '" + file + "' is not a .png, .jpg/.jpeg or .exr file");
+                    r.error(t.find("filename")->pos, t.label() + ": '" + file +
+                                                         "' is not an image unibeam reads (" +
+                                                         kBitmapFormats + ")");
             } catch (const InputError& e) {
                 for (const Diagnostic& d : e.diagnostics())
                     r.error(t.find("filename")->pos, t.label() + ": " + d.format());

@@ -156,11 +156,14 @@ bool hasDeltaLobe(const Scene& scene, int id) {
         case MaterialType::Mirror:
         case MaterialType::Dielectric:
         case MaterialType::Plastic:
-        case MaterialType::ThinDielectric: return true;
-        case MaterialType::MultiLobe: return m.refract || maxComponent(m.specular) > 0.0f;
+        case MaterialType::ThinDielectric:
+            return true;
+        case MaterialType::MultiLobe:
+            return m.refract || maxComponent(m.specular) > 0.0f;
         case MaterialType::Blend:
             return hasDeltaLobe(scene, m.blendParts[0]) || hasDeltaLobe(scene, m.blendParts[1]);
-        default: return false;
+        default:
+            return false;
     }
 }
 
@@ -172,8 +175,8 @@ void Builder::checkDirect() {
         for (const Light& l : b_.scene.lights)
             if (l.isDelta()) {
                 r_.error(direct_->find("emitter_samples")->pos,
-                         direct_->label() +
-                             ": emitter_samples = 0 leaves the delta emitter '" + l.name +
+                         direct_->label() + ": emitter_samples = 0 leaves the delta emitter '" +
+                             l.name +
                              "' dark in Mitsuba, which unibeam's estimators do not reproduce "
                              "(expected emitter_samples >= 1 in a scene with point, spot, "
                              "projector or directional emitters)");
@@ -184,8 +187,9 @@ void Builder::checkDirect() {
         for (const ShapeInfo& shape : b_.scene.shapes)
             if (const int i = shape.materialId; hasDeltaLobe(b_.scene, i)) {
                 r_.error(direct_->find("bsdf_samples")->pos,
-                         direct_->label() + ": bsdf_samples = 0 leaves light reflected or "
-                                            "refracted by the smooth BSDF '" +
+                         direct_->label() +
+                             ": bsdf_samples = 0 leaves light reflected or "
+                             "refracted by the smooth BSDF '" +
                              b_.scene.materials[size_t(i)].name +
                              "' dark in Mitsuba, which unibeam's estimators do not reproduce "
                              "(expected bsdf_samples >= 1 in a scene with smooth BSDFs)");
