@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <string>
 
 #include "core/error.h"
@@ -385,4 +386,56 @@ TEST(MeshIo, ErrorPlyCountsTheFileCannotHold) {
     d = loadError(meshPath("negative_count.ply"));
     EXPECT_EQ(d.line, 3);
     EXPECT_EQ(d.message, "PLY element 'vertex' has count '-5' (expected a non-negative integer)");
+}
+
+// Mesh attributes (Mitsuba 3's naming): red/green/blue as "color" (uchar / 255), NAME_k as
+// channel k of "NAME", other scalars as 1-channel attributes; face values are repeated for
+// every triangle of a polygon's fan and follow the triangles when degenerate ones are dropped.
+TEST(MeshIo, PlyMeshAttributesFollowMitsubasNaming) {
+    const std::string path = ::testing::TempDir() + "unibeam_attributes.ply";
+    std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 5\n"
+                           "property float x\nproperty float y\nproperty float z\n"
+                           "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                           "property float quality\n"
+                           "element face 2\nproperty list uchar int vertex_indices\n"
+                           "property float color_0\nproperty float color_1\n"
+                           "property float color_2\nproperty float weight_0\nend_header\n"
+                           "0 0 0 255 0 0 0.5\n1 0 0 0 255 0 1.5\n1 1 0 0 0 255 2.5\n"
+                           "0 1 0 51 102 153 3.5\n2 0 0 0 0 0 4.5\n"
+                           "4 0 1 2 3 0.1 0.2 0.3 0.25\n"
+                           "3 0 1 4 0.7 0.8 0.9 0.75\n";
+    Diagnostics diags;
+    TriangleMesh m = loadMeshFile(path, diags, "/shapes/0");
+    ASSERT_FALSE(diags.hasErrors()) << diags.all()[0].format();
+    ASSERT_EQ(m.triangleCount(), 2u);  // the quad's fan; the collinear triangle is dropped
+    std::map<std::string, const MeshAttribute*> byName;
+    for (const MeshAttribute& a : m.attributes) byName[a.name] = &a;
+    ASSERT_EQ(byName.size(), 4u);
+    const MeshAttribute* vc = byName["vertex_color"];
+    ASSERT_TRUE(vc);
+    EXPECT_FALSE(vc->perFace);
+    EXPECT_EQ(vc->channels, 3);
+    ASSERT_EQ(vc->values.size(), 15u);
+    EXPECT_FLOAT_EQ(vc->values[0], 1.0f);
+    EXPECT_FLOAT_EQ(vc->values[9], 0.2f);  // 51 / 255
+    EXPECT_FLOAT_EQ(vc->values[11], 0.6f);
+    const MeshAttribute* q = byName["vertex_quality"];
+    ASSERT_TRUE(q);
+    EXPECT_EQ(q->channels, 1);
+    ASSERT_EQ(q->values.size(), 5u);
+    EXPECT_FLOAT_EQ(q->values[3], 3.5f);
+    const MeshAttribute* fc = byName["face_color"];
+    ASSERT_TRUE(fc);
+    EXPECT_TRUE(fc->perFace);
+    ASSERT_EQ(fc->values.size(), 6u);  // both triangles of the quad, the degenerate one gone
+    for (int t = 0; t < 2; ++t) {
+        EXPECT_FLOAT_EQ(fc->values[3 * t + 0], 0.1f);
+        EXPECT_FLOAT_EQ(fc->values[3 * t + 2], 0.3f);
+    }
+    const MeshAttribute* w = byName["face_weight"];
+    ASSERT_TRUE(w);
+    EXPECT_EQ(w->channels, 1);
+    ASSERT_EQ(w->values.size(), 2u);
+    EXPECT_FLOAT_EQ(w->values[1], 0.25f);
+    std::remove(path.c_str());
 }

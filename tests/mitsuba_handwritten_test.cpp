@@ -119,6 +119,10 @@ const HandCase kCases[] = {
     {"projected", "bpt", 256},
     {"projected", "lt", 512},
     {"projected", "vcm", 256},
+    {"mesh_attributes", "pt", 512},
+    {"mesh_attributes", "bpt", 256},
+    {"mesh_attributes", "lt", 512},
+    {"mesh_attributes", "vcm", 256},
 };
 
 class MitsubaHandWritten : public ::testing::TestWithParam<HandCase> {};
@@ -321,4 +325,23 @@ TEST(MitsubaHandWrittenPower, ProjectedTextureOrientationIsDistinguished) {
         EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the orientation of "
                                             << (variant == 0 ? "the slide" : "the spot's texture");
     }
+}
+
+// Power of the mesh-attribute check: the middle cube coloured by the interpolated
+// vertex_color instead of its per-triangle face_color must fail the reference test.
+TEST(MitsubaHandWrittenPower, PerTriangleAttributesAreDistinguished) {
+    std::ifstream f(kDir + "/mesh_attributes.xml");
+    std::stringstream text;
+    text << f.rdbuf();
+    std::string xml = text.str();
+    const std::string from = "<string name=\"name\" value=\"face_color\"/>";
+    const size_t at = xml.find(from);
+    ASSERT_NE(at, std::string::npos);
+    xml.replace(at, from.size(), "<string name=\"name\" value=\"vertex_color\"/>");
+    std::unique_ptr<Scene> scene =
+        loadMitsubaSceneFromString(xml, "mesh_attributes.xml", kDir, {{"res", "48"}});
+    const test::ReferenceCheck check = checkAgainst("mesh_attributes", *scene, "pt", 512,
+                                                    "mesh_attributes pt, vertex for face colours");
+    EXPECT_FALSE(check.perPixel.passed)
+        << "the reference test cannot tell per-triangle from per-vertex attributes";
 }

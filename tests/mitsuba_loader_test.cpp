@@ -639,3 +639,59 @@ TEST(MitsubaBsdfs, BadBlendsAreErrorsWithPosition) {
         "</bsdf>\n");
     EXPECT_NE(e.find("tint"), std::string::npos) << e;
 }
+
+TEST(MitsubaLoader, MeshAttributeTexturesBindToTheirShape) {
+    const std::string dir = std::string(UNIBEAM_SOURCE_DIR) + "/tests/data/mitsuba";
+    auto shape = [](const std::string& bsdf, const std::string& type = "ply") {
+        return "<shape type=\"" + type + "\">" +
+               (type == "ply" ? "<string name=\"filename\" value=\"meshes/attributes.ply\"/>"
+                              : "") +
+               bsdf + "</shape>\n";
+    };
+    auto attr = [](const std::string& param, const std::string& name) {
+        return "<texture type=\"mesh_attribute\" name=\"" + param +
+               "\"><string name=\"name\" value=\"" + name + "\"/></texture>";
+    };
+    const std::string diffuse =
+        "<bsdf type=\"diffuse\">" + attr("reflectance", "vertex_color") + "</bsdf>";
+    auto s = load(scene(shape(diffuse) + kLight), dir);
+    ASSERT_EQ(s->textures.size(), 1u);
+    EXPECT_EQ(s->textures[0].type, TextureType::MeshAttribute);
+    EXPECT_EQ(s->textures[0].attributeName, "vertex_color");
+    // A ray into the cube's +z face sees the interpolated vertex colour, not 0.
+    Ray ray;
+    ray.org = Vec3(0.2f, 0.1f, 5.0f);
+    ray.dir = Vec3(0, 0, -1);
+    Hit hit;
+    ASSERT_TRUE(s->intersect(ray, &hit));
+    EXPECT_GT(hit.attribute.x + hit.attribute.y + hit.attribute.z, 0.1f);
+
+    std::string e = errorsOf(
+        scene(shape("<bsdf type=\"diffuse\">" + attr("reflectance", "vertex_foo") + "</bsdf>") +
+              kLight),
+        dir);
+    EXPECT_TRUE(contains(e,
+                         "its BSDF looks up the mesh attribute 'vertex_foo', which the mesh "
+                         "does not have (it has vertex_color, face_color, face_weight"))
+        << e;
+    e = errorsOf(scene(shape(diffuse, "sphere") + kLight), dir);
+    EXPECT_TRUE(contains(e, "'vertex_color', which a sphere does not have")) << e;
+    e = errorsOf(scene(shape("<bsdf type=\"blendbsdf\">" + attr("weight", "face_weight") +
+                             "<bsdf type=\"diffuse\">" + attr("reflectance", "face_color") +
+                             "</bsdf><bsdf type=\"diffuse\"/></bsdf>") +
+                       kLight),
+                 dir);
+    EXPECT_TRUE(contains(e,
+                         "looks up the mesh attributes 'face_color' and 'face_weight' "
+                         "(unibeam supports one mesh attribute per shape)"))
+        << e;
+    e = errorsOf(scene(shape("<bsdf type=\"normalmap\">" + attr("normalmap", "vertex_color") +
+                             "<bsdf type=\"diffuse\"/></bsdf>") +
+                       kLight),
+                 dir);
+    EXPECT_TRUE(contains(e, "a mesh_attribute cannot be its normal map")) << e;
+    e = errorsOf(
+        scene(shape("<bsdf type=\"diffuse\">" + attr("reflectance", "color") + "</bsdf>") + kLight),
+        dir);
+    EXPECT_TRUE(contains(e, "attribute name 'color' does not start with vertex_ or face_")) << e;
+}

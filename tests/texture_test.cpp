@@ -269,8 +269,8 @@ TEST(Texture, SceneSetupBsdfResolvesTexturesAtHitUv) {
         EXPECT_TRUE(sameRgb(bsdf.evaluate(gen, nullptr, nullptr, nullptr), p.expected * kInvPi))
             << p.at.x << " " << p.at.y;
         Bsdf stored;
-        ASSERT_TRUE(scene.setupBsdf(&stored, hit.materialId, hit.uv, -ray.dir, hit.geoNormal,
-                                    hit.shadingNormal, true));
+        ASSERT_TRUE(scene.setupBsdf(&stored, hit.materialId, hit.uv, hit.attribute, -ray.dir,
+                                    hit.geoNormal, hit.shadingNormal, true));
         EXPECT_TRUE(sameRgb(stored.evaluate(gen, nullptr, nullptr, nullptr), p.expected * kInvPi));
     }
     Hit none;

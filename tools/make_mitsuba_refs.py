@@ -8,9 +8,8 @@ var_sample = B * var(batch means of B samples)), 48x48, Mitsuba's `scalar_rgb` v
 and SCENE_ref.json with the Mitsuba version, sample count and batches.
 
 The scenes' inputs (textures/tiles.png, stripes.jpg, normalmap.png, heights.png, slide.png,
-volumes/density.vol, volumes/albedo.vol, volumes/chromatic.vol) are written by
---make-inputs, with Mitsuba's own
-writers.
+volumes/density.vol, volumes/albedo.vol, volumes/chromatic.vol, meshes/attributes.ply) are
+written by --make-inputs, with Mitsuba's own writers.
 
 Usage (not run by the tests; the outputs are committed):
     python3 -m venv venv && venv/bin/pip install mitsuba==3.9.1 numpy
@@ -93,6 +92,7 @@ def make_inputs(folder):
     mi.VolumeGrid(alb.astype(np.float32)).write(str(folder / "volumes" / "albedo.vol"))
     make_chromatic_volume(folder)
     make_slide(folder)
+    make_attribute_mesh(folder)
 
 
 def make_slide(folder):
@@ -109,6 +109,19 @@ def make_slide(folder):
     img[2, 18, :] = 1.0
     mi.Bitmap(np.round(np.clip(img, 0, 1) * 255).astype(np.uint8),
               pixel_format=mi.Bitmap.PixelFormat.RGB).write(str(folder / "textures" / "slide.png"))
+
+
+def make_attribute_mesh(folder):
+    """mesh_attributes.xml's mesh: Mitsuba's own unit cube (24 vertices, 12 triangles) with
+    the mesh attributes vertex_color (3 channels per vertex), face_color (3 per triangle) and
+    face_weight (1 per triangle), written by Mitsuba's PLY writer."""
+    (folder / "meshes").mkdir(exist_ok=True)
+    mesh = mi.load_dict({"type": "cube"})
+    rng = np.random.default_rng(7)
+    mesh.add_attribute("vertex_color", 3, (0.1 + 0.85 * rng.random(3 * 24)).tolist())
+    mesh.add_attribute("face_color", 3, (0.1 + 0.85 * rng.random(3 * 12)).tolist())
+    mesh.add_attribute("face_weight", 1, rng.random(12).tolist())
+    mesh.write_ply(str(folder / "meshes" / "attributes.ply"))
 
 
 def make_chromatic_volume(folder):

@@ -6,14 +6,14 @@
  * OpenCL size is 16), explicit padding; the host checks size and offsets below.
  *
  * The light BSDF is not stored: the host rebuilds it from (materialId, dirFix,
- * geoNormal, shadingNormal, uv) when a connection needs it. Merging only needs
+ * geoNormal, shadingNormal, uv, attribute) when a connection needs it. Merging only needs
  * dirFix and contProb.
  *
  * dVCM, dVC, dVM are the MIS partials of the light subpath after the hit update
  * at this vertex (ub_mis.h; VCM tech. rep. (31)-(36)).
  *
  * Medium vertices (vlt, vbpt, upbp): flags has UB_LIGHT_VERTEX_IN_MEDIUM,
- * materialId holds the medium's index, geoNormal, shadingNormal and uv are zero,
+ * materialId holds the medium's index, geoNormal, shadingNormal, uv and attribute are zero,
  * and the scattering function is sigma_s times the medium's phase function
  * (sigma_s is already part of the throughput). contProb is then the medium's
  * roulette probability at the vertex, and rInL the R (a length, ub_mis_volume.h)
@@ -41,7 +41,7 @@ typedef struct {
     ub_uint flags;          /* UB_LIGHT_VERTEX_* bits */
     float uv[2];            /* surface uv, where the textures are looked up */
     float rInL;             /* medium vertex: R of the photon beam that reached it */
-    ub_uint pad[3];
+    float attribute[3];     /* the surface's mesh attribute value (Hit::attribute), or 0 */
 } ub_light_vertex;
 
 #ifndef __OPENCL_C_VERSION__
@@ -55,6 +55,7 @@ static_assert(offsetof(ub_light_vertex, dVM) == 80, "ub_light_vertex layout");
 static_assert(offsetof(ub_light_vertex, flags) == 84, "ub_light_vertex layout");
 static_assert(offsetof(ub_light_vertex, uv) == 88, "ub_light_vertex layout");
 static_assert(offsetof(ub_light_vertex, rInL) == 96, "ub_light_vertex layout");
+static_assert(offsetof(ub_light_vertex, attribute) == 100, "ub_light_vertex layout");
 #endif
 
 #endif /* UB_LIGHT_VERTEX_H */

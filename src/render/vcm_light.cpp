@@ -108,6 +108,7 @@ void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuf
                     storeF3(lv.shadingNormal, v.hit.shadingNormal);
                     lv.uv[0] = v.hit.uv.x;
                     lv.uv[1] = v.hit.uv.y;
+                    storeF3(lv.attribute, v.hit.attribute);
                 }
                 // UPBP: surface vertices are connected and merged on surfaces; medium
                 // vertices are connected, and merged through the photon points below.

@@ -46,10 +46,12 @@ class VertexScatter {
         return true;
     }
     /// The same from stored vertex data (a light vertex).
-    bool setupSurface(const Scene& scene, int materialId, const Vec2& uv, const Vec3& dirFix,
-                      const Vec3& geoNormal, const Vec3& shadingNormal, bool fromLight) {
+    bool setupSurface(const Scene& scene, int materialId, const Vec2& uv, const Rgb& attribute,
+                      const Vec3& dirFix, const Vec3& geoNormal, const Vec3& shadingNormal,
+                      bool fromLight) {
         inMedium_ = false;
-        if (!scene.setupBsdf(&bsdf_, materialId, uv, dirFix, geoNormal, shadingNormal, fromLight))
+        if (!scene.setupBsdf(&bsdf_, materialId, uv, attribute, dirFix, geoNormal, shadingNormal,
+                             fromLight))
             return false;
         contProb_ = vcmContinuationProb(bsdf_);
         return true;

@@ -330,6 +330,8 @@ bool dropDegenerateTriangles(TriangleMesh& m, Reporter& rep, const char* kind) {
     std::vector<uint32_t> kept;
     kept.reserve(m.indices.size());
     size_t dropped = 0;
+    // Per-triangle attributes keep the values of the kept triangles.
+    std::vector<std::vector<float>> keptFace(m.attributes.size());
     for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
         const Vec3& p0 = m.positions[m.indices[t]];
         const Vec3& p1 = m.positions[m.indices[t + 1]];
@@ -340,6 +342,13 @@ bool dropDegenerateTriangles(TriangleMesh& m, Reporter& rep, const char* kind) {
             continue;
         }
         kept.insert(kept.end(), {m.indices[t], m.indices[t + 1], m.indices[t + 2]});
+        for (size_t a = 0; a < m.attributes.size(); ++a) {
+            const MeshAttribute& attr = m.attributes[a];
+            if (!attr.perFace) continue;
+            const size_t c = size_t(attr.channels), first = (t / 3) * c;
+            keptFace[a].insert(keptFace[a].end(), attr.values.begin() + long(first),
+                               attr.values.begin() + long(first + c));
+        }
     }
     if (kept.empty()) {
         rep.error(std::string(kind) + " file has no triangles with non-zero area (all " +
@@ -350,6 +359,8 @@ bool dropDegenerateTriangles(TriangleMesh& m, Reporter& rep, const char* kind) {
         rep.warning("dropped " + std::to_string(dropped) + " degenerate (zero-area) triangle" +
                     (dropped == 1 ? "" : "s"));
     m.indices = std::move(kept);
+    for (size_t a = 0; a < m.attributes.size(); ++a)
+        if (m.attributes[a].perFace) m.attributes[a].values = std::move(keptFace[a]);
     return true;
 }
 

@@ -242,6 +242,58 @@ int findProperty(const Element& e, std::initializer_list<const char*> names, boo
     return -1;
 }
 
+/// A mesh attribute being read: the properties of its channels in an element.
+struct AttributeGroup {
+    std::string prefix;
+    std::vector<int> props;     ///< property index per channel (-1: missing)
+    std::vector<double> scale;  ///< per channel: 1, or 1 / max of an integer type
+};
+
+/// Mitsuba 3's naming of the properties it keeps as mesh attributes: red/green/blue (or
+/// r/g/b) form "color"; NAME_0, NAME_1, ... form "NAME" with one channel each; any other
+/// scalar property is a 1-channel attribute of its own name. `used` marks the properties
+/// read as geometry (positions, normals, uvs, vertex indices). Integer colour channels are
+/// divided by their type's maximum (uchar 255).
+std::vector<AttributeGroup> attributeGroups(const Element& e, const std::vector<bool>& used) {
+    std::vector<AttributeGroup> groups;
+    auto group = [&](const std::string& prefix) -> AttributeGroup& {
+        for (AttributeGroup& g : groups)
+            if (g.prefix == prefix) return g;
+        groups.push_back(AttributeGroup{prefix, {}, {}});
+        return groups.back();
+    };
+    for (size_t i = 0; i < e.props.size(); ++i) {
+        const Property& p = e.props[i];
+        if (used[i] || p.list) continue;
+        std::string prefix = p.name;
+        size_t channel = 0;
+        double scale = 1.0;
+        static const char* const kRgb[2][3] = {{"r", "g", "b"}, {"red", "green", "blue"}};
+        bool colour = false;
+        for (auto& names : kRgb)
+            for (size_t c = 0; c < 3; ++c)
+                if (p.name == names[c]) colour = true, prefix = "color", channel = c;
+        if (colour) {
+            if (p.type != PlyType::kF32 && p.type != PlyType::kF64) {
+                double lo = 0, hi = 1;
+                integerRange(p.type, &lo, &hi);
+                scale = 1.0 / hi;
+            }
+        } else if (const size_t us = p.name.rfind('_');
+                   us != std::string::npos && us > 0 && us + 1 < p.name.size() &&
+                   p.name.find_first_not_of("0123456789", us + 1) == std::string::npos &&
+                   p.name.size() - us - 1 <= 2) {
+            prefix = p.name.substr(0, us);
+            channel = size_t(std::stoi(p.name.substr(us + 1)));
+        }
+        AttributeGroup& g = group(prefix);
+        if (g.props.size() <= channel) g.props.resize(channel + 1, -1), g.scale.resize(channel + 1);
+        g.props[channel] = int(i);
+        g.scale[channel] = scale;
+    }
+    return groups;
+}
+
 }  // namespace
 
 bool readPly(const std::string& path, const PlyReport& report, TriangleMesh* out) {
@@ -457,6 +509,33 @@ bool readPly(const std::string& path, const PlyReport& report, TriangleMesh* out
     m.positions.reserve(size_t(vertexCount));
     if (nx >= 0) m.normals.reserve(size_t(vertexCount));
     if (tu >= 0) m.uvs.reserve(size_t(vertexCount));
+    // Mesh attributes (Mitsuba's "vertex_*" and "face_*"): the other scalar properties of the
+    // vertex and face elements.
+    const Element* faceElement = nullptr;
+    for (const Element& e : elements)
+        if (e.name == "face" && !faceElement) faceElement = &e;
+    std::vector<AttributeGroup> vertexGroups, faceGroups;
+    if (vertexElement) {
+        std::vector<bool> used(vertexElement->props.size(), false);
+        for (int i : {px, py, pz, nx, ny, nz, tu, tv})
+            if (i >= 0) used[size_t(i)] = true;
+        vertexGroups = attributeGroups(*vertexElement, used);
+    }
+    if (faceElement)
+        faceGroups =
+            attributeGroups(*faceElement, std::vector<bool>(faceElement->props.size(), false));
+    auto startAttributes = [&](const std::vector<AttributeGroup>& groups, bool perFace) {
+        for (const AttributeGroup& g : groups) {
+            MeshAttribute a;
+            a.name = (perFace ? "face_" : "vertex_") + g.prefix;
+            a.perFace = perFace;
+            a.channels = int(g.props.size());
+            m.attributes.push_back(std::move(a));
+        }
+    };
+    startAttributes(vertexGroups, false);
+    const size_t firstFaceAttribute = m.attributes.size();
+    startAttributes(faceGroups, true);
     BodyReader body(data, headerBytes, format, lineNo);
     size_t ignoredFaces = 0;
     std::vector<double> values;
@@ -474,7 +553,9 @@ bool readPly(const std::string& path, const PlyReport& report, TriangleMesh* out
             return false;
         }
         values.assign(e.props.size(), 0.0);
+        const bool isAttributeFace = &e == faceElement;
         for (uint64_t k = 0; k < e.count; ++k) {
+            size_t faceTriangles = 0;  // triangles this face element became
             for (size_t pi = 0; pi < e.props.size(); ++pi) {
                 const Property& p = e.props[pi];
                 std::string bad;
@@ -552,8 +633,24 @@ bool readPly(const std::string& path, const PlyReport& report, TriangleMesh* out
                 // practice; pbrt-v4 and Mitsuba triangulate them the same way).
                 for (size_t j = 1; j + 1 < polygon.size(); ++j)
                     m.indices.insert(m.indices.end(), {polygon[0], polygon[j], polygon[j + 1]});
+                faceTriangles = polygon.size() - 2;
             }
+            // Attribute values: once per vertex, or once per triangle of the face's fan.
+            auto pushAttributes = [&](const std::vector<AttributeGroup>& groups, size_t first,
+                                      size_t times) {
+                for (size_t gi = 0; gi < groups.size(); ++gi) {
+                    std::vector<float>& dst = m.attributes[first + gi].values;
+                    for (size_t rep = 0; rep < times; ++rep)
+                        for (size_t c = 0; c < groups[gi].props.size(); ++c) {
+                            const int pi = groups[gi].props[c];
+                            dst.push_back(pi < 0 ? 0.0f
+                                                 : float(values[size_t(pi)] * groups[gi].scale[c]));
+                        }
+                }
+            };
+            if (isAttributeFace) pushAttributes(faceGroups, firstFaceAttribute, faceTriangles);
             if (!isVertex) continue;
+            pushAttributes(vertexGroups, 0, 1);
             m.positions.push_back(Vec3(float(values[size_t(px)]), float(values[size_t(py)]),
                                        float(values[size_t(pz)])));
             if (nx >= 0)

@@ -206,6 +206,7 @@ struct ShapeGeom {
     const uint32_t* indices = nullptr;   // 3 per triangle (Embree buffer)
     std::vector<Vec3> normals;
     std::vector<Vec2> uvs;
+    MeshAttribute attribute;  // the one bound to the shape's material (channels 0: none)
 };
 
 }  // namespace
@@ -295,6 +296,21 @@ uint32_t Scene::addMesh(TriangleMesh mesh, int materialId, int lightId, const st
         throw InputError(sourceFile, label + ": " + std::to_string(mesh.uvs.size()) + " uvs for " +
                                          std::to_string(nv) +
                                          " vertices (expected none or one per vertex)");
+    if (mesh.boundAttribute >= int(mesh.attributes.size()))
+        throw std::logic_error(label + ": boundAttribute out of range");
+    if (mesh.boundAttribute >= 0) {
+        const MeshAttribute& a = mesh.attributes[size_t(mesh.boundAttribute)];
+        const size_t n = a.perFace ? mesh.triangleCount() : nv;
+        if ((a.channels != 1 && a.channels != 3) || a.values.size() != n * size_t(a.channels))
+            throw InputError(sourceFile, label + ": mesh attribute '" + a.name + "' has " +
+                                             std::to_string(a.values.size()) + " values in " +
+                                             std::to_string(a.channels) + " channels (expected " +
+                                             std::to_string(n) + " values of 1 or 3 channels)");
+        for (float v : a.values)
+            if (!std::isfinite(v))
+                throw InputError(
+                    sourceFile, label + ": mesh attribute '" + a.name + "' has a non-finite value");
+    }
     Bounds3 box;
     for (size_t i = 0; i < nv; ++i) {
         if (!isFinite(mesh.positions[i]))
@@ -337,6 +353,10 @@ uint32_t Scene::addMesh(TriangleMesh mesh, int materialId, int lightId, const st
     g.indices = ib;
     g.normals = std::move(mesh.normals);
     g.uvs = std::move(mesh.uvs);
+    if (mesh.boundAttribute >= 0)
+        g.attribute = std::move(mesh.attributes[size_t(mesh.boundAttribute)]);
+    else
+        g.attribute.channels = 0;
     impl_->geoms.push_back(std::move(g));
 
     ShapeInfo info;
@@ -523,6 +543,7 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
     hit->primId = rh.hit.primID;
     hit->materialId = shapes[id].materialId;
     hit->lightId = shapes[id].lightId;
+    hit->attribute = Rgb(0.0f);
 
     if (g.isSphere) {
         // Re-project the hit onto the sphere (double precision) so that the point
@@ -581,6 +602,17 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
         hit->uv = Vec2(b0 * t0.x + b1 * t1.x + b2 * t2.x, b0 * t0.y + b1 * t1.y + b2 * t2.y);
     } else {
         hit->uv = Vec2(b1, b2);  // barycentrics when the mesh has no uvs
+    }
+    if (const MeshAttribute& a = g.attribute; a.channels > 0) {
+        // Mitsuba's mesh_attribute: a triangle's value, or the vertices' values interpolated.
+        const int c = a.channels;
+        auto value = [&](size_t i, int k) { return a.values[size_t(c) * i + size_t(k)]; };
+        float rgb[3];
+        for (int k = 0; k < c; ++k)
+            rgb[k] = a.perFace
+                         ? value(rh.hit.primID, k)
+                         : b0 * value(tri[0], k) + b1 * value(tri[1], k) + b2 * value(tri[2], k);
+        hit->attribute = c == 1 ? Rgb(rgb[0]) : Rgb(rgb[0], rgb[1], rgb[2]);
     }
     if (perturbs(hit->materialId)) {
         // Tangents of the uv parameterisation (scene/normal_perturbation.h).

@@ -23,6 +23,16 @@ namespace ub {
 class Bsdf;
 struct SurfaceColors;
 
+/// A named per-vertex or per-triangle value of a mesh (Mitsuba 3's mesh attributes, read
+/// from PLY files: `vertex_color`, `face_weight`, ...), looked up by `mesh_attribute`
+/// textures. Per-vertex values are interpolated with the hit's barycentrics.
+struct MeshAttribute {
+    std::string name;           ///< "vertex_<prefix>" or "face_<prefix>" (Mitsuba's naming)
+    bool perFace = false;       ///< one value per triangle (else per vertex)
+    int channels = 3;           ///< 1 (grey, replicated to RGB) or 3
+    std::vector<float> values;  ///< channels per vertex or triangle
+};
+
 /// Triangle mesh in world space (loaders apply transforms before adding).
 struct TriangleMesh {
     std::vector<Vec3> positions;
@@ -30,6 +40,11 @@ struct TriangleMesh {
         normals;            ///< optional per-vertex shading normals (empty or = positions.size())
     std::vector<Vec2> uvs;  ///< optional per-vertex uvs
     std::vector<uint32_t> indices;  ///< 3 per triangle
+    /// Attributes read from the file (PLY). Scene::addMesh keeps the one at index
+    /// boundAttribute, which the shape's material looks up (set by the Mitsuba loader), and
+    /// fills Hit::attribute with it; -1: none.
+    std::vector<MeshAttribute> attributes;
+    int boundAttribute = -1;
     size_t triangleCount() const { return indices.size() / 3; }
 };
 
@@ -41,6 +56,9 @@ struct Hit {
     Vec3 shadingNormal;  ///< unit shading normal, in the same hemisphere as geoNormal (with
                          ///< the material's normal or bump map applied)
     Vec2 uv;
+    /// The value of the shape's mesh attribute here (MeshAttribute; 0 without one): what a
+    /// `mesh_attribute` texture of its material returns.
+    Rgb attribute{0.0f, 0.0f, 0.0f};
     uint32_t shapeId = 0;
     uint32_t primId = 0;
     int materialId = -1;
@@ -211,11 +229,14 @@ class Scene {
     /// (scene_textures.cpp). Every integrator builds its BSDFs through this. Returns
     /// Bsdf::setup's result; false (and an invalid Bsdf) if the hit has no material.
     bool setupBsdf(Bsdf* bsdf, const Hit& hit, const Vec3& dirFix, bool fromLight) const;
-    /// The same from stored vertex data (e.g. a light vertex kept for later connections).
-    bool setupBsdf(Bsdf* bsdf, int materialId, const Vec2& uv, const Vec3& dirFix,
-                   const Vec3& geoNormal, const Vec3& shadingNormal, bool fromLight) const;
-    /// The material's RGB parameters at uv (textures looked up, constants otherwise).
-    SurfaceColors surfaceColors(const Material& m, const Vec2& uv) const;
+    /// The same from stored vertex data (e.g. a light vertex kept for later connections):
+    /// uv and the mesh attribute value (Hit::attribute) where the textures are looked up.
+    bool setupBsdf(Bsdf* bsdf, int materialId, const Vec2& uv, const Rgb& attribute,
+                   const Vec3& dirFix, const Vec3& geoNormal, const Vec3& shadingNormal,
+                   bool fromLight) const;
+    /// The material's RGB parameters at uv (textures looked up, `mesh_attribute` textures
+    /// give attribute, constants otherwise).
+    SurfaceColors surfaceColors(const Material& m, const Vec2& uv, const Rgb& attribute) const;
 
     // ---- data ----
     Camera camera;

@@ -14,10 +14,10 @@ int Scene::addTexture(const Texture& t) {
     return int(textures.size()) - 1;
 }
 
-SurfaceColors Scene::surfaceColors(const Material& m, const Vec2& uv) const {
+SurfaceColors Scene::surfaceColors(const Material& m, const Vec2& uv, const Rgb& attribute) const {
     SurfaceColors c = SurfaceColors::of(m);
     auto lookup = [&](int index, Rgb* value) {
-        if (index >= 0) *value = textures[size_t(index)].eval(uv);
+        if (index >= 0) *value = textures[size_t(index)].eval(uv, attribute);
     };
     lookup(m.textures.diffuse, &c.diffuse);
     lookup(m.textures.glossy, &c.glossy);
@@ -26,8 +26,9 @@ SurfaceColors Scene::surfaceColors(const Material& m, const Vec2& uv) const {
     return c;
 }
 
-bool Scene::setupBsdf(Bsdf* bsdf, int materialId, const Vec2& uv, const Vec3& dirFix,
-                      const Vec3& geoNormal, const Vec3& shadingNormal, bool fromLight) const {
+bool Scene::setupBsdf(Bsdf* bsdf, int materialId, const Vec2& uv, const Rgb& attribute,
+                      const Vec3& dirFix, const Vec3& geoNormal, const Vec3& shadingNormal,
+                      bool fromLight) const {
     if (materialId < 0 || size_t(materialId) >= materials.size()) {
         *bsdf = Bsdf();
         return false;
@@ -40,17 +41,20 @@ bool Scene::setupBsdf(Bsdf* bsdf, int materialId, const Vec2& uv, const Vec3& di
         // float texture; its grey value is the luminance of an RGB one).
         Bsdf parts[2];
         for (int i = 0; i < 2; ++i)
-            setupBsdf(&parts[i], m.blendParts[i], uv, dirFix, geoNormal, shadingNormal, fromLight);
+            setupBsdf(&parts[i], m.blendParts[i], uv, attribute, dirFix, geoNormal, shadingNormal,
+                      fromLight);
         float w = m.blendWeight;
-        if (m.textures.weight >= 0) w = luminance(textures[size_t(m.textures.weight)].eval(uv));
+        if (m.textures.weight >= 0)
+            w = luminance(textures[size_t(m.textures.weight)].eval(uv, attribute));
         return bsdf->setupBlend(m, w, parts[0], parts[1]);
     }
-    return bsdf->setup(m, surfaceColors(m, uv), dirFix, geoNormal, shadingNormal, fromLight);
+    return bsdf->setup(m, surfaceColors(m, uv, attribute), dirFix, geoNormal, shadingNormal,
+                       fromLight);
 }
 
 bool Scene::setupBsdf(Bsdf* bsdf, const Hit& hit, const Vec3& dirFix, bool fromLight) const {
-    return setupBsdf(bsdf, hit.materialId, hit.uv, dirFix, hit.geoNormal, hit.shadingNormal,
-                     fromLight);
+    return setupBsdf(bsdf, hit.materialId, hit.uv, hit.attribute, dirFix, hit.geoNormal,
+                     hit.shadingNormal, fromLight);
 }
 
 }  // namespace ub

@@ -105,6 +105,7 @@ UvTransform UvTransform::fromMatrix4(const Transform& t) {
 
 Rgb Texture::eval(const Vec2& uvSurface) const {
     if (type == TextureType::Constant) return color0;
+    if (type == TextureType::MeshAttribute) return Rgb(0.0f);  // needs the hit's attribute
     const Vec2 uv = toUv.apply(uvSurface);
     if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return Rgb(0.0f);
     if (type == TextureType::Bitmap &&
@@ -168,6 +169,10 @@ void Texture::validate() const {
             for (const Rgb& p : image->pixels)
                 if (!validColor(p))
                     throwTextureError(*this, "bitmap has a negative or non-finite pixel");
+            break;
+        case TextureType::MeshAttribute:
+            if (attributeName.empty()) throwTextureError(*this, "mesh attribute has no name");
+            if (!validColor(color0)) throwTextureError(*this, "scale must be finite and >= 0");
             break;
         default:
             throwTextureError(*this, "unknown texture type");

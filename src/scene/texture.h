@@ -40,6 +40,9 @@ enum class TextureType : uint32_t {
     Constant = 0,      ///< color0 everywhere
     Checkerboard = 1,  ///< color0 / color1 squares
     Bitmap = 2,        ///< image, bilinear, repeat
+    /// Mitsuba 3's `mesh_attribute`: the hit's mesh attribute value (Hit::attribute) times
+    /// color0 (Mitsuba's `scale`); the attribute is attributeName. No uv lookup.
+    MeshAttribute = 3,
 };
 
 /// uv' = (m[0][0] u + m[0][1] v + m[0][2], m[1][0] u + m[1][1] v + m[1][2]).
@@ -69,9 +72,15 @@ struct Texture {
     std::shared_ptr<const Image> image;  ///< Bitmap: linear RGB, row 0 at v' = 0
     TextureFilter filter = TextureFilter::Bilinear;  ///< Bitmap
     TextureWrap wrap = TextureWrap::Repeat;          ///< Bitmap
+    std::string attributeName;  ///< MeshAttribute: "vertex_color", "face_weight", ...
 
     /// Value at the surface uv (before toUv). Non-finite uv gives black.
     Rgb eval(const Vec2& uv) const;
+    /// Value at a surface point with uv and mesh attribute value `attribute`: a
+    /// MeshAttribute texture gives color0 * attribute, the others eval(uv).
+    Rgb eval(const Vec2& uv, const Rgb& attribute) const {
+        return type == TextureType::MeshAttribute ? color0 * attribute : eval(uv);
+    }
     /// Gradient d/d(u, v) of the luminance of eval() (Rec. 709 weights, luminance()) at the
     /// surface uv, as Mitsuba 3's `eval_1_grad`: a bilinear bitmap differentiates its
     /// interpolation in the cell of uv' (pixel-space slopes, times the transpose of toUv's

@@ -17,7 +17,7 @@ const std::vector<std::string> kBsdfs = {
     "diffuse",        "conductor", "roughconductor", "dielectric", "roughdielectric",
     "thindielectric", "plastic",   "roughplastic",   "null",       "twosided",
     "normalmap",      "bumpmap",   "blendbsdf",      "mask"};
-const std::vector<std::string> kTextures = {"checkerboard", "bitmap"};
+const std::vector<std::string> kTextures = {"checkerboard", "bitmap", "mesh_attribute"};
 
 constexpr float kAirIor = 1.000277f;        // Mitsuba's default ext_ior ("air")
 constexpr float kBk7Ior = 1.5046f;          // Mitsuba's default int_ior ("bk7")
@@ -71,6 +71,21 @@ int buildMitsubaTexture(MitsubaBuild& b, const XmlObject& t) {
                     r.error(t.find("filename")->pos, t.label() + ": " + d.format());
             }
         }
+    } else if (t.type == "mesh_attribute") {
+        // The shape's attribute `name` (a "vertex_" or "face_" attribute of its PLY file),
+        // times `scale`; the shape binds it (Builder::bindMeshAttribute).
+        tex.type = TextureType::MeshAttribute;
+        tex.attributeName = r.getString(t, "name", "");
+        if (tex.attributeName.empty())
+            r.error(t.pos, t.label() +
+                               ": needs <string name=\"name\"> (the mesh attribute, "
+                               "e.g. vertex_color or face_color)");
+        else if (tex.attributeName.rfind("vertex_", 0) != 0 &&
+                 tex.attributeName.rfind("face_", 0) != 0)
+            r.error(t.find("name")->pos, t.label() + ": attribute name '" + tex.attributeName +
+                                             "' does not start with vertex_ or face_");
+        tex.color0 = Rgb(r.getFloatIn(t, "scale", 1.0f, 0.0f, 1e30f));
+        tex.name = "mesh_attribute '" + tex.attributeName + "'";
     } else {
         r.unsupportedPlugin(t, kTextures);
         b.textureIds[&t] = -1;
@@ -271,6 +286,12 @@ bool readPerturbation(MitsubaBuild& b, const XmlObject& o, Material* m) {
     const int textureId = texture ? buildMitsubaTexture(b, *texture) : -1;
     const int innerId = buildMitsubaBsdf(b, *inner[0]);
     if (innerId < 0 || textureId < 0) return false;
+    if (b.scene.textures[size_t(textureId)].type == TextureType::MeshAttribute) {
+        r.error(texture->pos, o.label() + ": a mesh_attribute cannot be its " +
+                                  (normalMap ? "normal map" : "height map") +
+                                  " (not supported; use a bitmap)");
+        return false;
+    }
     *m = b.scene.materials[size_t(innerId)];
     m->perturbation = normalMap ? NormalPerturbation::kNormalMap : NormalPerturbation::kBumpMap;
     m->perturbationTexture = textureId;

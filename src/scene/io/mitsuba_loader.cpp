@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <set>
 
 #include "core/image.h"
 #include "scene/io/mitsuba_build.h"
@@ -72,6 +73,9 @@ class Builder {
     void readFilm(const XmlObject& o, int* w, int* h);
     void readShape(const XmlObject& o);
     void readGeometry(const XmlObject& o, ShapeGeometry* g);
+    /// Keeps the mesh attribute that the material's mesh_attribute textures look up (at most
+    /// one name per shape) and drops the others; false after an error at o.
+    bool bindMeshAttribute(const XmlObject& o, int materialId, ShapeGeometry* g);
     const ShapeGroupShapes& shapeGroup(const XmlObject& group);
     void readInstance(const XmlObject& o);
     void readEmitter(const XmlObject& o);
@@ -196,6 +200,63 @@ void Builder::checkDirect() {
                 return;
             }
     }
+}
+
+namespace {
+
+/// The attribute names the material's mesh_attribute textures look up (blend parts too).
+void meshAttributeNames(const Scene& scene, int id, std::set<std::string>* names) {
+    if (id < 0 || size_t(id) >= scene.materials.size()) return;
+    const Material& m = scene.materials[size_t(id)];
+    for (int t : {m.textures.diffuse, m.textures.glossy, m.textures.specular,
+                  m.textures.transmittance, m.textures.weight})
+        if (t >= 0 && scene.textures[size_t(t)].type == TextureType::MeshAttribute)
+            names->insert(scene.textures[size_t(t)].attributeName);
+    if (m.type == MaterialType::Blend)
+        for (int part : m.blendParts) meshAttributeNames(scene, part, names);
+}
+
+}  // namespace
+
+bool Builder::bindMeshAttribute(const XmlObject& o, int materialId, ShapeGeometry* g) {
+    std::set<std::string> names;
+    meshAttributeNames(b_.scene, materialId, &names);
+    TriangleMesh& mesh = g->mesh;
+    mesh.boundAttribute = -1;
+    if (names.empty()) {
+        mesh.attributes.clear();
+        return true;
+    }
+    const std::string& name = *names.begin();
+    if (names.size() > 1) {
+        r_.error(o.pos, o.label() + ": its BSDF looks up the mesh attributes '" + name + "' and '" +
+                            *std::next(names.begin()) +
+                            "' (unibeam supports one mesh attribute per shape)");
+        return false;
+    }
+    std::string have;
+    for (size_t i = 0; i < mesh.attributes.size(); ++i) {
+        const MeshAttribute& a = mesh.attributes[i];
+        have += (have.empty() ? "" : ", ") + a.name;
+        if (a.name != name) continue;
+        if (a.channels != 1 && a.channels != 3) {
+            r_.error(o.pos, o.label() + ": mesh attribute '" + name + "' has " +
+                                std::to_string(a.channels) +
+                                " channels (a mesh_attribute texture needs 1 or 3)");
+            return false;
+        }
+        MeshAttribute kept = std::move(mesh.attributes[i]);
+        mesh.attributes.clear();
+        mesh.attributes.push_back(std::move(kept));
+        mesh.boundAttribute = 0;
+        return true;
+    }
+    r_.error(o.pos, o.label() + ": its BSDF looks up the mesh attribute '" + name + "', which " +
+                        (g->isSphere ? std::string("a sphere does not have")
+                                     : "the mesh does not have (it has " +
+                                           (have.empty() ? std::string("none") : have) +
+                                           "; PLY files carry mesh attributes)"));
+    return false;
 }
 
 void Builder::readIntegrator(const XmlObject& top) {
@@ -583,6 +644,7 @@ void Builder::readShape(const XmlObject& o) {
         materialId = buildMitsubaBsdf(b_, *bsdf);
     else
         materialId = em ? blackMaterial() : defaultMaterial();
+    if (!bindMeshAttribute(o, materialId, &g)) return;
 
     int lightId = -1;
     Light light;
@@ -696,6 +758,7 @@ const ShapeGroupShapes& Builder::shapeGroup(const XmlObject& group) {
                                                 "boundary (not supported)");
         r_.checkUnused(o);
         if (r_.errorCount() != memberBefore) continue;
+        if (!bindMeshAttribute(o, m.materialId, &m.geometry)) continue;
         if (m.materialId == -1) {
             r_.warning(o.pos, o.label() + " '" + m.name + "' in shapegroup '" + groupName +
                                   "' has a null BSDF and no medium: it is invisible and is "
