@@ -107,27 +107,23 @@ fs::path prepare(const std::string& target, const std::string& data, const fs::p
                             light + "]"));
         return dir / "scene.json";
     }
-    if (target == "fuzz_png_image" || target == "fuzz_exr_image") {
-        const std::string ext = target == "fuzz_png_image" ? "png" : "exr";
-        writeFile(dir / ("image." + ext), data);
+    // Image targets: the file as a diffuse bitmap texture of a cube.
+    auto bitmapScene = [&](const std::string& ext, const std::string& bytes) {
+        writeFile(dir / ("image." + ext), bytes);
         writeFile(
             dir / "scene.json",
             sceneWith(
                 R"("materials": {"m": {"type": "diffuse", "reflectance": {"type": "bitmap", "file": "image.)" +
                 ext + R"("}}}, "shapes": [{"type": "cube", "material": "m"}, )" + light + "]"));
         return dir / "scene.json";
-    }
+    };
+    if (target == "fuzz_png_image" || target == "fuzz_exr_image")
+        return bitmapScene(target == "fuzz_png_image" ? "png" : "exr", data);
     if (target == "fuzz_stb_image") {
         // The target's first byte chooses the extension (% 4: bmp, tga, hdr, ppm).
         static const char* const kExt[4] = {"bmp", "tga", "hdr", "ppm"};
-        const std::string ext = data.empty() ? "bmp" : kExt[uint8_t(data[0]) % 4];
-        writeFile(dir / ("image." + ext), data.empty() ? data : data.substr(1));
-        writeFile(
-            dir / "scene.json",
-            sceneWith(
-                R"("materials": {"m": {"type": "diffuse", "reflectance": {"type": "bitmap", "file": "image.)" +
-                ext + R"("}}}, "shapes": [{"type": "cube", "material": "m"}, )" + light + "]"));
-        return dir / "scene.json";
+        if (data.empty()) return bitmapScene("bmp", data);
+        return bitmapScene(kExt[uint8_t(data[0]) % 4], data.substr(1));
     }
     if (target == "fuzz_serialized_mesh") {
         // The target picks shape index size % 3; a Mitsuba scene does so explicitly.

@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "scene/io/mitsuba_loader.h"
+#include "tests/support/temp_file.h"
 
 using namespace ub;
 namespace fs = std::filesystem;
@@ -29,11 +30,7 @@ std::string readAll(const std::string& path) {
 }
 
 std::string writeTemp(const std::string& name, const std::string& data) {
-    fs::path d = fs::temp_directory_path() / "unibeam_jpeg_test";
-    fs::create_directories(d);
-    std::string path = (d / name).string();
-    std::ofstream(path, std::ios::binary) << data;
-    return path;
+    return test::writeTempFile("unibeam_jpeg_test", name, data);
 }
 
 std::string errorOf(const std::string& path) {

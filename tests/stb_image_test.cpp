@@ -12,6 +12,7 @@
 #include "core/image.h"
 #include "scene/io/mitsuba_loader.h"
 #include "scene/scene.h"
+#include "tests/support/temp_file.h"
 
 using namespace ub;
 namespace fs = std::filesystem;
@@ -19,11 +20,7 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string writeTemp(const std::string& name, const std::string& data) {
-    fs::path d = fs::temp_directory_path() / "unibeam_stb_image_test";
-    fs::create_directories(d);
-    std::string path = (d / name).string();
-    std::ofstream(path, std::ios::binary) << data;
-    return path;
+    return test::writeTempFile("unibeam_stb_image_test", name, data);
 }
 
 std::string errorOf(const std::string& path) {
