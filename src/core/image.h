@@ -47,8 +47,8 @@ Image readStbImage(const std::string& path, bool linearize = true);
 /// The image formats of the bitmap textures (Mitsuba 3's bitmap reads the same set but PFM).
 inline constexpr const char* kBitmapFormats =
     ".png, .jpg/.jpeg, .exr, .bmp, .tga, .hdr/.rgbe or .ppm/.pgm/.pnm";
-/// Whether a lower-case extension (".png") names one of kBitmapFormats.
-bool isBitmapExtension(const std::string& extLower);
+/// Whether the file name's extension (any case) names one of kBitmapFormats.
+bool isBitmapFile(const std::string& path);
 /// Reads any of kBitmapFormats by its extension (EXR and RGBE linear, the others sRGB unless
 /// linearize = false). An unknown extension throws InputError.
 Image readBitmapFile(const std::string& path, bool linearize = true);

@@ -50,6 +50,13 @@ namespace {
 
 constexpr size_t kPadding = 1 << 16;
 
+/// The file name's extension in lower case (".bmp").
+std::string extensionOf(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
+}
+
 struct Decoded {
     int w = 0, h = 0;
     std::vector<float> hdr;          // RGB floats (.hdr)
@@ -126,8 +133,7 @@ Image readStbImage(const std::string& path, bool linearize) {
                                     std::istreambuf_iterator<char>());
     if (!f.good() && !f.eof()) throw InputError(path, "cannot read the image file");
     if (data.size() > (size_t(1) << 30)) throw InputError(path, "image file larger than 1 GiB");
-    std::string ext = std::filesystem::path(path).extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = extensionOf(path);
     const bool isHdr = ext == ".hdr" || ext == ".rgbe";
     const size_t size = data.size();
 
@@ -174,20 +180,20 @@ Image readStbImage(const std::string& path, bool linearize) {
     return img;
 }
 
-bool isBitmapExtension(const std::string& extLower) {
+bool isBitmapFile(const std::string& path) {
+    const std::string ext = extensionOf(path);
     for (const char* e :
          {".png", ".jpg", ".jpeg", ".exr", ".bmp", ".tga", ".hdr", ".rgbe", ".ppm", ".pgm", ".pnm"})
-        if (extLower == e) return true;
+        if (ext == e) return true;
     return false;
 }
 
 Image readBitmapFile(const std::string& path, bool linearize) {
-    std::string ext = std::filesystem::path(path).extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = extensionOf(path);
     if (ext == ".png") return readPng(path, linearize);
     if (ext == ".jpg" || ext == ".jpeg") return readJpeg(path, linearize);
     if (ext == ".exr") return readExr(path);
-    if (isBitmapExtension(ext)) return readStbImage(path, linearize);
+    if (isBitmapFile(path)) return readStbImage(path, linearize);
     throw InputError(path, std::string("unsupported image format '") + ext + "' (expected " +
                                kBitmapFormats + ")");
 }

@@ -331,33 +331,23 @@ Rgb Light::illuminate(const SceneSphere& sphere, const Vec3& receivingPos, const
             if (cosAtLight) *cosAtLight = 1.0f;
             return intensity;
         }
-        case LightType::Spot: {
-            Vec3 toLight = position - receivingPos;
-            float distSqr = lengthSqr(toLight);
-            if (!(distSqr > 0)) return Rgb(0);
-            float dist = std::sqrt(distSqr);
-            Vec3 dir = toLight / dist;
-            Rgb value = projectedIntensity(-dir);  // falloff (and texture)
-            if (isBlack(value)) return Rgb(0);
-            *dirToLight = dir;
-            *distance = dist;
-            *directPdfW = distSqr;  // as a point light: I(dir) / d^2
-            if (emissionPdfW) *emissionPdfW = spotConePdfW(*this);
-            if (cosAtLight) *cosAtLight = 1.0f;
-            return value;
-        }
+        case LightType::Spot:
         case LightType::Projector: {
+            // A point emitter whose intensity depends on the direction (falloff, texture):
+            // I(dir) / d^2 as for a point light. The emission pdf is emit()'s: uniform in the
+            // spot's cone, the projector's texture-proportional density.
             Vec3 toLight = position - receivingPos;
             float distSqr = lengthSqr(toLight);
             if (!(distSqr > 0)) return Rgb(0);
             float dist = std::sqrt(distSqr);
             Vec3 dir = toLight / dist;
-            float pdfW;
-            Rgb value = projectedIntensity(-dir, &pdfW);
+            const bool projector = type == LightType::Projector;
+            float pdfW = projector ? 0.0f : spotConePdfW(*this);
+            Rgb value = projectedIntensity(-dir, projector ? &pdfW : nullptr);
             if (isBlack(value) || !(pdfW > 0)) return Rgb(0);
             *dirToLight = dir;
             *distance = dist;
-            *directPdfW = distSqr;
+            *directPdfW = distSqr;  // directPdfA = 1 (delta position), cos = 1
             if (emissionPdfW) *emissionPdfW = pdfW;
             if (cosAtLight) *cosAtLight = 1.0f;
             return value;

@@ -147,6 +147,8 @@ Rgb Texture::mean() const {
             return (color0 + color1) * 0.5f;
         case TextureType::Bitmap:
             return image ? image->mean() : Rgb(0.0f);
+        case TextureType::MeshAttribute:
+            return color0;  // the scale: the attribute's values belong to each mesh
     }
     return Rgb(0.0f);
 }

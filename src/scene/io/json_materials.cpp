@@ -63,6 +63,8 @@ Rgb textureMax(const Texture& t) {
                 for (const Rgb& p : t.image->pixels) m = vmax(m, p);
             return m;
         }
+        case TextureType::MeshAttribute:  // not made by the JSON loader; no bound known
+            return Rgb(kInf);
     }
     return Rgb(0.0f);
 }

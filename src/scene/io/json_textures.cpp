@@ -1,8 +1,6 @@
 // Textured colours of the native JSON format (docs/scene-format.md, "Textures"): a
 // material colour is an RGB value or a texture object {"type": "checkerboard" | "bitmap",
 // ...} whose conventions are those of scene/texture.h (Mitsuba 3's).
-#include <algorithm>
-#include <cctype>
 #include <filesystem>
 #include <memory>
 
@@ -16,13 +14,6 @@ namespace fs = std::filesystem;
 namespace {
 
 const std::vector<std::string> kTextureTypes = {"checkerboard", "bitmap"};
-
-std::string lowerExtension(const std::string& path) {
-    std::string ext = fs::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return char(std::tolower(c)); });
-    return ext;
-}
 
 /// "to_uv": {"scale": s | [su, sv], "translate": [tu, tv]} (uv' = scale * uv + translate)
 /// or {"matrix": 3 rows of 3 numbers (last row [0, 0, 1]) | 4 rows of 4 numbers}.
@@ -102,8 +93,7 @@ UvTransform readUvTransform(JsonReader& r, const Json& v, const std::string& ptr
 std::shared_ptr<const Image> loadBitmap(JsonReader& r, const std::string& file, bool raw,
                                         const std::string& filePtr, JsonSceneParts& parts) {
     const std::string path = resolveScenePath(parts.baseDir, file);
-    const std::string ext = lowerExtension(file);
-    if (!isBitmapExtension(ext)) {
+    if (!isBitmapFile(file)) {
         r.error(filePtr, "unsupported bitmap file '" + file + "' (expected " + kBitmapFormats +
                              "; EXR and RGBE are linear, the others sRGB unless raw)");
         return nullptr;

@@ -1,7 +1,5 @@
 // Mitsuba <bsdf> plugins -> unibeam materials (docs/mitsuba.md lists the mapping).
-#include <cctype>
 #include <cmath>
-#include <filesystem>
 #include <utility>
 
 #include "core/image.h"
@@ -57,10 +55,8 @@ int buildMitsubaTexture(MitsubaBuild& b, const XmlObject& t) {
         if (file.empty()) {
             r.error(t.pos, t.label() + ": needs <string name=\"filename\">");
         } else if (std::string path = b.resolveFile(t, "filename", file); !path.empty()) {
-            std::string ext = std::filesystem::path(path).extension().string();
-            for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
             try {
-                if (isBitmapExtension(ext))
+                if (isBitmapFile(path))
                     tex.image = std::make_shared<Image>(readBitmapFile(path, !raw));
                 else
                     r.error(t.find("filename")->pos, t.label() + ": '" + file +
