@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/image.h"
+#include "scene/bsdf.h"
 #include "scene/io/mitsuba_spectra.h"
 #include "scene/io/scene_loader.h"
 #include "scene/texture.h"
@@ -300,6 +302,114 @@ TEST(MitsubaXml, RoughConductorDistributions) {
                          "scene.xml:10:31: error: <bsdf type=\"roughconductor\">: unknown "
                          "microfacet distribution 'phong' (expected 'beckmann' or 'ggx')"))
         << e;
+}
+
+// Anisotropic and textured roughness (docs/mitsuba.md): alpha_u/alpha_v as floats or textures
+// on roughconductor and roughdielectric, alpha as a texture; roughplastic stays isotropic and
+// untextured, and the malformed combinations are errors naming the parameter.
+TEST(MitsubaXml, AnisotropicAndTexturedRoughness) {
+    const std::string checker =
+        "<texture name=\"%s\" type=\"checkerboard\"><float name=\"color0\" value=\"0.1\"/>"
+        "<float name=\"color1\" value=\"0.3\"/></texture>";
+    auto tex = [&](const std::string& name) {
+        std::string t = checker;
+        t.replace(t.find("%s"), 2, name);
+        return t;
+    };
+    auto s = load(scene(std::string(kLight) +
+                        "<shape type=\"sphere\"><bsdf type=\"roughconductor\">"
+                        "<float name=\"alpha_u\" value=\"0.05\"/>"
+                        "<float name=\"alpha_v\" value=\"0.3\"/></bsdf></shape>\n"
+                        "<shape type=\"sphere\"><point name=\"center\" x=\"3\" y=\"0\" z=\"0\"/>"
+                        "<bsdf type=\"roughdielectric\">" +
+                        tex("alpha") +
+                        "</bsdf></shape>\n"
+                        "<shape type=\"sphere\"><point name=\"center\" x=\"-3\" y=\"0\" z=\"0\"/>"
+                        "<bsdf type=\"roughconductor\">" +
+                        tex("alpha_u") +
+                        "<float name=\"alpha_v\" value=\"0.1\"/></bsdf></shape>\n"
+                        "<shape type=\"sphere\"><point name=\"center\" x=\"0\" y=\"3\" z=\"0\"/>"
+                        "<bsdf type=\"roughconductor\"><float name=\"alpha_u\" value=\"0.2\"/>"
+                        "<float name=\"alpha_v\" value=\"0.2\"/></bsdf></shape>\n"));
+    ASSERT_GE(s->materials.size(), 4u);
+    const Material& aniso = s->materials[0];
+    EXPECT_EQ(aniso.alpha, 0.05f);
+    EXPECT_EQ(aniso.alphaV, 0.3f);
+    EXPECT_TRUE(aniso.anisotropic());
+    const Material& glass = s->materials[1];
+    EXPECT_EQ(glass.type, MaterialType::RoughDielectric);
+    EXPECT_GE(glass.textures.alpha, 0);
+    EXPECT_LT(glass.textures.alphaV, 0);
+    EXPECT_FALSE(glass.anisotropic());
+    const Material& half = s->materials[2];
+    EXPECT_GE(half.textures.alpha, 0);
+    EXPECT_EQ(half.alphaV, 0.1f);
+    EXPECT_TRUE(half.anisotropic()) << "a textured alpha_u with alpha_v = the default 0.1";
+    EXPECT_FALSE(s->materials[3].anisotropic()) << "equal constants are isotropic";
+    // The textured roughness reaches the BSDF: at two uvs of the checkerboard's two colours.
+    // (Mitsuba's float parity: a checkerboard used as a float swaps its colours.)
+    const Vec2 uv0(0.25f, 0.25f), uv1(0.75f, 0.25f);
+    const SurfaceColors c0 = s->surfaceColors(glass, uv0, Rgb(0.0f));
+    const SurfaceColors c1 = s->surfaceColors(glass, uv1, Rgb(0.0f));
+    EXPECT_NEAR(c0.alphaU, 0.3f, 1e-6f);
+    EXPECT_NEAR(c1.alphaU, 0.1f, 1e-6f);
+    EXPECT_EQ(c0.alphaV, c0.alphaU);
+    EXPECT_EQ(c1.alphaV, c1.alphaU);
+
+    const std::string sphere = "<shape type=\"sphere\"><bsdf type=\"";
+    auto bsdfErrors = [&](const std::string& type, const std::string& body) {
+        return errorsOf(
+            scene(std::string(kLight) + sphere + type + "\">" + body + "</bsdf></shape>\n"));
+    };
+    std::string e = bsdfErrors("roughconductor", "<float name=\"alpha_u\" value=\"0.2\"/>");
+    EXPECT_TRUE(contains(e, "give both 'alpha_u' and 'alpha_v'")) << e;
+    e = bsdfErrors("roughdielectric",
+                   "<float name=\"alpha\" value=\"0.2\"/>" + tex("alpha_u") + tex("alpha_v"));
+    EXPECT_TRUE(contains(e, "give either 'alpha' or 'alpha_u'/'alpha_v', not both")) << e;
+    e = bsdfErrors(
+        "roughplastic",
+        "<float name=\"alpha_u\" value=\"0.1\"/><float name=\"alpha_v\" value=\"0.3\"/>");
+    EXPECT_TRUE(contains(e, "Mitsuba's roughplastic is isotropic")) << e;
+    e = bsdfErrors("roughplastic", tex("alpha"));
+    EXPECT_TRUE(contains(e, "a textured 'alpha' is not supported here")) << e;
+}
+
+// rawconstant (Mitsuba 2's raw constant texture) and the bitmap's storage `format`.
+TEST(MitsubaXml, RawConstantAndBitmapFormat) {
+    auto s = load(scene(std::string(kLight) +
+                        "<shape type=\"sphere\"><bsdf type=\"normalmap\">"
+                        "<texture name=\"normalmap\" type=\"rawconstant\">"
+                        "<vector name=\"value\" value=\"0.5, 0.5, 1.0\"/></texture>"
+                        "<bsdf type=\"diffuse\"><texture name=\"reflectance\" type=\"rawconstant\">"
+                        "<float name=\"value\" value=\"0.25\"/></texture></bsdf>"
+                        "</bsdf></shape>\n"));
+    int constants = 0;
+    for (const Texture& t : s->textures)
+        if (t.type == TextureType::Constant) {
+            ++constants;
+            EXPECT_TRUE((t.color0.x == 0.5f && t.color0.z == 1.0f) || t.color0.x == 0.25f);
+        }
+    EXPECT_EQ(constants, 2);
+    std::string e = errorsOf(scene(std::string(kLight) +
+                                   "<shape type=\"sphere\"><bsdf type=\"diffuse\"><texture "
+                                   "name=\"reflectance\" type=\"rawconstant\"/></bsdf></shape>\n"));
+    EXPECT_TRUE(contains(e, "needs a <float> or <vector> named \"value\"")) << e;
+    const std::string dir = scratchDir("bitmap_format");
+    Image img(2, 2);
+    for (Rgb& p : img.pixels) p = Rgb(0.5f);
+    writeExr(dir + "/t.exr", img);
+    auto bitmap = [&](const std::string& format) {
+        return errorsOf(scene(std::string(kLight) +
+                              "<shape type=\"sphere\"><bsdf type=\"diffuse\"><texture "
+                              "name=\"reflectance\" type=\"bitmap\"><string name=\"filename\" "
+                              "value=\"t.exr\"/><string name=\"format\" value=\"" +
+                              format + "\"/></texture></bsdf></shape>\n"),
+                        dir);
+    };
+    EXPECT_EQ(bitmap("variant"), "");
+    EXPECT_EQ(bitmap("float16"), "");
+    EXPECT_TRUE(contains(bitmap("uint8"), "format 'uint8' on a floating-point image"));
+    EXPECT_TRUE(contains(bitmap("int4"), "format 'int4' is not one of auto, variant"));
 }
 
 TEST(MitsubaXml, SceneLoaderDispatchesXmlAndRejectsDefinesForJson) {

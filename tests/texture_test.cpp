@@ -270,7 +270,7 @@ TEST(Texture, SceneSetupBsdfResolvesTexturesAtHitUv) {
             << p.at.x << " " << p.at.y;
         Bsdf stored;
         ASSERT_TRUE(scene.setupBsdf(&stored, hit.materialId, hit.uv, hit.attribute, -ray.dir,
-                                    hit.geoNormal, hit.shadingNormal, true));
+                                    hit.geoNormal, hit.shadingNormal, hit.tangent, true));
         EXPECT_TRUE(sameRgb(stored.evaluate(gen, nullptr, nullptr, nullptr), p.expected * kInvPi));
     }
     Hit none;

@@ -67,9 +67,10 @@ typedef struct {
     float geoNormal[3]; /* same side convention as frameN */
     float exponent;     /* Phong exponent */
     float localFix[3];  /* dirFix in the shading frame */
-    float alpha;        /* GGX roughness as given (clamped to UB_MIN_GGX_ALPHA when used) */
-    float diffuse[3];   /* RGB parameters at the point (textures resolved) */
-    float ior;          /* interior / exterior IOR (dielectrics, plastics) */
+    float alpha; /* microfacet roughness as given (clamped to UB_MIN_GGX_ALPHA when used); rough
+                    conductor and dielectric: along frameS (alpha_u) */
+    float diffuse[3]; /* RGB parameters at the point (textures resolved) */
+    float ior;        /* interior / exterior IOR (dielectrics, plastics) */
     float glossy[3];
     float etaFix; /* dielectrics: IOR on dirFix's side */
     float specular[3];
@@ -83,7 +84,7 @@ typedef struct {
     float specularWeight;   /* plastics: mean(specular) / (mean(diffuse) + mean(specular)) */
     ub_uint tableIndex;     /* rough plastic: the material whose coating table applies */
     float terminatorAlpha2; /* perturbed normals: a^2 of the shadow-terminator factor (0: off) */
-    float pad1;
+    float alphaV; /* rough conductor and dielectric: roughness along frameT (= alpha: isotropic) */
 } ub_bsdf;
 
 /* The microfacet distribution of b (UB_MF_*). */
@@ -206,17 +207,18 @@ UB_INLINE ub_float3 ub_bsdf_eval_rough_conductor(UB_PRIVATE const ub_bsdf* b, ub
     ub_uint dist = ub_bsdf_distribution(b);
     ub_float3 fix = ub_f3_from(b->localFix);
     if (fix.z <= 0.0f || gen.z <= 0.0f) return ub_make_float3(0.0f, 0.0f, 0.0f);
-    float alpha = ub_fmax(b->alpha, UB_MIN_GGX_ALPHA);
+    float au = ub_fmax(b->alpha, UB_MIN_GGX_ALPHA), av = ub_fmax(b->alphaV, UB_MIN_GGX_ALPHA);
     ub_float3 h = ub_f3_normalize(ub_f3_add(fix, gen)); /* h.z > 0, fix.h = gen.h > 0 */
     float cosFixH = ub_f3_dot(fix, h), cosGenH = ub_f3_dot(gen, h);
-    float d = ub_mf_d(dist, h.z, alpha);
-    float g2 = (b->flags & UB_BSDF_SEPARABLE) ? ub_mf_g2_separable(dist, fix.z, gen.z, alpha)
-                                              : ub_mf_g2_correlated(dist, fix.z, gen.z, alpha);
-    /* visible-normal density times the reflection Jacobian (Walter et al. 2007, eq. 14) */
-    *directPdfW =
-        ub_mf_visible_pdf(dist, fix.z, cosFixH, h.z, alpha) * ub_jacobian_reflect(cosGenH);
-    *reversePdfW =
-        ub_mf_visible_pdf(dist, gen.z, cosGenH, h.z, alpha) * ub_jacobian_reflect(cosFixH);
+    float d = ub_mf_d_aniso(dist, h.x, h.y, h.z, au, av);
+    float lFix = ub_mf_lambda_aniso(dist, fix.x, fix.y, fix.z, au, av);
+    float lGen = ub_mf_lambda_aniso(dist, gen.x, gen.y, gen.z, au, av);
+    float g2 = (b->flags & UB_BSDF_SEPARABLE) ? 1.0f / ((1.0f + lFix) * (1.0f + lGen))
+                                              : 1.0f / (1.0f + lFix + lGen);
+    /* visible-normal density D_v = G1(v) (v.m) D / v.z (Heitz 2014, eq. 38) times the
+     * reflection Jacobian (Walter et al. 2007, eq. 14) */
+    *directPdfW = cosFixH * d / ((1.0f + lFix) * fix.z) * ub_jacobian_reflect(cosGenH);
+    *reversePdfW = cosGenH * d / ((1.0f + lGen) * gen.z) * ub_jacobian_reflect(cosFixH);
     /* Walter et al. 2007, eq. 20: F D G / (4 |i.n| |o.n|) */
     float s = d * g2 / (4.0f * fix.z * gen.z);
     return ub_make_float3(b->specular[0] * ub_fresnel_conductor(cosFixH, b->eta[0], b->k[0]) * s,
@@ -230,7 +232,7 @@ UB_INLINE ub_float3 ub_bsdf_eval_rough_dielectric(UB_PRIVATE const ub_bsdf* b, u
     ub_uint dist = ub_bsdf_distribution(b);
     ub_float3 fix = ub_f3_from(b->localFix);
     ub_float3 zero = ub_make_float3(0.0f, 0.0f, 0.0f);
-    float alpha = ub_fmax(b->alpha, UB_MIN_GGX_ALPHA);
+    float au = ub_fmax(b->alpha, UB_MIN_GGX_ALPHA), av = ub_fmax(b->alphaV, UB_MIN_GGX_ALPHA);
     int reflect = fix.z * gen.z > 0.0f;
     float etaGen = reflect ? b->etaFix : b->etaOther;
     /* half vector: Walter et al. 2007 eq. 13 (reflection), eq. 16 (refraction), to +z */
@@ -245,17 +247,20 @@ UB_INLINE ub_float3 ub_bsdf_eval_rough_dielectric(UB_PRIVATE const ub_bsdf* b, u
     if (cosFixH * fix.z <= 0.0f || cosGenH * gen.z <= 0.0f) return zero;
     float cFix = ub_fabs(fix.z), cGen = ub_fabs(gen.z);
     float aFix = ub_fabs(cosFixH), aGen = ub_fabs(cosGenH);
-    float d = ub_mf_d(dist, h.z, alpha);
-    float visFix = ub_mf_visible_pdf(dist, cFix, aFix, h.z, alpha);
-    float visGen = ub_mf_visible_pdf(dist, cGen, aGen, h.z, alpha);
+    float d = ub_mf_d_aniso(dist, h.x, h.y, h.z, au, av);
+    /* Lambda depends on |v.z| and v's azimuth only: the mirrored direction has the same */
+    float lFix = ub_mf_lambda_aniso(dist, fix.x, fix.y, cFix, au, av);
+    float lGen = ub_mf_lambda_aniso(dist, gen.x, gen.y, cGen, au, av);
+    float visFix = aFix * d / ((1.0f + lFix) * cFix); /* Heitz 2014, eq. 38 */
+    float visGen = aGen * d / ((1.0f + lGen) * cGen);
     float etaRel = b->etaOther / b->etaFix;
     if (reflect) {
         float fresnelFix = ub_fresnel_dielectric(aFix, etaRel);
         float fresnelGen = ub_fresnel_dielectric(aGen, etaRel);
         *directPdfW = fresnelFix * visFix * ub_jacobian_reflect(aGen);
         *reversePdfW = fresnelGen * visGen * ub_jacobian_reflect(aFix);
-        float g2 = (b->flags & UB_BSDF_SEPARABLE) ? ub_mf_g2_separable(dist, cFix, cGen, alpha)
-                                                  : ub_mf_g2_correlated(dist, cFix, cGen, alpha);
+        float g2 = (b->flags & UB_BSDF_SEPARABLE) ? 1.0f / ((1.0f + lFix) * (1.0f + lGen))
+                                                  : 1.0f / (1.0f + lFix + lGen);
         /* F at the mean of fix.h and gen.h (equal in exact arithmetic) keeps f(fix, gen) =
          * f(gen, fix) bit for bit; the pdfs keep F(fix.h), what the sampler used */
         float fresnelSym = ub_fresnel_dielectric(0.5f * (aFix + aGen), etaRel);
@@ -271,7 +276,7 @@ UB_INLINE ub_float3 ub_bsdf_eval_rough_dielectric(UB_PRIVATE const ub_bsdf* b, u
     /* Walter eq. 21 with o the camera side: eta_o = etaFix for radiance, etaGen for
      * importance (the adjoint BTDF) */
     float etaO = (b->flags & UB_BSDF_FROM_LIGHT) ? etaGen : b->etaFix;
-    float g2 = ub_mf_g2_separable(dist, cFix, cGen, alpha);
+    float g2 = 1.0f / ((1.0f + lFix) * (1.0f + lGen)); /* separable (Walter et al. eq. 23) */
     return ub_f3_scale(ub_f3_from(b->specular),
                        transmit * d * g2 * aFix * aGen * etaO * etaO / (cFix * cGen * denom));
 }

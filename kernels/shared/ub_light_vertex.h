@@ -6,14 +6,15 @@
  * OpenCL size is 16), explicit padding; the host checks size and offsets below.
  *
  * The light BSDF is not stored: the host rebuilds it from (materialId, dirFix,
- * geoNormal, shadingNormal, uv, attribute) when a connection needs it. Merging only needs
+ * geoNormal, shadingNormal, uv, attribute, tangent) when a connection needs it. Merging only needs
  * dirFix and contProb.
  *
  * dVCM, dVC, dVM are the MIS partials of the light subpath after the hit update
  * at this vertex (ub_mis.h; VCM tech. rep. (31)-(36)).
  *
  * Medium vertices (vlt, vbpt, upbp): flags has UB_LIGHT_VERTEX_IN_MEDIUM,
- * materialId holds the medium's index, geoNormal, shadingNormal, uv and attribute are zero,
+ * materialId holds the medium's index, geoNormal, shadingNormal, uv, attribute and tangent
+ * are zero,
  * and the scattering function is sigma_s times the medium's phase function
  * (sigma_s is already part of the throughput). contProb is then the medium's
  * roulette probability at the vertex, and rInL the R (a length, ub_mis_volume.h)
@@ -42,11 +43,13 @@ typedef struct {
     float uv[2];            /* surface uv, where the textures are looked up */
     float rInL;             /* medium vertex: R of the photon beam that reached it */
     float attribute[3];     /* the surface's mesh attribute value (Hit::attribute), or 0 */
+    float tangent[3];       /* shading tangent (Hit::tangent): orients anisotropic BSDFs, or 0 */
+    ub_uint pad;
 } ub_light_vertex;
 
 #ifndef __OPENCL_C_VERSION__
 #include <cstddef>
-static_assert(sizeof(ub_light_vertex) == 112, "ub_light_vertex layout");
+static_assert(sizeof(ub_light_vertex) == 128, "ub_light_vertex layout");
 static_assert(offsetof(ub_light_vertex, throughput) == 16, "ub_light_vertex layout");
 static_assert(offsetof(ub_light_vertex, dirFix) == 32, "ub_light_vertex layout");
 static_assert(offsetof(ub_light_vertex, geoNormal) == 48, "ub_light_vertex layout");
@@ -56,6 +59,7 @@ static_assert(offsetof(ub_light_vertex, flags) == 84, "ub_light_vertex layout");
 static_assert(offsetof(ub_light_vertex, uv) == 88, "ub_light_vertex layout");
 static_assert(offsetof(ub_light_vertex, rInL) == 96, "ub_light_vertex layout");
 static_assert(offsetof(ub_light_vertex, attribute) == 100, "ub_light_vertex layout");
+static_assert(offsetof(ub_light_vertex, tangent) == 112, "ub_light_vertex layout");
 #endif
 
 #endif /* UB_LIGHT_VERTEX_H */

@@ -1,5 +1,6 @@
 /* GGX (Trowbridge-Reitz) and Beckmann microfacet distributions, isotropic roughness
- * alpha (host C++ and OpenCL C). Local frame: z is the macro-surface normal, and
+ * alpha or anisotropic (alphaU along the frame's x = s axis, alphaV along y = t; the
+ * ub_mf_*_aniso functions) (host C++ and OpenCL C). Local frame: z is the macro-surface normal, and
  * every function here assumes the directions were mirrored to z >= 0 by the
  * caller (GGX is symmetric under z -> -z).
  *
@@ -19,6 +20,12 @@
  *         Lambda; Heitz 2014, eq. 80). Its visible normals are sampled on the host
  *         (src/scene/microfacet_sampling.cpp); the density is D_v above with Beckmann D, G1.
  *  ub_mf_*: the same quantities for either distribution (UB_MF_GGX, UB_MF_BECKMANN).
+ *  Anisotropy (Heitz 2014, Sec. 5.4): D(m) with tan^2 theta_m / alpha^2 replaced by
+ *         (m.x^2 / alphaU^2 + m.y^2 / alphaV^2) / m.z^2 and the normalisation 1 / alpha^2 by
+ *         1 / (alphaU alphaV); Lambda(v) is the isotropic one with the roughness seen along
+ *         v's azimuth, alpha_v = sqrt(cos^2 phi_v alphaU^2 + sin^2 phi_v alphaV^2). Visible
+ *         normals: the stretch to alpha = 1 scales x by alphaU and y by alphaV (Heitz 2018,
+ *         Sec. 3; Heitz & d'Eon 2014, Sec. 4). Equal roughnesses take the isotropic code.
  *  Jacobians from the microfacet normal to the generated direction:
  *         reflection 1 / (4 |o.m|) (Walter et al. 2007, eq. 14),
  *         refraction eta_o^2 |o.m| / (eta_i (i.m) + eta_o (o.m))^2 (eq. 17).
@@ -67,13 +74,14 @@ UB_INLINE float ub_ggx_visible_pdf(float cosThetaV, float vDotM, float cosThetaM
 }
 
 /* Samples a microfacet normal m visible from v (v.z > 0, unit) from (u1, u2) in [0,1)^2
- * (Heitz 2018, Sec. 3-4): stretch v to the alpha = 1 configuration, sample the
- * projected half disk, lift it onto the hemisphere, unstretch. */
-UB_INLINE void ub_ggx_sample_visible(float vx, float vy, float vz, float alpha, float u1, float u2,
-                                     UB_PRIVATE float* mx, UB_PRIVATE float* my,
+ * (Heitz 2018, Sec. 3-4) for roughness alphaU along x and alphaV along y (equal: isotropic):
+ * stretch v to the alpha = 1 configuration, sample the projected half disk, lift it onto
+ * the hemisphere, unstretch. */
+UB_INLINE void ub_ggx_sample_visible(float vx, float vy, float vz, float alphaU, float alphaV,
+                                     float u1, float u2, UB_PRIVATE float* mx, UB_PRIVATE float* my,
                                      UB_PRIVATE float* mz) {
     /* Stretched view direction. */
-    float hx = alpha * vx, hy = alpha * vy, hz = vz;
+    float hx = alphaU * vx, hy = alphaV * vy, hz = vz;
     float inv = 1.0f / ub_sqrt(hx * hx + hy * hy + hz * hz);
     hx *= inv;
     hy *= inv;
@@ -103,7 +111,7 @@ UB_INLINE void ub_ggx_sample_visible(float vx, float vy, float vz, float alpha, 
     float nx = p1 * t1x + p2 * t2x + p3 * hx;
     float ny = p1 * t1y + p2 * t2y + p3 * hy;
     float nz = p2 * t2z + p3 * hz;
-    float ex = alpha * nx, ey = alpha * ny, ez = ub_fmax(1e-7f, nz);
+    float ex = alphaU * nx, ey = alphaV * ny, ez = ub_fmax(1e-7f, nz);
     float ie = 1.0f / ub_sqrt(ex * ex + ey * ey + ez * ez);
     *mx = ex * ie;
     *my = ey * ie;
@@ -155,6 +163,43 @@ UB_INLINE float ub_mf_visible_pdf(ub_uint dist, float cosThetaV, float vDotM, fl
                                   float alpha) {
     if (cosThetaV <= 0.0f || vDotM <= 0.0f) return 0.0f;
     return ub_mf_g1(dist, cosThetaV, alpha) * vDotM * ub_mf_d(dist, cosThetaM, alpha) / cosThetaV;
+}
+
+/* Anisotropic roughness (banner): the roughness seen along the azimuth of (vx, vy). */
+UB_INLINE float ub_mf_alpha_along(float vx, float vy, float alphaU, float alphaV) {
+    if (alphaU == alphaV) return alphaU;
+    float r2 = vx * vx + vy * vy;
+    if (!(r2 > 0.0f)) return alphaU; /* normal incidence: Lambda = 0 for any roughness */
+    return ub_sqrt((vx * vx * alphaU * alphaU + vy * vy * alphaV * alphaV) / r2);
+}
+/* D(m) for a unit microfacet normal m (Heitz 2014, Sec. 5.4: GGX and Beckmann). */
+UB_INLINE float ub_mf_d_aniso(ub_uint dist, float mx, float my, float mz, float alphaU,
+                              float alphaV) {
+    if (alphaU == alphaV) return ub_mf_d(dist, mz, alphaU);
+    if (mz <= 0.0f) return 0.0f;
+    float x = mx / alphaU, y = my / alphaV;
+    float slope2 = x * x + y * y; /* m.z^2 tan^2 theta (cos^2 phi / aU^2 + sin^2 phi / aV^2) */
+    float mz2 = mz * mz;
+    if (dist == UB_MF_BECKMANN)
+        return ub_exp(-slope2 / mz2) / (UB_PI * alphaU * alphaV * mz2 * mz2);
+    float t = mz2 + slope2; /* cos^2 (1 + tan^2 (...)) */
+    return 1.0f / (UB_PI * alphaU * alphaV * t * t);
+}
+UB_INLINE float ub_mf_lambda_aniso(ub_uint dist, float vx, float vy, float vz, float alphaU,
+                                   float alphaV) {
+    return ub_mf_lambda(dist, vz, ub_mf_alpha_along(vx, vy, alphaU, alphaV));
+}
+UB_INLINE float ub_mf_g1_aniso(ub_uint dist, float vx, float vy, float vz, float alphaU,
+                               float alphaV) {
+    return 1.0f / (1.0f + ub_mf_lambda_aniso(dist, vx, vy, vz, alphaU, alphaV));
+}
+/* D_v(m) = G1(v) max(0, v.m) D(m) / v.z (Heitz 2014, eq. 38), v = (vx, vy, vz) with vz > 0
+ * and m unit; vDotM = v.m. */
+UB_INLINE float ub_mf_visible_pdf_aniso(ub_uint dist, float vx, float vy, float vz, float vDotM,
+                                        float mx, float my, float mz, float alphaU, float alphaV) {
+    if (vz <= 0.0f || vDotM <= 0.0f) return 0.0f;
+    return ub_mf_g1_aniso(dist, vx, vy, vz, alphaU, alphaV) * vDotM *
+           ub_mf_d_aniso(dist, mx, my, mz, alphaU, alphaV) / vz;
 }
 
 /* |d omega_o / d omega_m| for reflection (Walter et al. 2007, eq. 14). */

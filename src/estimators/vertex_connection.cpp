@@ -38,7 +38,7 @@ Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const
         lightScatter.setupMedium(scene_.media[size_t(lv.mediumId())].g, lv.dirFix3(), lv.contProb);
     else if (!lightScatter.setupSurface(scene_, int(lv.materialId), lv.uv2(), lv.attribute3(),
                                         lv.dirFix3(), lv.geoNormal3(), lv.shadingNormal3(),
-                                        /*fromLight=*/true))
+                                        lv.tangent3(), /*fromLight=*/true))
         return Rgb(0.0f);
     float cosLight = 0.0f, lightDirPdfW = 0.0f, lightRevPdfW = 0.0f;
     Rgb fLight = lightScatter.evaluate(-dir, &cosLight, &lightDirPdfW, &lightRevPdfW);

@@ -29,6 +29,7 @@ struct LightVertex : ub_light_vertex {
     Vec3 shadingNormal3() const { return loadF3(shadingNormal); }
     Vec2 uv2() const { return Vec2(uv[0], uv[1]); }
     Rgb attribute3() const { return loadF3(attribute); }
+    Vec3 tangent3() const { return loadF3(tangent); }
     bool inMedium() const { return (flags & UB_LIGHT_VERTEX_IN_MEDIUM) != 0; }
     /// Medium of a medium vertex (index into Scene::media).
     int mediumId() const { return int(materialId); }

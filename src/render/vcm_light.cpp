@@ -109,6 +109,7 @@ void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuf
                     lv.uv[0] = v.hit.uv.x;
                     lv.uv[1] = v.hit.uv.y;
                     storeF3(lv.attribute, v.hit.attribute);
+                    storeF3(lv.tangent, v.hit.tangent);
                 }
                 // UPBP: surface vertices are connected and merged on surfaces; medium
                 // vertices are connected, and merged through the photon points below.

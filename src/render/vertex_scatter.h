@@ -48,10 +48,10 @@ class VertexScatter {
     /// The same from stored vertex data (a light vertex).
     bool setupSurface(const Scene& scene, int materialId, const Vec2& uv, const Rgb& attribute,
                       const Vec3& dirFix, const Vec3& geoNormal, const Vec3& shadingNormal,
-                      bool fromLight) {
+                      const Vec3& tangent, bool fromLight) {
         inMedium_ = false;
         if (!scene.setupBsdf(&bsdf_, materialId, uv, attribute, dirFix, geoNormal, shadingNormal,
-                             fromLight))
+                             tangent, fromLight))
             return false;
         contProb_ = vcmContinuationProb(bsdf_);
         return true;

@@ -93,8 +93,6 @@ namespace ub {
 namespace {
 
 constexpr float kEpsCosine = 1e-6f;
-/// Smallest GGX roughness used (alpha -> 0 is a delta lobe the float math cannot represent).
-constexpr float kMinAlpha = 1e-4f;
 
 float clamp01(float x) {
     return std::min(1.0f, std::max(0.0f, x));
@@ -104,10 +102,6 @@ Rgb fresnelConductor(float cosThetaI, const Rgb& eta, const Rgb& k) {
     return {ub_fresnel_conductor(cosThetaI, eta.x, k.x),
             ub_fresnel_conductor(cosThetaI, eta.y, k.y),
             ub_fresnel_conductor(cosThetaI, eta.z, k.z)};
-}
-
-float ggxAlpha(const Material& m) {
-    return std::max(m.alpha, kMinAlpha);
 }
 
 bool isDielectric(MaterialType t) {
@@ -128,7 +122,8 @@ bool Bsdf::setup(const Material& mat, const Vec3& dirFix, const Vec3& geoNormal,
 }
 
 bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& dirFix,
-                 const Vec3& geoNormal, const Vec3& shadingNormal, bool fromLight) {
+                 const Vec3& geoNormal, const Vec3& shadingNormal, bool fromLight,
+                 const Vec3& tangent) {
     mat_ = &mat;
     colors_ = colors;
     fromLight_ = fromLight;
@@ -158,6 +153,13 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
         }
     }
     frame_ = Frame(ns);
+    if (colors_.alphaU != colors_.alphaV && lengthSqr(tangent) > 0.0f) {
+        // Anisotropic roughness: alpha_u along Mitsuba's shading tangent s, the tangent made
+        // orthogonal to the (perturbed, possibly flipped) shading normal; t = n x s. The
+        // distribution is even in s and t, so the frame's handedness does not matter.
+        frame_.s = shadingTangent(ns, tangent);
+        frame_.t = cross(ns, frame_.s);
+    }
     geoNormal_ = ng;
     localDirFix_ = frame_.toLocal(dirFix);
     cosGeoFix_ = dot(dirFix, ng);
@@ -267,7 +269,8 @@ void Bsdf::packShared() {
               (perturbed_ ? UB_BSDF_PERTURBED : 0u);
     b.cosGeoFix = cosGeoFix_;
     b.exponent = m.exponent;
-    b.alpha = m.alpha;
+    b.alpha = colors_.alphaU;
+    b.alphaV = colors_.alphaV;
     b.ior = m.ior;
     b.etaFix = etaFix_;
     b.etaOther = etaOther_;
@@ -277,7 +280,6 @@ void Bsdf::packShared() {
     b.specularWeight = specularWeight_;
     b.tableIndex = 0;  // the surface-merging pass sets the material's index
     b.terminatorAlpha2 = terminatorAlpha2_;
-    b.pad1 = 0.0f;
     coating_ = m.type == MaterialType::RoughPlastic ? m.coatingTransmittance.data() : nullptr;
 }
 
@@ -372,8 +374,8 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
             }
             break;
         case MaterialType::RoughConductor: {
-            const Vec3 m = sampleVisibleNormal(uint32_t(mat_->distribution), fix, ggxAlpha(*mat_),
-                                               rnd.x, rnd.y);
+            const Vec3 m = sampleVisibleNormal(uint32_t(mat_->distribution), fix, alphaU(),
+                                               alphaV(), rnd.x, rnd.y);
             gen = 2.0f * dot(fix, m) * m - fix;
             break;
         }
@@ -399,8 +401,8 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
             break;
         case MaterialType::RoughPlastic:
             if (rnd.z < plasticSpecularProb(fix.z)) {
-                const Vec3 m = sampleVisibleNormal(uint32_t(mat_->distribution), fix,
-                                                   ggxAlpha(*mat_), rnd.x, rnd.y);
+                const Vec3 m =
+                    sampleVisibleNormal(uint32_t(mat_->distribution), fix, alphaU(), rnd.x, rnd.y);
                 gen = 2.0f * dot(fix, m) * m - fix;
             } else {
                 gen = sampleCosineHemisphere(Vec2(rnd.x, rnd.y));
@@ -411,8 +413,8 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
             // Work mirrored to dirFix's side (GGX is symmetric under z -> -z).
             const float side = fix.z < 0.0f ? -1.0f : 1.0f;
             const Vec3 fixUp(fix.x, fix.y, side * fix.z);
-            const Vec3 m = sampleVisibleNormal(uint32_t(mat_->distribution), fixUp, ggxAlpha(*mat_),
-                                               rnd.x, rnd.y);
+            const Vec3 m = sampleVisibleNormal(uint32_t(mat_->distribution), fixUp, alphaU(),
+                                               alphaV(), rnd.x, rnd.y);
             const float cosI = dot(fixUp, m);
             float cosT;
             const float fresnel = ub_fresnel_dielectric_ct(cosI, etaOther_ / etaFix_, &cosT);

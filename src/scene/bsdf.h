@@ -32,6 +32,7 @@
 //    density of the successful samples only, and is zero exactly where they cannot land.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 
@@ -45,9 +46,13 @@ namespace ub {
 /// its textures looked up at the hit's uv (Scene::setupBsdf).
 struct SurfaceColors {
     Rgb diffuse, glossy, specular, transmittance;
+    /// RoughConductor, RoughDielectric: the microfacet roughness along the shading tangent s
+    /// and along t (equal: isotropic), textures resolved.
+    float alphaU = 0.1f, alphaV = 0.1f;
     /// The material's constants (no textures).
     static SurfaceColors of(const Material& m) {
-        return {m.diffuse, m.glossy, m.specular, m.transmittance};
+        return {m.diffuse,       m.glossy, m.specular,
+                m.transmittance, m.alpha,  m.alphaV >= 0.0f ? m.alphaV : m.alpha};
     }
 };
 
@@ -80,10 +85,13 @@ class Bsdf {
     /// grazing the shading hemisphere (|cos| < 1e-6); callers then stop the path.
     bool setup(const Material& mat, const Vec3& dirFix, const Vec3& geoNormal,
                const Vec3& shadingNormal, bool fromLight);
-    /// Same, with the RGB parameters given (textures resolved at the hit); the Material
-    /// supplies the type and the scalar parameters.
+    /// Same, with the RGB parameters and roughness given (textures resolved at the hit); the
+    /// Material supplies the type and the other scalar parameters. tangent: the hit's shading
+    /// tangent (Hit::tangent), which orients the frame of an anisotropic material (its s axis
+    /// is tangent made orthogonal to the shading normal); zero or unused: an arbitrary frame.
     bool setup(const Material& mat, const SurfaceColors& colors, const Vec3& dirFix,
-               const Vec3& geoNormal, const Vec3& shadingNormal, bool fromLight);
+               const Vec3& geoNormal, const Vec3& shadingNormal, bool fromLight,
+               const Vec3& tangent = Vec3(0.0f));
 
     /// f_s(dirFix, dirGen) for the non-delta lobes; 0 for pure delta materials.
     /// Any of the out pointers may be null.
@@ -162,6 +170,10 @@ class Bsdf {
     /// Mirror: the conductor Fresnel reflectance at dirFix's angle (1 without
     /// Material::conductorFresnel).
     Rgb mirrorReflectance() const;
+    /// The microfacet roughness at this point along frame_.s and frame_.t, clamped to
+    /// UB_MIN_GGX_ALPHA as the evaluation clamps it.
+    float alphaU() const { return std::max(colors_.alphaU, UB_MIN_GGX_ALPHA); }
+    float alphaV() const { return std::max(colors_.alphaV, UB_MIN_GGX_ALPHA); }
 
     const Material* mat_ = nullptr;
     SurfaceColors colors_;    ///< RGB parameters at this point (textures resolved)

@@ -39,6 +39,10 @@ struct MaterialTextures {
     int specular = -1;       ///< replaces Material::specular
     int transmittance = -1;  ///< replaces Material::transmittance
     int weight = -1;         ///< Blend: replaces Material::blendWeight (the texture's luminance)
+    /// RoughConductor, RoughDielectric: replace Material::alpha and Material::alphaV (the
+    /// texture's luminance, Mitsuba's float textures). alphaV -1 with alpha >= 0: isotropic.
+    int alpha = -1;
+    int alphaV = -1;
 };
 
 /// Mitsuba 3's `normalmap` and `bumpmap` wrappers: the shading normal of a hit perturbed by a
@@ -69,8 +73,13 @@ struct Material {
     /// Mirror: multiply the reflection by the conductor Fresnel reflectance of eta + i k at
     /// the angle of incidence (Mitsuba's smooth `conductor`); false: a perfect mirror.
     bool conductorFresnel = false;
-    float alpha =
-        0.1f;  ///< GGX roughness (alpha = roughness^2 convention NOT used: alpha as given)
+    /// Microfacet roughness (alpha = roughness^2 convention NOT used: alpha as given); for an
+    /// anisotropic RoughConductor or RoughDielectric the roughness along the shading tangent s
+    /// (Mitsuba's alpha_u: s is dp/du made orthogonal to the shading normal, Hit::tangent).
+    float alpha = 0.1f;
+    /// RoughConductor, RoughDielectric: the roughness along t = n x s (Mitsuba's alpha_v);
+    /// negative: isotropic (alpha in every direction). RoughPlastic is always isotropic.
+    float alphaV = -1.0f;
     /// RoughConductor, RoughDielectric reflection: Smith masking-shadowing G2 separable,
     /// G1(i) G1(o) (Mitsuba 3's choice; Walter 2007 eq. 23), instead of the default
     /// height-correlated 1 / (1 + Lambda(i) + Lambda(o)) (Heitz 2014 eq. 99). Refraction
@@ -116,6 +125,14 @@ struct Material {
     /// std::logic_error for a plastic whose current ior/alpha differ from these.
     float preparedIor = -1.0f, preparedAlpha = -1.0f;
     MicrofacetDistribution preparedDistribution = MicrofacetDistribution::kGgx;
+
+    /// Anisotropic roughness (alphaV or its texture given): the BSDF needs the shading
+    /// tangent of the hit (Hit::tangent).
+    bool anisotropic() const {
+        return (type == MaterialType::RoughConductor || type == MaterialType::RoughDielectric) &&
+               ((alphaV >= 0.0f && (alphaV != alpha || textures.alpha >= 0)) ||
+                textures.alphaV >= 0);
+    }
 };
 
 }  // namespace ub

@@ -65,13 +65,18 @@ double inverseNormalCdfErf(double u) {
 }
 
 Vec3 sampleVisibleNormal(uint32_t dist, const Vec3& v, float alpha, float u1, float u2) {
+    return sampleVisibleNormal(dist, v, alpha, alpha, u1, u2);
+}
+
+Vec3 sampleVisibleNormal(uint32_t dist, const Vec3& v, float alphaU, float alphaV, float u1,
+                         float u2) {
     if (dist != UB_MF_BECKMANN) {
         Vec3 m;
-        ub_ggx_sample_visible(v.x, v.y, v.z, alpha, u1, u2, &m.x, &m.y, &m.z);
+        ub_ggx_sample_visible(v.x, v.y, v.z, alphaU, alphaV, u1, u2, &m.x, &m.y, &m.z);
         return m;
     }
-    // Stretch to alpha = 1 (Heitz & d'Eon 2014, Sec. 4, step 1).
-    double sx = double(alpha) * v.x, sy = double(alpha) * v.y, sz = v.z;
+    // Stretch to alpha = 1 (Heitz & d'Eon 2014, Sec. 4, step 1; x by alphaU, y by alphaV).
+    double sx = double(alphaU) * v.x, sy = double(alphaV) * v.y, sz = v.z;
     const double len = std::sqrt(sx * sx + sy * sy + sz * sz);
     sx /= len;
     sy /= len;
@@ -99,7 +104,7 @@ Vec3 sampleVisibleNormal(uint32_t dist, const Vec3& v, float alpha, float u1, fl
     // Steps 3-4: rotate by phi, unstretch, and turn the slope into a normal.
     const double rx = cosPhi * slopeX - sinPhi * slopeY;
     const double ry = sinPhi * slopeX + cosPhi * slopeY;
-    const double nx = -double(alpha) * rx, ny = -double(alpha) * ry;
+    const double nx = -double(alphaU) * rx, ny = -double(alphaV) * ry;
     const double n = std::sqrt(nx * nx + ny * ny + 1.0);
     return Vec3(float(nx / n), float(ny / n), float(1.0 / n));
 }

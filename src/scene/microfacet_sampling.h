@@ -18,6 +18,9 @@ namespace ub {
 /// A microfacet normal visible from v (unit, v.z > 0) for distribution dist (UB_MF_*) and
 /// roughness alpha, from (u1, u2) in [0, 1)^2.
 Vec3 sampleVisibleNormal(uint32_t dist, const Vec3& v, float alpha, float u1, float u2);
+/// The same for anisotropic roughness: alphaU along the local x axis, alphaV along y.
+Vec3 sampleVisibleNormal(uint32_t dist, const Vec3& v, float alphaU, float alphaV, float u1,
+                         float u2);
 
 /// x with (1 + erf(x)) / 2 = u, for u in (0, 1) (clamped to [-9, 9] at the ends).
 double inverseNormalCdfErf(double u);

@@ -564,7 +564,8 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
         if (phi < 0.0) phi += 2.0 * kPiD;
         double theta = std::acos(std::max(-1.0, std::min(1.0, nz)));
         hit->uv = Vec2(float(phi / (2.0 * kPiD)), float(theta / kPiD));
-        if (perturbs(hit->materialId)) {
+        hit->tangent = Vec3(0.0f);
+        if (needsTangent(hit->materialId)) {
             // Derivatives of c + r (sin v' cos u', sin v' sin u', cos v'), u' = 2 pi u,
             // v' = pi v.
             const double sinTheta = std::sqrt(std::max(0.0, 1.0 - nz * nz));
@@ -573,7 +574,8 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
             const Vec3 dpdu(float(-2.0 * kPiD * r * ny), float(2.0 * kPiD * r * nx), 0.0f);
             const Vec3 dpdv(float(kPiD * r * nz * cosPhi), float(kPiD * r * nz * sinPhi),
                             float(-kPiD * r * sinTheta));
-            perturbShadingNormal(hit, dpdu, dpdv);
+            hit->tangent = shadingTangent(hit->shadingNormal, dpdu);
+            if (perturbs(hit->materialId)) perturbShadingNormal(hit, dpdu, dpdv);
         }
         return true;
     }
@@ -614,7 +616,8 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
                          : b0 * value(tri[0], k) + b1 * value(tri[1], k) + b2 * value(tri[2], k);
         hit->attribute = c == 1 ? Rgb(rgb[0]) : Rgb(rgb[0], rgb[1], rgb[2]);
     }
-    if (perturbs(hit->materialId)) {
+    hit->tangent = Vec3(0.0f);
+    if (needsTangent(hit->materialId)) {
         // Tangents of the uv parameterisation (scene/normal_perturbation.h).
         const Vec3 e1 = p1 - p0, e2 = p2 - p0;
         Vec3 dpdu = e1, dpdv = e2;
@@ -632,7 +635,8 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
                 dpdv = f.t;
             }
         }
-        perturbShadingNormal(hit, dpdu, dpdv);
+        hit->tangent = shadingTangent(hit->shadingNormal, dpdu);
+        if (perturbs(hit->materialId)) perturbShadingNormal(hit, dpdu, dpdv);
     }
     return true;
 }
@@ -640,6 +644,15 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
 bool Scene::perturbs(int materialId) const {
     return materialId >= 0 && size_t(materialId) < materials.size() &&
            materials[size_t(materialId)].perturbation != NormalPerturbation::kNone;
+}
+
+bool Scene::needsTangent(int materialId) const {
+    if (materialId < 0 || size_t(materialId) >= materials.size()) return false;
+    const Material& m = materials[size_t(materialId)];
+    if (m.perturbation != NormalPerturbation::kNone || m.anisotropic()) return true;
+    // A blend's parts precede it (Scene::addMaterial checks), so this recursion ends.
+    return m.type == MaterialType::Blend &&
+           (needsTangent(m.blendParts[0]) || needsTangent(m.blendParts[1]));
 }
 
 void Scene::perturbShadingNormal(Hit* hit, const Vec3& dpdu, const Vec3& dpdv) const {

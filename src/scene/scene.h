@@ -59,6 +59,10 @@ struct Hit {
     /// The value of the shape's mesh attribute here (MeshAttribute; 0 without one): what a
     /// `mesh_attribute` texture of its material returns.
     Rgb attribute{0.0f, 0.0f, 0.0f};
+    /// Mitsuba's shading tangent s: dp/du of the shape's uv parameterisation made orthogonal
+    /// to the shading normal before its normal or bump map is applied, unit; set only where
+    /// the material needs it (anisotropic roughness or a perturbed normal; zero elsewhere).
+    Vec3 tangent{0.0f, 0.0f, 0.0f};
     uint32_t shapeId = 0;
     uint32_t primId = 0;
     int materialId = -1;
@@ -230,12 +234,13 @@ class Scene {
     /// Bsdf::setup's result; false (and an invalid Bsdf) if the hit has no material.
     bool setupBsdf(Bsdf* bsdf, const Hit& hit, const Vec3& dirFix, bool fromLight) const;
     /// The same from stored vertex data (e.g. a light vertex kept for later connections):
-    /// uv and the mesh attribute value (Hit::attribute) where the textures are looked up.
+    /// uv and the mesh attribute value (Hit::attribute) where the textures are looked up,
+    /// and the shading tangent (Hit::tangent).
     bool setupBsdf(Bsdf* bsdf, int materialId, const Vec2& uv, const Rgb& attribute,
                    const Vec3& dirFix, const Vec3& geoNormal, const Vec3& shadingNormal,
-                   bool fromLight) const;
-    /// The material's RGB parameters at uv (textures looked up, `mesh_attribute` textures
-    /// give attribute, constants otherwise).
+                   const Vec3& tangent, bool fromLight) const;
+    /// The material's RGB parameters and roughness at uv (textures looked up,
+    /// `mesh_attribute` textures give attribute, constants otherwise).
     SurfaceColors surfaceColors(const Material& m, const Vec2& uv, const Rgb& attribute) const;
 
     // ---- data ----
@@ -259,6 +264,9 @@ class Scene {
     MediumStack mediumStackAtShapeSides(const Vec3& p) const;
     /// True if material materialId has a normal or bump map (Material::perturbation).
     bool perturbs(int materialId) const;
+    /// True if the material's BSDF needs Hit::tangent (a perturbed normal, or anisotropic
+    /// roughness, also in a blend's parts).
+    bool needsTangent(int materialId) const;
     /// Replaces hit->shadingNormal by its material's perturbed normal (tangents dpdu, dpdv).
     void perturbShadingNormal(Hit* hit, const Vec3& dpdu, const Vec3& dpdv) const;
 

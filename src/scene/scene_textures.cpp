@@ -23,12 +23,20 @@ SurfaceColors Scene::surfaceColors(const Material& m, const Vec2& uv, const Rgb&
     lookup(m.textures.glossy, &c.glossy);
     lookup(m.textures.specular, &c.specular);
     lookup(m.textures.transmittance, &c.transmittance);
+    // Roughness: Mitsuba's float textures, the luminance of an RGB one (as blend weights);
+    // alpha_v follows alpha_u where only one is given (isotropic).
+    if (m.textures.alpha >= 0) {
+        c.alphaU = luminance(textures[size_t(m.textures.alpha)].eval(uv, attribute));
+        if (m.alphaV < 0.0f && m.textures.alphaV < 0) c.alphaV = c.alphaU;
+    }
+    if (m.textures.alphaV >= 0)
+        c.alphaV = luminance(textures[size_t(m.textures.alphaV)].eval(uv, attribute));
     return c;
 }
 
 bool Scene::setupBsdf(Bsdf* bsdf, int materialId, const Vec2& uv, const Rgb& attribute,
                       const Vec3& dirFix, const Vec3& geoNormal, const Vec3& shadingNormal,
-                      bool fromLight) const {
+                      const Vec3& tangent, bool fromLight) const {
     if (materialId < 0 || size_t(materialId) >= materials.size()) {
         *bsdf = Bsdf();
         return false;
@@ -42,19 +50,19 @@ bool Scene::setupBsdf(Bsdf* bsdf, int materialId, const Vec2& uv, const Rgb& att
         Bsdf parts[2];
         for (int i = 0; i < 2; ++i)
             setupBsdf(&parts[i], m.blendParts[i], uv, attribute, dirFix, geoNormal, shadingNormal,
-                      fromLight);
+                      tangent, fromLight);
         float w = m.blendWeight;
         if (m.textures.weight >= 0)
             w = luminance(textures[size_t(m.textures.weight)].eval(uv, attribute));
         return bsdf->setupBlend(m, w, parts[0], parts[1]);
     }
     return bsdf->setup(m, surfaceColors(m, uv, attribute), dirFix, geoNormal, shadingNormal,
-                       fromLight);
+                       fromLight, tangent);
 }
 
 bool Scene::setupBsdf(Bsdf* bsdf, const Hit& hit, const Vec3& dirFix, bool fromLight) const {
     return setupBsdf(bsdf, hit.materialId, hit.uv, hit.attribute, dirFix, hit.geoNormal,
-                     hit.shadingNormal, fromLight);
+                     hit.shadingNormal, hit.tangent, fromLight);
 }
 
 }  // namespace ub

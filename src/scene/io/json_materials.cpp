@@ -208,26 +208,31 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         bool rough = type == "rough_dielectric";
         mat.type = rough ? MaterialType::RoughDielectric : MaterialType::Dielectric;
         keys.insert(keys.end(), {"ior", "tint"});
-        if (rough) keys.insert(keys.end(), {"alpha", "masking", "distribution"});
+        if (rough) keys.insert(keys.end(), {"alpha", "alpha_v", "masking", "distribution"});
         r.checkKeys(m, ptr, keys, type + " material");
         mat.ior = r.getNumber(m, ptr, "ior", Presence::Required, NumberRange::positive(), 1.5f);
         if (rough) mat.separableMasking = readMasking(r, m, ptr);
         if (rough) mat.distribution = readDistribution(r, m, ptr);
         colour("tint", Rgb(1.0f), &mat.specular, &mat.textures.specular);
-        if (rough)
+        if (rough) {
             mat.alpha = r.getNumber(m, ptr, "alpha", Presence::Required,
                                     NumberRange::leftOpen(0.0, 1.0), 0.1f);
+            mat.alphaV = r.getNumber(m, ptr, "alpha_v", Presence::Optional,
+                                     NumberRange::leftOpen(0.0, 1.0), -1.0f);
+        }
         mat.twoSided = false;  // the inside of a dielectric is defined by its normal
     } else if (type == "rough_conductor") {
         mat.type = MaterialType::RoughConductor;
-        keys.insert(keys.end(),
-                    {"metal", "eta", "k", "alpha", "masking", "distribution", "tint", "two_sided"});
+        keys.insert(keys.end(), {"metal", "eta", "k", "alpha", "alpha_v", "masking", "distribution",
+                                 "tint", "two_sided"});
         r.checkKeys(m, ptr, keys, "rough_conductor material");
         mat.separableMasking = readMasking(r, m, ptr);
         mat.distribution = readDistribution(r, m, ptr);
         readConductorIor(r, m, ptr, mat, true);
         mat.alpha =
             r.getNumber(m, ptr, "alpha", Presence::Required, NumberRange::leftOpen(0.0, 1.0), 0.1f);
+        mat.alphaV = r.getNumber(m, ptr, "alpha_v", Presence::Optional,
+                                 NumberRange::leftOpen(0.0, 1.0), -1.0f);
         colour("tint", Rgb(1.0f), &mat.specular, &mat.textures.specular);
     } else if (type == "plastic" || type == "rough_plastic") {
         const bool rough = type == "rough_plastic";

@@ -1,5 +1,7 @@
 // Mitsuba <bsdf> plugins -> unibeam materials (docs/mitsuba.md lists the mapping).
+#include <cctype>
 #include <cmath>
+#include <string>
 #include <utility>
 
 #include "core/image.h"
@@ -15,7 +17,8 @@ const std::vector<std::string> kBsdfs = {
     "diffuse",        "conductor", "roughconductor", "dielectric", "roughdielectric",
     "thindielectric", "plastic",   "roughplastic",   "null",       "twosided",
     "normalmap",      "bumpmap",   "blendbsdf",      "mask"};
-const std::vector<std::string> kTextures = {"checkerboard", "bitmap", "mesh_attribute"};
+const std::vector<std::string> kTextures = {"checkerboard", "bitmap", "mesh_attribute",
+                                            "rawconstant"};
 
 constexpr float kAirIor = 1.000277f;        // Mitsuba's default ext_ior ("air")
 constexpr float kBk7Ior = 1.5046f;          // Mitsuba's default int_ior ("bk7")
@@ -51,10 +54,28 @@ int buildMitsubaTexture(MitsubaBuild& b, const XmlObject& t) {
             r.error(t.find("wrap_mode")->pos,
                     t.label() + ": wrap_mode '" + wrap + "' is not one of repeat, mirror, clamp");
         const bool raw = r.getBool(t, "raw", false);
+        // Mitsuba's storage precision of the texels (auto, variant, float16/fp16, uint8): the
+        // values a 8- or 16-bit file holds are the same in every format; unibeam keeps floats.
+        const std::string format = r.getString(t, "format", "auto");
+        if (format != "auto" && format != "variant" && format != "float16" && format != "fp16" &&
+            format != "uint8")
+            r.error(t.find("format")->pos, t.label() + ": format '" + format +
+                                               "' is not one of auto, variant, float16, uint8");
         std::string file = r.getString(t, "filename", "");
         if (file.empty()) {
             r.error(t.pos, t.label() + ": needs <string name=\"filename\">");
         } else if (std::string path = b.resolveFile(t, "filename", file); !path.empty()) {
+            std::string lower = path;
+            for (char& c : lower) c = char(std::tolower(static_cast<unsigned char>(c)));
+            auto endsWith = [&](const char* e) {
+                const size_t n = std::char_traits<char>::length(e);
+                return lower.size() >= n && lower.compare(lower.size() - n, n, e) == 0;
+            };
+            if (format == "uint8" && (endsWith(".exr") || endsWith(".hdr") || endsWith(".rgbe")))
+                r.error(t.find("format")->pos,
+                        t.label() +
+                            ": format 'uint8' on a floating-point image (Mitsuba would "
+                            "quantise it to 8 bits; unibeam does not)");
             try {
                 if (isBitmapFile(path))
                     tex.image = std::make_shared<Image>(readBitmapFile(path, !raw));
@@ -67,6 +88,22 @@ int buildMitsubaTexture(MitsubaBuild& b, const XmlObject& t) {
                     r.error(t.find("filename")->pos, t.label() + ": " + d.format());
             }
         }
+    } else if (t.type == "rawconstant") {
+        // Mitsuba 2's raw constant (not a Mitsuba 3 plugin; corpus scenes of format 2.x use
+        // it, e.g. as a normal map): `value`, a float or a 3-vector, used as given, without
+        // any colour conversion.
+        tex.type = TextureType::Constant;
+        const XmlProperty* v = t.find("value");
+        if (!v) {
+            r.error(t.pos, t.label() + ": needs a <float> or <vector> named \"value\"");
+        } else if (v->kind == XmlValueKind::Vector) {
+            tex.color0 = r.getVector(t, "value", Vec3(0.0f));
+        } else {
+            tex.color0 = Rgb(r.getFloat(t, "value", 0.0f));
+        }
+        if (!std::isfinite(tex.color0.x) || !std::isfinite(tex.color0.y) ||
+            !std::isfinite(tex.color0.z))
+            r.error(v ? v->pos : t.pos, t.label() + ": value is not finite");
     } else if (t.type == "mesh_attribute") {
         // The shape's attribute `name` (a "vertex_" or "face_" attribute of its PLY file),
         // times `scale`; the shape binds it (Builder::bindMeshAttribute).
@@ -114,22 +151,27 @@ void readReflectance(MitsubaBuild& b, const XmlObject& o, const std::string& nam
     *value = b.r.getColor(o, name, def, ColorUse::Reflectance);
 }
 
+/// Mitsuba's float textures through unibeam's RGB ones: the texture's luminance. Mitsuba 3's
+/// checkerboard evaluates as a float texture with the opposite parity of its colour
+/// evaluation (src/textures/checkerboard.cpp in 3.9.1: eval_1 takes color0 where exactly one
+/// of frac(u), frac(v) exceeds 1/2, eval where both or neither do), so a float use sees the
+/// colours swapped; measured against Mitsuba on tests/data/mitsuba/blend.xml.
+int floatTexture(MitsubaBuild& b, const XmlObject& tex) {
+    int id = buildMitsubaTexture(b, tex);
+    if (id >= 0 && b.scene.textures[size_t(id)].type == TextureType::Checkerboard) {
+        Texture swapped = b.scene.textures[size_t(id)];
+        std::swap(swapped.color0, swapped.color1);
+        id = b.scene.addTexture(swapped);
+    }
+    return id;
+}
+
 /// A [0, 1] weight given as a float or as a nested/referenced texture (Mitsuba's float
 /// textures: unibeam uses the texture's luminance).
 void readWeight(MitsubaBuild& b, const XmlObject& o, const std::string& name, float def,
                 float* value, int* texture) {
     if (const XmlObject* tex = b.r.child(o, "texture", name)) {
-        *texture = buildMitsubaTexture(b, *tex);
-        // Mitsuba 3's checkerboard evaluates as a float texture with the opposite parity of
-        // its colour evaluation (src/textures/checkerboard.cpp in 3.9.1: eval_1 takes
-        // color0 where exactly one of frac(u), frac(v) exceeds 1/2, eval where both or
-        // neither do), so a float use sees the colours swapped; measured against Mitsuba
-        // on tests/data/mitsuba/blend.xml.
-        if (*texture >= 0 && b.scene.textures[size_t(*texture)].type == TextureType::Checkerboard) {
-            Texture swapped = b.scene.textures[size_t(*texture)];
-            std::swap(swapped.color0, swapped.color1);
-            *texture = b.scene.addTexture(swapped);
-        }
+        *texture = floatTexture(b, *tex);
         return;
     }
     *value = b.r.getFloatIn(o, name, def, 0.0f, 1.0f);
@@ -145,33 +187,67 @@ int twoSidedCopy(MitsubaBuild& b, int id) {
     return b.scene.addMaterial(m);
 }
 
-/// Reads a microfacet roughness: `alpha`, or `alpha_u` = `alpha_v` (anisotropy is not
-/// supported), and the `distribution` (beckmann, Mitsuba's default, or ggx) into *dist.
-float readMicrofacetAlpha(XmlReader& r, const XmlObject& o, MicrofacetDistribution* dist) {
+/// Reads a microfacet roughness into m: `alpha`, or `alpha_u` and `alpha_v` (both, as Mitsuba
+/// requires), each a float or a texture where `full` (roughconductor, roughdielectric), a float
+/// and isotropic otherwise (roughplastic); and the `distribution` (beckmann, Mitsuba's default,
+/// or ggx).
+void readMicrofacetRoughness(MitsubaBuild& b, const XmlObject& o, Material* m, bool full) {
+    XmlReader& r = b.r;
     const XmlProperty* d = o.find("distribution");
     const std::string name = r.getString(o, "distribution", "beckmann");
     if (name == "beckmann") {
-        *dist = MicrofacetDistribution::kBeckmann;
+        m->distribution = MicrofacetDistribution::kBeckmann;
     } else if (name == "ggx") {
-        *dist = MicrofacetDistribution::kGgx;
+        m->distribution = MicrofacetDistribution::kGgx;
     } else {
         r.error(d ? d->pos : o.pos, o.label() + ": unknown microfacet distribution '" + name +
                                         "' (expected 'beckmann' or 'ggx')");
     }
     r.getBool(o, "sample_visible", true);  // sampling strategy only: same expectation
-    if (o.find("alpha_u") || o.find("alpha_v")) {
-        float au = r.getFloatIn(o, "alpha_u", 0.1f, 0.0f, 1.0f, true);
-        float av = r.getFloatIn(o, "alpha_v", 0.1f, 0.0f, 1.0f, true);
-        if (o.find("alpha"))
-            r.error(o.find("alpha")->pos, o.label() +
-                                              ": give either 'alpha' or "
-                                              "'alpha_u'/'alpha_v', not both");
-        if (au != av)
-            r.error(o.find("alpha_u") ? o.find("alpha_u")->pos : o.pos,
-                    o.label() + ": anisotropic roughness (alpha_u != alpha_v) is not supported");
-        return au;
+    // One roughness: a float property or a texture child (full only).
+    auto has = [&](const char* n) {
+        return o.find(n) != nullptr || r.child(o, "texture", n) != nullptr;
+    };
+    auto read = [&](const char* n, float* value, int* texture) {
+        if (const XmlObject* tex = r.child(o, "texture", n)) {
+            if (!full) {
+                r.error(tex->pos, o.label() + ": a textured '" + n +
+                                      "' is not supported here (Mitsuba's roughplastic takes a "
+                                      "float)");
+                return;
+            }
+            *texture = floatTexture(b, *tex);
+            return;
+        }
+        *value = r.getFloatIn(o, n, 0.1f, 0.0f, 1.0f, true);
+    };
+    if (has("alpha_u") || has("alpha_v")) {
+        if (has("alpha")) {
+            const XmlProperty* a = o.find("alpha");
+            r.error(a ? a->pos : o.pos, o.label() +
+                                            ": give either 'alpha' or "
+                                            "'alpha_u'/'alpha_v', not both");
+        }
+        if (!has("alpha_u") || !has("alpha_v")) {
+            r.error(o.pos, o.label() + ": give both 'alpha_u' and 'alpha_v' (as Mitsuba requires)");
+            return;
+        }
+        float av = 0.1f;
+        read("alpha_u", &m->alpha, &m->textures.alpha);
+        read("alpha_v", &av, &m->textures.alphaV);
+        if (!full && av != m->alpha) {
+            const XmlProperty* p = o.find("alpha_v");
+            r.error(p ? p->pos : o.pos,
+                    o.label() +
+                        ": anisotropic roughness (alpha_u != alpha_v) is not supported "
+                        "here (Mitsuba's roughplastic is isotropic)");
+        }
+        // Equal constants are isotropic; a texture on either side makes it anisotropic.
+        if (full && (av != m->alpha || m->textures.alpha >= 0 || m->textures.alphaV >= 0))
+            m->alphaV = av;
+        return;
     }
-    return r.getFloatIn(o, "alpha", 0.1f, 0.0f, 1.0f, true);
+    read("alpha", &m->alpha, &m->textures.alpha);
 }
 
 /// Dielectric tints: unibeam has one `specular` tint for reflection and transmission.
@@ -390,7 +466,7 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
         m.specular = r.getColor(o, "specular_reflectance", Rgb(1.0f), ColorUse::Reflectance);
     } else if (o.type == "roughconductor") {
         m.type = MaterialType::RoughConductor;
-        m.alpha = readMicrofacetAlpha(r, o, &m.distribution);
+        readMicrofacetRoughness(b, o, &m, /*full=*/true);
         m.separableMasking = true;  // Mitsuba's MicrofacetDistribution::G = G1(i) G1(o)
         readConductorIor(b, o, m);  // "none" (the default): eta 0, k 1
         m.specular = r.getColor(o, "specular_reflectance", Rgb(1.0f), ColorUse::Reflectance);
@@ -417,11 +493,11 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
         readReflectance(b, o, "diffuse_reflectance", Rgb(0.5f), &m.diffuse, &m.textures.diffuse);
         readReflectance(b, o, "specular_reflectance", Rgb(1.0f), &m.specular, &m.textures.specular);
         m.nonlinear = r.getBool(o, "nonlinear", false);
-        if (rough) m.alpha = readMicrofacetAlpha(r, o, &m.distribution);
+        if (rough) readMicrofacetRoughness(b, o, &m, /*full=*/false);
     } else if (o.type == "roughdielectric") {
         m.type = MaterialType::RoughDielectric;
         m.ior = readRelativeIor(r, o);
-        m.alpha = readMicrofacetAlpha(r, o, &m.distribution);
+        readMicrofacetRoughness(b, o, &m, /*full=*/true);
         m.separableMasking = true;  // Mitsuba's MicrofacetDistribution::G = G1(i) G1(o)
         m.specular = readDielectricTint(r, o);
     } else {
