@@ -106,8 +106,8 @@ double mitsubaLookup(const Image& img, double u, double v) {
 
 Rgb radianceAt(const Light& l, const Vec3& worldDir, float* pdfW = nullptr) {
     float pdf;
-    Rgb le = l.radianceAlong(testSceneSphere(), normalize(worldDir), Vec3(0.0f), Vec3(0.0f), &pdf,
-                             nullptr);
+    Rgb le = l.radianceAlong(testSceneSphere(), normalize(worldDir), Vec3(0.0f), Vec3(0.0f),
+                             Vec2(0.0f, 0.0f), &pdf, nullptr);
     if (pdfW) *pdfW = pdf;
     return le;
 }

@@ -171,7 +171,7 @@ std::function<Vec3()> emitDirectionSampler(const Light& l, Rng& rng) {
 /// Solid-angle pdf of illuminate() for an environment, as reported by radianceAlong().
 double envPdfW(const Light& l, const Vec3& d) {
     float pdfW;
-    l.radianceAlong(testSceneSphere(), d, Vec3(0.0f), Vec3(0.0f), &pdfW, nullptr);
+    l.radianceAlong(testSceneSphere(), d, Vec3(0.0f), Vec3(0.0f), Vec2(0.0f, 0.0f), &pdfW, nullptr);
     return pdfW;
 }
 
@@ -334,7 +334,7 @@ void checkConsistency(const Light& l, uint64_t seed) {
         Vec3 hit = l.isFinite() ? x + dist * dir : Vec3(0.0f);
         Vec3 n = l.type == LightType::Area ? areaNormalAt(l, hit) : Vec3(0.0f);
         float pdfA, emPdfW2;
-        Rgb le2 = l.radianceAlong(ss, dir, hit, n, &pdfA, &emPdfW2);
+        Rgb le2 = l.radianceAlong(ss, dir, hit, n, Vec2(0.0f, 0.0f), &pdfA, &emPdfW2);
         float pdfW2 = l.type == LightType::Area ? pdfA * dist * dist / cosL : pdfA;
         // Like an integrator, the test reconstructs the hit point and normal, so the
         // light cosine carries ~1e-6 absolute float error: relative 1e-6 / cos at
@@ -356,7 +356,7 @@ void checkConsistency(const Light& l, uint64_t seed) {
         ++valid;
         Vec3 n = l.type == LightType::Area ? areaNormalAt(l, pos) : Vec3(0.0f);
         float pdfA2, emPdfW2;
-        Rgb le2 = l.radianceAlong(ss, -dir, pos, n, &pdfA2, &emPdfW2);
+        Rgb le2 = l.radianceAlong(ss, -dir, pos, n, Vec2(0.0f, 0.0f), &pdfA2, &emPdfW2);
         ASSERT_TRUE(relNear(le.x, le2.x) && relNear(le.y, le2.y) && relNear(le.z, le2.z));
         double rel = 1e-4 + 1e-6 / cosL;  // as above
         ASSERT_TRUE(relNear(pdfA, pdfA2)) << pdfA << " vs " << pdfA2;
@@ -409,8 +409,8 @@ TEST(Light, DeltaLightsCannotBeHit) {
     EXPECT_NEAR(length(d.direction), 1.0f, 1e-6f);  // prepare() normalizes
     for (const Light* l : {&p, &d}) {
         float pdfA = -1, emPdfW = -1;
-        Rgb le = l->radianceAlong(testSceneSphere(), Vec3(0, 0, 1), Vec3(0.0f), Vec3(0.0f), &pdfA,
-                                  &emPdfW);
+        Rgb le = l->radianceAlong(testSceneSphere(), Vec3(0, 0, 1), Vec3(0.0f), Vec3(0.0f),
+                                  Vec2(0.0f, 0.0f), &pdfA, &emPdfW);
         EXPECT_TRUE(isBlack(le));
         EXPECT_EQ(pdfA, 0.0f);
         EXPECT_EQ(emPdfW, 0.0f);
@@ -469,8 +469,8 @@ TEST(Light, EnvMapMatchesMitsubaOrientation) {
     };
     for (const Case& c : cases) {
         float pdfW;
-        Rgb le = l.radianceAlong(testSceneSphere(), normalize(c.dir), Vec3(0.0f), Vec3(0.0f), &pdfW,
-                                 nullptr);
+        Rgb le = l.radianceAlong(testSceneSphere(), normalize(c.dir), Vec3(0.0f), Vec3(0.0f),
+                                 Vec2(0.0f, 0.0f), &pdfW, nullptr);
         EXPECT_EQ(le.x, float(c.x + 10 * c.y + 1)) << c.dir.x << " " << c.dir.y << " " << c.dir.z;
     }
     // envToWorld rotates the map: the world direction R d sees what d saw before.
@@ -479,7 +479,8 @@ TEST(Light, EnvMapMatchesMitsubaOrientation) {
     for (const Case& c : cases) {
         float pdfW;
         Vec3 w = normalize(l.envToWorld.vector(normalize(c.dir)));
-        Rgb le = l.radianceAlong(testSceneSphere(), w, Vec3(0.0f), Vec3(0.0f), &pdfW, nullptr);
+        Rgb le = l.radianceAlong(testSceneSphere(), w, Vec3(0.0f), Vec3(0.0f), Vec2(0.0f, 0.0f),
+                                 &pdfW, nullptr);
         EXPECT_EQ(le.x, float(c.x + 10 * c.y + 1));
     }
 }

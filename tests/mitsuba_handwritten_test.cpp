@@ -88,6 +88,9 @@ std::string caseName(const ::testing::TestParamInfo<HandCase>& info) {
 // camera only rarely; lt's image there is heavy-tailed (measured: at 16384 iterations the
 // sphere's region mean is within 1% of Mitsuba's but single pixels are off by 3x to 20x, and
 // at 512 iterations 7 pixels fail, all darker), which bpt's camera paths avoid.
+// textured_emitter.xml (area emitters with a bitmap on a rectangle and on a uv-mapped OBJ
+// panel, a checkerboard on a sphere): pt (emitter hits and light sampling look the texture up
+// at the hit's and the sampled point's uv), bpt, lt (emission sampling) and vcm.
 const HandCase kCases[] = {
     {"blend", "pt", 512},
     {"blend", "bpt", 256},
@@ -137,6 +140,10 @@ const HandCase kCases[] = {
     {"anisotropic", "bpt", 256},
     {"anisotropic", "vcm", 256},
     {"anisotropic", "upbp", 128},
+    {"textured_emitter", "pt", 512},
+    {"textured_emitter", "bpt", 256},
+    {"textured_emitter", "lt", 512},
+    {"textured_emitter", "vcm", 256},
 };
 
 class MitsubaHandWritten : public ::testing::TestWithParam<HandCase> {};
@@ -397,5 +404,43 @@ TEST(MitsubaHandWrittenPower, AnisotropicTangentIsDistinguished) {
             std::string("anisotropic pt, alpha_u and alpha_v swapped on the ") + v.label);
         EXPECT_FALSE(check.perPixel.passed)
             << "the reference test cannot see the tangent's orientation on the " << v.label;
+    }
+}
+
+// Power of the textured-emitter check: light sampling of the two rectangles with barycentric
+// instead of their mesh uvs (pt; emitter hits keep the right uvs: the image mean fails, |z| up
+// to 9.5), and every emitter texture replaced by a constant of its mean (lt: the same power,
+// emitted uniformly; per-pixel and mean fail), each fail the reference test.
+TEST(MitsubaHandWrittenPower, EmitterTextureLookupIsDistinguished) {
+    for (int variant = 0; variant < 2; ++variant) {
+        std::unique_ptr<Scene> scene =
+            loadMitsubaScene(kDir + "/textured_emitter.xml", {{"res", "48"}});
+        int edited = 0;
+        for (Light& l : scene->lights) {
+            if (!l.radianceTexture) continue;
+            if (variant == 0 && !l.triangleUvs.empty()) {
+                l.triangleUvs.clear();
+            } else if (variant == 1) {
+                Texture flat;
+                flat.type = TextureType::Constant;
+                flat.color0 = l.radianceTexture->mean();
+                l.radianceTexture = std::make_shared<const Texture>(flat);
+            } else {
+                continue;
+            }
+            l.prepare();
+            ++edited;
+        }
+        ASSERT_EQ(edited, variant == 0 ? 2 : 3);
+        const test::ReferenceCheck check =
+            checkAgainst("textured_emitter", *scene, variant == 0 ? "pt" : "lt", 512,
+                         variant == 0 ? "textured_emitter pt, barycentric uvs in light sampling"
+                                      : "textured_emitter lt, textures replaced by their means");
+        // The reference test's two parts (MatchesMitsuba3Reference): one of them must fail.
+        bool meansPass = true;
+        for (int ch = 0; ch < 3; ++ch) meansPass &= std::fabs(check.meanZ[ch]) < kMeanZBound;
+        EXPECT_FALSE(check.perPixel.passed && meansPass)
+            << "the reference test cannot see "
+            << (variant == 0 ? "the emitters' uvs" : "the textures");
     }
 }

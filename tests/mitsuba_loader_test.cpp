@@ -15,6 +15,7 @@
 #include "scene/bsdf.h"
 #include "scene/io/mitsuba_spectra.h"
 #include "scene/io/scene_loader.h"
+#include "scene/light.h"
 #include "scene/texture.h"
 
 using namespace ub;
@@ -410,6 +411,29 @@ TEST(MitsubaXml, RawConstantAndBitmapFormat) {
     EXPECT_EQ(bitmap("float16"), "");
     EXPECT_TRUE(contains(bitmap("uint8"), "format 'uint8' on a floating-point image"));
     EXPECT_TRUE(contains(bitmap("int4"), "format 'int4' is not one of auto, variant"));
+}
+
+// A textured area emitter keeps its texture and the mesh's uvs per triangle vertex (a sphere
+// none: spherical uvs); a mesh_attribute radiance is an error.
+TEST(MitsubaXml, TexturedAreaEmitters) {
+    const std::string checker =
+        "<texture name=\"radiance\" type=\"checkerboard\"><rgb name=\"color0\" value=\"0.9\"/>"
+        "<rgb name=\"color1\" value=\"0.1\"/></texture>";
+    auto s = load(scene("<shape type=\"rectangle\"><emitter type=\"area\">" + checker +
+                        "</emitter></shape>\n<shape type=\"sphere\"><point name=\"center\" "
+                        "x=\"3\" y=\"0\" z=\"0\"/><emitter type=\"area\">" +
+                        checker + "</emitter></shape>\n"));
+    ASSERT_EQ(s->lights.size(), 2u);
+    for (const Light& l : s->lights) {
+        ASSERT_TRUE(l.radianceTexture != nullptr) << l.name;
+        EXPECT_EQ(l.radianceTexture->type, TextureType::Checkerboard);
+        EXPECT_EQ(l.triangleUvs.size(), l.isSphere ? 0u : l.triangles.size()) << l.name;
+    }
+    std::string e = errorsOf(
+        scene("<shape type=\"rectangle\"><emitter type=\"area\"><texture name=\"radiance\" "
+              "type=\"mesh_attribute\"><string name=\"name\" value=\"vertex_color\"/></texture>"
+              "</emitter></shape>\n"));
+    EXPECT_TRUE(contains(e, "a mesh_attribute radiance is not supported")) << e;
 }
 
 TEST(MitsubaXml, SceneLoaderDispatchesXmlAndRejectsDefinesForJson) {

@@ -155,8 +155,8 @@ TEST(ProjectorLight, IrradianceOnTheImagePlane) {
                                      &pdfW, &emPdfW, &cosAt)));
     EXPECT_TRUE(l.isDelta() && l.isDeltaPosition() && l.isFinite());
     float pdfA = 1, em = 1;
-    EXPECT_TRUE(
-        isBlack(l.radianceAlong(sceneSphere(), -l.direction, l.position, Vec3(0.0f), &pdfA, &em)));
+    EXPECT_TRUE(isBlack(l.radianceAlong(sceneSphere(), -l.direction, l.position, Vec3(0.0f),
+                                        Vec2(0.0f, 0.0f), &pdfA, &em)));
 }
 
 // Power: Phi = pi scale A integral of E over [0, 1]^2 (A = 4 t^2 / a, the plane's area):

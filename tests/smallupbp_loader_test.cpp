@@ -334,8 +334,8 @@ TEST(SmallUpbpLoader, EnvironmentMapLookupMatchesSmallUpbp) {
             const Vec3 d(std::sin(theta) * std::cos(alpha), std::sin(theta) * std::sin(alpha),
                          std::cos(theta));
             float pdfA = 0, pdfE = 0;
-            const Rgb got =
-                env.radianceAlong(s->sceneSphere, d, Vec3(0.0f), Vec3(0.0f), &pdfA, &pdfE);
+            const Rgb got = env.radianceAlong(s->sceneSphere, d, Vec3(0.0f), Vec3(0.0f),
+                                              Vec2(0.0f, 0.0f), &pdfA, &pdfE);
             const int fileX = ((x - rot) % W + W) % W;
             EXPECT_FLOAT_EQ(got.x, 2.0f * float(fileX + 1)) << "x " << x << " y " << y;
             EXPECT_FLOAT_EQ(got.y, 2.0f * float(y + 1)) << "x " << x << " y " << y;

@@ -190,8 +190,8 @@ TEST(SpotLight, IlluminateIrradiance) {
         EXPECT_NEAR(dist, d, 1e-5f);
     }
     float pdfA = 1, emPdfW = 1;
-    EXPECT_TRUE(
-        isBlack(l.radianceAlong(sceneSphere(), -kAxis, l.position, Vec3(0.0f), &pdfA, &emPdfW)));
+    EXPECT_TRUE(isBlack(l.radianceAlong(sceneSphere(), -kAxis, l.position, Vec3(0.0f),
+                                        Vec2(0.0f, 0.0f), &pdfA, &emPdfW)));
     EXPECT_EQ(pdfA, 0.0f);
     EXPECT_TRUE(l.isDelta() && l.isDeltaPosition() && l.isFinite());
 }

@@ -106,8 +106,8 @@ Rgb PathTracer::tracePixel(int x, int y, int iteration) const {
                 const Light& env = scene_.lights[size_t(scene_.backgroundLightId)];
                 float directPdfW = 0.0f, emissionPdfW = 0.0f;
                 // For environments radianceAlong's directPdfA is a solid-angle pdf.
-                Rgb le = env.radianceAlong(sphere, ray.dir, ray.org, Vec3(0.0f), &directPdfW,
-                                           &emissionPdfW);
+                Rgb le = env.radianceAlong(sphere, ray.dir, ray.org, Vec3(0.0f), Vec2(0.0f, 0.0f),
+                                           &directPdfW, &emissionPdfW);
                 if (!isBlack(le))
                     radiance +=
                         throughput * le * emitterHitWeight(pathLength, directPdfW * lightPickProb_);
@@ -119,8 +119,8 @@ Rgb PathTracer::tracePixel(int x, int y, int iteration) const {
         if (hit.lightId >= 0 && pathLength >= minLength) {
             const Light& light = scene_.lights[size_t(hit.lightId)];
             float directPdfA = 0.0f, emissionPdfW = 0.0f;
-            Rgb le = light.radianceAlong(sphere, ray.dir, hit.pos, hit.geoNormal, &directPdfA,
-                                         &emissionPdfW);
+            Rgb le = light.radianceAlong(sphere, ray.dir, hit.pos, hit.geoNormal, hit.uv,
+                                         &directPdfA, &emissionPdfW);
             if (!isBlack(le)) {
                 float cosAtLight = std::fabs(dot(hit.geoNormal, ray.dir));
                 float lightPdfW = pdfAtoW(directPdfA, hit.dist, cosAtLight) * lightPickProb_;

@@ -194,7 +194,7 @@ class VertexCM : public Integrator {
     // Camera pass (vcm_camera.cpp).
     Rgb traceCameraPath(int x, int y, int iteration, CameraRecords* records) const;
     Rgb lightHitRadiance(const Light& light, const SubPath& state, const Vec3& rayDir,
-                         const Vec3& hitPos, const Vec3& hitNormal) const;
+                         const Vec3& hitPos, const Vec3& hitNormal, const Vec2& hitUv) const;
     Rgb directIllumination(Rng& rng, const SubPath& state, const PathVertex& v,
                            const VertexScatter& scatter) const;
     Rgb connectVertices(const LightVertex& lv, const SubPath& state, const PathVertex& v,

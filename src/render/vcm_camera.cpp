@@ -57,9 +57,10 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
             if (escaped && scene_.backgroundLightId >= 0 && state.pathLength >= minLength) {
                 SubPath atLight = state;
                 atLight.mis = misAtHit(state, v, 1.0f, 0);
-                color += state.throughput *
-                         lightHitRadiance(scene_.lights[size_t(scene_.backgroundLightId)], atLight,
-                                          state.ray.dir, state.ray.org, Vec3(0.0f));
+                color +=
+                    state.throughput *
+                    lightHitRadiance(scene_.lights[size_t(scene_.backgroundLightId)], atLight,
+                                     state.ray.dir, state.ray.org, Vec3(0.0f), Vec2(0.0f, 0.0f));
             }
             break;
         }
@@ -71,9 +72,9 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
         if (!v.inMedium && v.hit.lightId >= 0 && state.pathLength >= minLength) {
             SubPath atLight = state;
             atLight.mis = misAtHit(state, v, std::fabs(dot(v.hit.geoNormal, state.ray.dir)), 1);
-            color +=
-                state.throughput * lightHitRadiance(scene_.lights[size_t(v.hit.lightId)], atLight,
-                                                    state.ray.dir, v.hit.pos, v.hit.geoNormal);
+            color += state.throughput * lightHitRadiance(scene_.lights[size_t(v.hit.lightId)],
+                                                         atLight, state.ray.dir, v.hit.pos,
+                                                         v.hit.geoNormal, v.hit.uv);
         }
         // Light tracing uses the camera pass only for directly visible emitters.
         if (lightTraceOnly_) break;
@@ -143,9 +144,9 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
 }
 
 Rgb VertexCM::lightHitRadiance(const Light& light, const SubPath& state, const Vec3& rayDir,
-                               const Vec3& hitPos, const Vec3& hitNormal) const {
+                               const Vec3& hitPos, const Vec3& hitNormal, const Vec2& hitUv) const {
     float directPdfA = 0.0f, emissionPdfW = 0.0f;
-    Rgb le = light.radianceAlong(scene_.sceneSphere, rayDir, hitPos, hitNormal, &directPdfA,
+    Rgb le = light.radianceAlong(scene_.sceneSphere, rayDir, hitPos, hitNormal, hitUv, &directPdfA,
                                  &emissionPdfW);
     if (isBlack(le)) return Rgb(0.0f);
     // A directly visible light has no other technique.

@@ -37,9 +37,10 @@ bool isFiniteNonNegative(const Rgb& c) {
 // ---- area lights -------------------------------------------------------------
 
 /// Picks a point uniformly by area over all triangles and the sphere (the sphere,
-/// if any, is the last bin of triangleDistribution). Returns the point and its
-/// front-side unit normal. rnd is reused for the discrete choice (rescaled).
-Vec3 sampleAreaPoint(const Light& l, const Vec2& rnd, Vec3* normal) {
+/// if any, is the last bin of triangleDistribution). Returns the point, its
+/// front-side unit normal and its uv (for a radiance texture; computed only with one).
+/// rnd is reused for the discrete choice (rescaled).
+Vec3 sampleAreaPoint(const Light& l, const Vec2& rnd, Vec3* normal, Vec2* uv) {
     int bin = 0;
     float binPdf;
     float x = l.triangleDistribution.sampleContinuous(rnd.x, &binPdf, &bin);
@@ -50,13 +51,26 @@ Vec3 sampleAreaPoint(const Light& l, const Vec2& rnd, Vec3* normal) {
     if (size_t(bin) >= triCount) {  // the sphere
         Vec3 n = sampleUniformSphere(Vec2(u0, rnd.y));
         *normal = n;
+        if (l.radianceTexture) *uv = sphereUv(n);
         return l.position + l.sphereRadius * n;
     }
-    const Vec3& p0 = l.triangles[3 * size_t(bin)];
-    Vec3 e1 = l.triangles[3 * size_t(bin) + 1] - p0;
-    Vec3 e2 = l.triangles[3 * size_t(bin) + 2] - p0;
+    const size_t t = 3 * size_t(bin);
+    const Vec3& p0 = l.triangles[t];
+    Vec3 e1 = l.triangles[t + 1] - p0;
+    Vec3 e2 = l.triangles[t + 2] - p0;
     Vec2 b = sampleUniformTriangle(Vec2(u0, rnd.y));
     *normal = normalize(cross(e1, e2));
+    if (l.radianceTexture) {
+        // Scene::intersect's uv at the same barycentrics (b.x on p1, b.y on p2).
+        if (l.triangleUvs.empty()) {
+            *uv = b;
+        } else {
+            const Vec2 &t0 = l.triangleUvs[t], &t1 = l.triangleUvs[t + 1],
+                       &t2 = l.triangleUvs[t + 2];
+            const float b0 = 1.0f - b.x - b.y;
+            *uv = Vec2(b0 * t0.x + b.x * t1.x + b.y * t2.x, b0 * t0.y + b.x * t1.y + b.y * t2.y);
+        }
+    }
     return p0 + b.x * e1 + b.y * e2;
 }
 
@@ -159,6 +173,17 @@ void Light::prepare() {
                                 "area light triangle list must hold 3 vertices per triangle");
             if (triangles.empty() && !isSphere)
                 throwLightError(*this, "area light has no geometry (no triangles and no sphere)");
+            if (!triangleUvs.empty() && triangleUvs.size() != triangles.size())
+                throwLightError(*this, "area light has " + std::to_string(triangleUvs.size()) +
+                                           " vertex uvs for " + std::to_string(triangles.size()) +
+                                           " triangle vertices");
+            if (radianceTexture) {
+                if (radianceTexture->type == TextureType::MeshAttribute)
+                    throwLightError(*this,
+                                    "a mesh_attribute cannot be an area light's radiance "
+                                    "(not supported)");
+                radianceTexture->validate();
+            }
             std::vector<float> areas;
             areas.reserve(triangles.size() / 3 + 1);
             double total = 0;
@@ -302,7 +327,8 @@ Rgb Light::illuminate(const SceneSphere& sphere, const Vec3& receivingPos, const
     switch (type) {
         case LightType::Area: {
             Vec3 n;
-            Vec3 p = sampleAreaPoint(*this, rnd, &n);
+            Vec2 uv;
+            Vec3 p = sampleAreaPoint(*this, rnd, &n, &uv);
             Vec3 toLight = p - receivingPos;
             float distSqr = lengthSqr(toLight);
             if (!(distSqr > 0)) return Rgb(0);
@@ -316,7 +342,7 @@ Rgb Light::illuminate(const SceneSphere& sphere, const Vec3& receivingPos, const
             *distance = dist;
             *directPdfW = ub_pdf_a_to_w(directPdfA, distSqr, cosOut);
             if (cosAtLight) *cosAtLight = cosOut;
-            return radiance;
+            return areaRadiance(uv);
         }
         case LightType::Point: {
             Vec3 toLight = position - receivingPos;
@@ -387,7 +413,8 @@ Rgb Light::emit(const SceneSphere& sphere, const Vec2& rndDir, const Vec2& rndPo
     switch (type) {
         case LightType::Area: {
             Vec3 n;
-            *positionOut = sampleAreaPoint(*this, rndPos, &n);
+            Vec2 uv;
+            *positionOut = sampleAreaPoint(*this, rndPos, &n, &uv);
             Vec2 u = rndDir;
             if (twoSided) {  // coin flip for the side, rndDir.x rescaled to [0,1)
                 if (u.x < 0.5f) {
@@ -403,7 +430,7 @@ Rgb Light::emit(const SceneSphere& sphere, const Vec2& rndDir, const Vec2& rndPo
             // Same formula as radianceAlong(): emissionPdfW = 1/A * P(side) * cos/pi.
             areaPdfs(*this, local.z, directPdfA, emissionPdfW);
             if (cosThetaLight) *cosThetaLight = local.z;
-            return radiance;
+            return areaRadiance(uv);
         }
         case LightType::Point:
             *positionOut = position;
@@ -468,7 +495,8 @@ Rgb Light::emit(const SceneSphere& sphere, const Vec2& rndDir, const Vec2& rndPo
 // ---- radianceAlong ---------------------------------------------------------------
 
 Rgb Light::radianceAlong(const SceneSphere& sphere, const Vec3& rayDir, const Vec3& /*hitPoint*/,
-                         const Vec3& hitNormal, float* directPdfA, float* emissionPdfW) const {
+                         const Vec3& hitNormal, const Vec2& hitUv, float* directPdfA,
+                         float* emissionPdfW) const {
     if (directPdfA) *directPdfA = 0;
     if (emissionPdfW) *emissionPdfW = 0;
     switch (type) {
@@ -476,7 +504,7 @@ Rgb Light::radianceAlong(const SceneSphere& sphere, const Vec3& rayDir, const Ve
             float cosOut = emissionCosine(*this, hitNormal, -rayDir);
             if (cosOut <= kEpsCosine) return Rgb(0);
             areaPdfs(*this, cosOut, directPdfA, emissionPdfW);
-            return radiance;
+            return areaRadiance(hitUv);
         }
         case LightType::Point:
         case LightType::Spot:

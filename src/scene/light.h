@@ -26,7 +26,11 @@
 // emissionPdfW includes that 1/2); a sphere emits outward. A point is picked
 // uniformly by area over all triangles and the sphere (the sphere is the last bin
 // of triangleDistribution), so directPdfA = 1 / totalArea. radianceAlong() trusts
-// hitNormal as that front-side normal.
+// hitNormal as that front-side normal. A textured area light (Mitsuba 3's `area` with a
+// `radiance` texture) emits radiance x radianceTexture(uv), uv being the shape's own
+// (Hit::uv): the triangles' `triangleUvs` interpolated at the sampled point (barycentrics
+// when the mesh has none), the sphere's spherical uv. Points are still sampled uniformly by
+// area, so every pdf is the untextured one.
 //
 // Environment map orientation (same as Mitsuba 3's `envmap`): a direction
 // d = (dx, dy, dz) in the map's frame (d = worldToEnv(dirToLight)) looks up
@@ -41,6 +45,8 @@
 // for Bilinear), pdfW = pdfUv / (2 pi^2 sin theta) (0 at the poles).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -53,6 +59,19 @@
 #include "scene/texture.h"
 
 namespace ub {
+
+/// The uv of a sphere shape at the point with unit outward normal n (Scene::intersect's and
+/// Mitsuba's spherical coordinates about +z): u = phi / 2 pi in [0, 1), v = theta / pi.
+inline Vec2 sphereUv(double nx, double ny, double nz) {
+    constexpr double kTwoPi = 6.283185307179586476925;
+    double phi = std::atan2(ny, nx);
+    if (phi < 0.0) phi += kTwoPi;
+    const double theta = std::acos(std::max(-1.0, std::min(1.0, nz)));
+    return Vec2(float(phi / kTwoPi), float(theta / (0.5 * kTwoPi)));
+}
+inline Vec2 sphereUv(const Vec3& n) {
+    return sphereUv(n.x, n.y, n.z);
+}
 
 struct SceneSphere {
     Vec3 center{0, 0, 0};
@@ -103,6 +122,12 @@ struct Light {
     // ---- Area light geometry (world space) ----
     std::vector<Vec3>
         triangles;  ///< 3 vertices per triangle (emits on the side of (p1-p0)x(p2-p0))
+    /// Area: uv of each triangle vertex (3 per triangle, as `triangles`; empty: barycentric
+    /// uvs, as Scene::intersect gives a mesh without them). Used by radianceTexture only.
+    std::vector<Vec2> triangleUvs;
+    /// Area: the emitted radiance is `radiance` x this texture at the point's uv (null:
+    /// constant). Mitsuba's `radiance` bitmap; its `scale` folds into `radiance`.
+    std::shared_ptr<const Texture> radianceTexture;
     Distribution1D triangleDistribution;  ///< by area
     bool isSphere = false;  ///< Area light is a sphere (center=position, sphereRadius)
     float sphereRadius = 0.0f;
@@ -160,10 +185,16 @@ struct Light {
              Vec3* direction, float* emissionPdfW, float* directPdfA, float* cosThetaLight) const;
     /// Radiance arriving along rayDir (unit, from the shading point towards the light)
     /// when a ray hits this light: area lights at hitPoint with surface normal
-    /// hitNormal (geometric, as stored); environments: hitPoint/hitNormal unused.
+    /// hitNormal (geometric, as stored) and uv hitUv (Hit::uv, where a radiance texture is
+    /// looked up); environments: hitPoint, hitNormal and hitUv unused.
     /// Fills the pdfs that illuminate()/emit() would have used for this point.
     Rgb radianceAlong(const SceneSphere& sphere, const Vec3& rayDir, const Vec3& hitPoint,
-                      const Vec3& hitNormal, float* directPdfA, float* emissionPdfW) const;
+                      const Vec3& hitNormal, const Vec2& hitUv, float* directPdfA,
+                      float* emissionPdfW) const;
+    /// Area: the radiance at a point with uv (radiance x radianceTexture(uv)).
+    Rgb areaRadiance(const Vec2& uv) const {
+        return radianceTexture ? radiance * radianceTexture->eval(uv, Rgb(0.0f)) : radiance;
+    }
 };
 
 }  // namespace ub

@@ -559,11 +559,7 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
         hit->pos = Vec3(float(c.x + r * nx), float(c.y + r * ny), float(c.z + r * nz));
         hit->geoNormal = normalize(Vec3(float(nx), float(ny), float(nz)));
         hit->shadingNormal = hit->geoNormal;
-        // Spherical coordinates about +z: u = phi / 2pi in [0,1), v = theta / pi.
-        double phi = std::atan2(ny, nx);
-        if (phi < 0.0) phi += 2.0 * kPiD;
-        double theta = std::acos(std::max(-1.0, std::min(1.0, nz)));
-        hit->uv = Vec2(float(phi / (2.0 * kPiD)), float(theta / kPiD));
+        hit->uv = sphereUv(nx, ny, nz);  // spherical coordinates about +z
         hit->tangent = Vec3(0.0f);
         if (needsTangent(hit->materialId)) {
             // Derivatives of c + r (sin v' cos u', sin v' sin u', cos v'), u' = 2 pi u,

@@ -124,7 +124,9 @@ std::string describeScene(const Scene& scene) {
         if (!l.name.empty()) os << " '" << l.name << "'";
         switch (l.type) {
             case LightType::Area:
-                os << ", radiance " << vec(l.radiance) << ", "
+                os << ", radiance " << vec(l.radiance)
+                   << (l.radianceTexture ? " x texture '" + l.radianceTexture->name + "'" : "")
+                   << ", "
                    << (l.isSphere ? "sphere"
                                   : std::to_string(l.triangles.size() / 3) + " triangles")
                    << ", area " << num(l.totalArea) << (l.twoSided ? ", two-sided" : "");

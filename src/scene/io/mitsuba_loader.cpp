@@ -654,7 +654,20 @@ void Builder::readShape(const XmlObject& o) {
         } else {
             light.type = LightType::Area;
             light.name = name;
-            light.radiance = r_.getColor(*em, "radiance", Rgb(1.0f), ColorUse::Emission);
+            // A `radiance` texture (Mitsuba: the emitted radiance at the shape's uv) or a colour.
+            if (const XmlObject* tex = r_.child(*em, "texture", "radiance")) {
+                const int id = buildMitsubaTexture(b_, *tex);
+                if (id >= 0) {
+                    const Texture& t = b_.scene.textures[size_t(id)];
+                    if (t.type == TextureType::MeshAttribute)
+                        r_.error(tex->pos,
+                                 em->label() + ": a mesh_attribute radiance is not supported");
+                    light.radianceTexture = std::make_shared<const Texture>(t);
+                }
+                light.radiance = Rgb(1.0f);
+            } else {
+                light.radiance = r_.getColor(*em, "radiance", Rgb(1.0f), ColorUse::Emission);
+            }
             light.twoSided = false;  // Mitsuba's area emitters emit on the normal's side only
             r_.checkUnused(*em);
             if (isSphere) {
@@ -663,6 +676,9 @@ void Builder::readShape(const XmlObject& o) {
                 light.sphereRadius = radius;
             } else {
                 for (uint32_t idx : mesh.indices) light.triangles.push_back(mesh.positions[idx]);
+                // The mesh's uvs, as Scene::intersect interpolates them (none: barycentric).
+                if (light.radianceTexture && !mesh.uvs.empty())
+                    for (uint32_t idx : mesh.indices) light.triangleUvs.push_back(mesh.uvs[idx]);
             }
         }
     }
