@@ -91,6 +91,10 @@ std::string caseName(const ::testing::TestParamInfo<HandCase>& info) {
 // textured_emitter.xml (area emitters with a bitmap on a rectangle and on a uv-mapped OBJ
 // panel, a checkerboard on a sphere): pt (emitter hits and light sampling look the texture up
 // at the hit's and the sampled point's uv), bpt, lt (emission sampling) and vcm.
+// orthographic.xml (orthographic sensor with a scaled to_world and a near clip plane through a
+// sphere): pt (vpt renders pt's image on a scene without media; ppm and bpm accept the camera
+// but, biased, are not compared with references); light tracing needs a pinhole
+// (OrthographicRefusesLightTracingAndClipsAtTheNearPlane).
 const HandCase kCases[] = {
     {"blend", "pt", 512},
     {"blend", "bpt", 256},
@@ -144,6 +148,7 @@ const HandCase kCases[] = {
     {"textured_emitter", "bpt", 256},
     {"textured_emitter", "lt", 512},
     {"textured_emitter", "vcm", 256},
+    {"orthographic", "pt", 512},
 };
 
 class MitsubaHandWritten : public ::testing::TestWithParam<HandCase> {};
@@ -443,4 +448,28 @@ TEST(MitsubaHandWrittenPower, EmitterTextureLookupIsDistinguished) {
             << "the reference test cannot see "
             << (variant == 0 ? "the emitters' uvs" : "the textures");
     }
+}
+
+// The orthographic sensor: light-tracing algorithms are refused with a message naming the
+// camera, and the near clip plane is applied (the scene with near_clip 0.01, the front sphere
+// then seen from outside, fails the reference test).
+TEST(MitsubaHandWrittenPower, OrthographicRefusesLightTracingAndClipsAtTheNearPlane) {
+    std::unique_ptr<Scene> scene = loadMitsubaScene(kDir + "/orthographic.xml", {{"res", "48"}});
+    ASSERT_TRUE(scene->camera.isOrthographic());
+    for (const char* algorithm : {"bpt", "lt", "vcm"}) {
+        RenderOptions options;
+        options.algorithm = algorithm;
+        try {
+            makeIntegrator(*scene, options);
+            ADD_FAILURE() << algorithm << " accepted an orthographic camera";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("is orthographic"), std::string::npos) << e.what();
+        }
+    }
+    std::unique_ptr<Scene> unclipped =
+        loadEdited("orthographic", "<float name=\"near_clip\" value=\"6.1\"/>",
+                   "<float name=\"near_clip\" value=\"0.01\"/>");
+    const test::ReferenceCheck check =
+        checkAgainst("orthographic", *unclipped, "pt", 512, "orthographic pt, near clip 0.01");
+    EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the near clip plane";
 }

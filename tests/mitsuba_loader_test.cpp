@@ -13,6 +13,7 @@
 
 #include "core/image.h"
 #include "scene/bsdf.h"
+#include "scene/camera.h"
 #include "scene/io/mitsuba_spectra.h"
 #include "scene/io/scene_loader.h"
 #include "scene/light.h"
@@ -434,6 +435,36 @@ TEST(MitsubaXml, TexturedAreaEmitters) {
               "type=\"mesh_attribute\"><string name=\"name\" value=\"vertex_color\"/></texture>"
               "</emitter></shape>\n"));
     EXPECT_TRUE(contains(e, "a mesh_attribute radiance is not supported")) << e;
+}
+
+// The orthographic sensor: the region's size from to_world's scale, rays from the near plane;
+// a sheared to_world is an error.
+TEST(MitsubaXml, OrthographicSensor) {
+    auto ortho = [](const std::string& transform) {
+        return std::string(
+                   "<scene version=\"3.0.0\">\n<sensor type=\"orthographic\">"
+                   "<float name=\"near_clip\" value=\"2\"/><transform name=\"to_world\">") +
+               transform +
+               "</transform><film type=\"hdrfilm\"><integer name=\"width\" value=\"40\"/>"
+               "<integer name=\"height\" value=\"20\"/><rfilter type=\"box\"/></film></sensor>\n" +
+               kLight + "</scene>\n";
+    };
+    auto s =
+        load(ortho("<scale x=\"3\" y=\"2\"/><lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" "
+                   "up=\"0, 1, 0\"/>"));
+    const Camera& c = s->camera;
+    ASSERT_TRUE(c.isOrthographic());
+    EXPECT_FALSE(c.isPinhole());
+    EXPECT_NEAR(c.orthoHalfWidth(), 3.0f, 1e-5f);
+    EXPECT_NEAR(c.orthoHalfHeight(), 2.0f / 2.0f, 1e-5f);  // y in [-1/aspect, 1/aspect] x 2
+    // The top-left corner's ray: camera x = +1 (the image's left) is world -x here.
+    const Ray r = c.generateRay(Vec2(0.0f, 0.0f));
+    EXPECT_NEAR(r.org.x, -3.0f, 1e-5f);
+    EXPECT_NEAR(r.org.y, 1.0f, 1e-5f);
+    EXPECT_NEAR(r.org.z, 3.0f, 1e-5f);  // the near plane, 2 in front of the origin
+    EXPECT_NEAR(r.dir.z, -1.0f, 1e-6f);
+    const std::string e = errorsOf(ortho("<matrix value=\"1 0.5 0 0 0 1 0 0 0 0 1 0 0 0 0 1\"/>"));
+    EXPECT_TRUE(contains(e, "to_world must map the camera axes to orthogonal")) << e;
 }
 
 TEST(MitsubaXml, SceneLoaderDispatchesXmlAndRejectsDefinesForJson) {

@@ -35,8 +35,9 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
     state.ray = camera.generateRay(raster, lensU);
     if (pixelWeight <= 0.0f) return Rgb(0.0f);  // outside the image (ptracer convention)
     state.throughput = Rgb(pixelWeight);
-    // Camera subpath partials [TR (31)-(33)], completed at the first hit. Thin lenses (ppm and
-    // bpm only) never use dVCM of the camera vertex: it is multiplied by bptFactor = 0.
+    // Camera subpath partials [TR (31)-(33)], completed at the first hit. Thin lenses and
+    // orthographic cameras (ppm and bpm only) never use dVCM of the camera vertex: it is
+    // multiplied by bptFactor = 0.
     const float cameraPdfW = camera.isPinhole() ? camera.pdfW(state.ray.dir) : 1.0f;
     state.mis = ub_mis_init_camera(mis_, cameraPdfW);
 

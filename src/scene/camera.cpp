@@ -17,11 +17,43 @@ void Camera::setup(const Vec3& position, const Vec3& target, const Vec3& up, flo
     height_ = height;
     lensRadius_ = lensRadius;
     focusDistance_ = focusDistance;
+    orthographic_ = false;
+    orthoHalfWidth_ = orthoHalfHeight_ = 0.0f;
     float tanHalf = std::tan(0.5f * fovYDeg * kPi / 180.0f);
     imagePlaneDist_ = float(height) / (2.0f * tanHalf);
 }
 
+void Camera::setupOrthographic(const Vec3& nearCentre, const Vec3& forward, const Vec3& right,
+                               const Vec3& up, float halfWidth, float halfHeight, int width,
+                               int height) {
+    position_ = nearCentre;
+    forward_ = forward;
+    right_ = right;
+    up_ = up;
+    width_ = width;
+    height_ = height;
+    lensRadius_ = 0.0f;
+    focusDistance_ = 1.0f;
+    orthographic_ = true;
+    orthoHalfWidth_ = halfWidth;
+    orthoHalfHeight_ = halfHeight;
+    // Not used by an orthographic camera (no light tracing); kept finite.
+    fovYDeg_ = 0.0f;
+    imagePlaneDist_ = 1.0f;
+}
+
 Camera Camera::resized(int width, int height, bool keepHorizontalFov) const {
+    if (orthographic_) {
+        // Square pixels: keep the region's width (or height), the other follows the aspect.
+        Camera c = *this;
+        c.width_ = width;
+        c.height_ = height;
+        if (keepHorizontalFov)
+            c.orthoHalfHeight_ = orthoHalfWidth_ * float(height) / float(width);
+        else
+            c.orthoHalfWidth_ = orthoHalfHeight_ * float(width) / float(height);
+        return c;
+    }
     float fovY = fovYDeg_;
     if (keepHorizontalFov && width_ > 0 && height_ > 0) {
         // tan(fovX / 2) = tan(fovY / 2) * width / height, kept across the two sizes.
@@ -35,6 +67,15 @@ Camera Camera::resized(int width, int height, bool keepHorizontalFov) const {
 }
 
 Ray Camera::generateRay(const Vec2& raster, const Vec2& lensU) const {
+    if (orthographic_) {
+        // Mitsuba's orthographic sensor: the raster position on the near plane, along forward.
+        const float x = (2.0f * raster.x / float(width_) - 1.0f) * orthoHalfWidth_;
+        const float y = (1.0f - 2.0f * raster.y / float(height_)) * orthoHalfHeight_;
+        Ray ray;
+        ray.org = position_ + right_ * x + up_ * y;
+        ray.dir = forward_;
+        return ray;
+    }
     float px = raster.x - 0.5f * float(width_);
     float py = 0.5f * float(height_) - raster.y;
     Vec3 d = normalize(forward_ * imagePlaneDist_ + right_ * px + up_ * py);

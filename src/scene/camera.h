@@ -26,8 +26,17 @@ class Camera {
     void setup(const Vec3& position, const Vec3& target, const Vec3& up, float fovYDeg, int width,
                int height, float lensRadius = 0.0f, float focusDistance = 1.0f);
 
+    /// An orthographic camera (Mitsuba 3's `orthographic`): parallel rays along `forward`
+    /// from the near plane, the point nearCentre + right x + up y for the raster position
+    /// with x in [-halfWidth, halfWidth] (left to right) and y in [-halfHeight, halfHeight]
+    /// (bottom to top), world units. forward, right and up must be orthonormal.
+    void setupOrthographic(const Vec3& nearCentre, const Vec3& forward, const Vec3& right,
+                           const Vec3& up, float halfWidth, float halfHeight, int width,
+                           int height);
+
     /// The same camera with a width x height image: the vertical field of view is kept,
-    /// or the horizontal one if keepHorizontalFov.
+    /// or the horizontal one if keepHorizontalFov (orthographic: the width of the viewed
+    /// region, or its height).
     Camera resized(int width, int height, bool keepHorizontalFov = false) const;
 
     /// Primary ray through raster position `raster` (e.g. pixel + jitter); lensU in [0,1)^2
@@ -35,11 +44,16 @@ class Camera {
     Ray generateRay(const Vec2& raster, const Vec2& lensU = Vec2(0.5f, 0.5f)) const;
     /// Projects world point p to raster coordinates; false if behind the camera or
     /// outside the image. Pinhole only (light tracing requires isPinhole()).
+    /// For an orthographic camera position() is the centre of the near plane.
     bool worldToRaster(const Vec3& p, Vec2* raster) const;
     /// Solid-angle pdf of sampling direction `dir` (unit, world) from the eye (pinhole).
     float pdfW(const Vec3& dir) const;
 
-    bool isPinhole() const { return lensRadius_ <= 0.0f; }
+    bool isPinhole() const { return lensRadius_ <= 0.0f && !orthographic_; }
+    bool isOrthographic() const { return orthographic_; }
+    /// Orthographic: half the width and height of the viewed region (world units).
+    float orthoHalfWidth() const { return orthoHalfWidth_; }
+    float orthoHalfHeight() const { return orthoHalfHeight_; }
     int width() const { return width_; }
     int height() const { return height_; }
     const Vec3& position() const { return position_; }
@@ -57,6 +71,8 @@ class Camera {
     float fovYDeg_ = 45.0f, imagePlaneDist_ = 1.0f;
     float lensRadius_ = 0.0f, focusDistance_ = 1.0f;
     int width_ = 0, height_ = 0;
+    bool orthographic_ = false;
+    float orthoHalfWidth_ = 0.0f, orthoHalfHeight_ = 0.0f;
 };
 
 }  // namespace ub

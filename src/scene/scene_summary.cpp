@@ -194,13 +194,15 @@ std::string describeScene(const Scene& scene) {
 
     const Camera& c = scene.camera;
     os << "camera: " << c.width() << "x" << c.height() << ", position " << vec(c.position())
-       << ", forward " << vec(c.forward()) << ", up " << vec(c.up()) << ", fov " << num(c.fovYDeg())
-       << " deg (vertical)";
-    if (c.isPinhole())
-        os << ", pinhole\n";
+       << ", forward " << vec(c.forward()) << ", up " << vec(c.up());
+    if (c.isOrthographic())
+        os << ", orthographic " << num(2.0f * c.orthoHalfWidth()) << " x "
+           << num(2.0f * c.orthoHalfHeight()) << "\n";
+    else if (c.isPinhole())
+        os << ", fov " << num(c.fovYDeg()) << " deg (vertical), pinhole\n";
     else
-        os << ", thin lens radius " << num(c.lensRadius()) << " focused at "
-           << num(c.focusDistance()) << "\n";
+        os << ", fov " << num(c.fovYDeg()) << " deg (vertical), thin lens radius "
+           << num(c.lensRadius()) << " focused at " << num(c.focusDistance()) << "\n";
 
     const RenderSettings& st = scene.settings;
     os << "settings: max_path_length " << st.maxPathLength << ", min_path_length "

@@ -67,6 +67,7 @@ class Builder {
     void readIntegrator(const XmlObject& o);
     void checkDirect();
     void readSensor(const XmlObject& o);
+    void readOrthographic(const XmlObject& o, int w, int h);
     /// The horizontal field of view in degrees of a perspective sensor or a projector
     /// (Mitsuba's parse_fov: `fov` along `fov_axis`, or `focal_length` on 36 x 24 mm film).
     float readFovX(const XmlObject& o, float aspect);
@@ -408,8 +409,8 @@ float Builder::readFovX(const XmlObject& o, float aspect) {
 }
 
 void Builder::readSensor(const XmlObject& o) {
-    if (o.type != "perspective" && o.type != "thinlens") {
-        r_.unsupportedPlugin(o, {"perspective", "thinlens"});
+    if (o.type != "perspective" && o.type != "thinlens" && o.type != "orthographic") {
+        r_.unsupportedPlugin(o, {"perspective", "thinlens", "orthographic"});
         return;
     }
     int w = 768, h = 576;
@@ -433,6 +434,10 @@ void Builder::readSensor(const XmlObject& o) {
                                    "the iterations with `unibeam render -i`)");
     }
     const float aspect = float(w) / float(h);
+    if (o.type == "orthographic") {
+        readOrthographic(o, w, h);
+        return;
+    }
     const float fovX = readFovX(o, aspect);
     if (o.find("near_clip") || o.find("far_clip")) {
         r_.getFloatIn(o, "near_clip", 0.01f, 0.0f, kInf, true);
@@ -471,6 +476,41 @@ void Builder::readSensor(const XmlObject& o) {
     float fovY = 2.0f * std::atan(std::tan(0.5f * fovX * kPi / 180.0f) / aspect) * 180.0f / kPi;
     b_.scene.camera.setup(origin, origin + normalize(fwd), normalize(up), fovY, w, h, lensRadius,
                           focusDistance);
+    b_.cameraSet = true;
+}
+
+// Mitsuba 3.9.1's orthographic sensor (src/sensors/orthographic.cpp, orthographic_projection
+// in include/mitsuba/render/sensor.h): camera space x in [-1, 1] (+x at the image's left), y in
+// [-1 / aspect, 1 / aspect], rays from the near plane z = near_clip along +z, all mapped by
+// to_world, whose scale sets the size of the viewed region. far_clip is not applied.
+void Builder::readOrthographic(const XmlObject& o, int w, int h) {
+    const float nearClip = r_.getFloatIn(o, "near_clip", 0.01f, 0.0f, kInf, true);
+    const float farClip = r_.getFloatIn(o, "far_clip", 1e4f, 0.0f, kInf, true);
+    if (o.find("far_clip"))
+        r_.warning(o.find("far_clip")->pos,
+                   o.label() + ": far_clip is not applied (rays are not cut off at " +
+                       std::to_string(farClip) + ")");
+    Transform m = r_.getTransform(o, "to_world");
+    r_.checkUnused(o);
+    const Vec3 ax = m.vector(Vec3(1, 0, 0)), ay = m.vector(Vec3(0, 1, 0)),
+               az = m.vector(Vec3(0, 0, 1));
+    const float lx = length(ax), ly = length(ay), lz = length(az);
+    const XmlProperty* tp = o.find("to_world");
+    const bool orthogonal =
+        lx > 0 && ly > 0 && lz > 0 && std::fabs(dot(ax, ay)) <= 1e-4f * lx * ly &&
+        std::fabs(dot(ax, az)) <= 1e-4f * lx * lz && std::fabs(dot(ay, az)) <= 1e-4f * ly * lz;
+    if (!orthogonal || !std::isfinite(lx * ly * lz) || dot(cross(ay, az), ax) <= 0) {
+        r_.error(tp ? tp->pos : o.pos, o.label() +
+                                           ": to_world must map the camera axes to orthogonal, "
+                                           "non-mirrored directions (a rotation, a translation and "
+                                           "a scale along the camera axes)");
+        return;
+    }
+    const Vec3 forward = az / lz, up = ay / ly, right = -ax / lx;
+    const Vec3 nearCentre = m.point(Vec3(0.0f, 0.0f, nearClip));
+    const float aspect = float(w) / float(h);
+    b_.scene.camera.setupOrthographic(nearCentre, forward, right, up, lx, ly / aspect, w, h);
+    b_.scene.settings.keepHorizontalFov = true;  // Mitsuba fixes the x extent
     b_.cameraSet = true;
 }
 
