@@ -256,7 +256,7 @@ Scene::~Scene() = default;
 
 int Scene::addMaterial(const Material& m) {
     for (int t : {m.textures.diffuse, m.textures.glossy, m.textures.specular,
-                  m.textures.transmittance, m.textures.weight})
+                  m.textures.transmittance, m.textures.weight, m.textures.alpha, m.textures.alphaV})
         if (t >= int(textures.size()))
             throw std::logic_error("Scene::addMaterial: material '" + m.name +
                                    "' refers to texture " + std::to_string(t) +
@@ -265,6 +265,12 @@ int Scene::addMaterial(const Material& m) {
         (m.perturbationTexture < 0 || m.perturbationTexture >= int(textures.size())))
         throw std::logic_error("Scene::addMaterial: material '" + m.name +
                                "' has a normal or bump map without a texture");
+    const bool microfacet =
+        m.type == MaterialType::RoughConductor || m.type == MaterialType::RoughDielectric;
+    if (!microfacet && (m.textures.alpha >= 0 || m.textures.alphaV >= 0 || m.alphaV >= 0.0f))
+        throw std::logic_error("Scene::addMaterial: material '" + m.name +
+                               "' has a textured or anisotropic roughness, which only rough "
+                               "conductors and rough dielectrics take");
     // A blend's parts are added before it, so no blend contains itself (nesting is finite).
     if (m.type == MaterialType::Blend)
         for (int part : m.blendParts)
