@@ -49,6 +49,8 @@ inline constexpr const char* kBitmapFormats =
     ".png, .jpg/.jpeg, .exr, .bmp, .tga, .hdr/.rgbe or .ppm/.pgm/.pnm";
 /// Whether the file name's extension (any case) names one of kBitmapFormats.
 bool isBitmapFile(const std::string& path);
+/// Whether it names one of the floating-point formats among them (EXR, Radiance RGBE).
+bool isFloatBitmapFile(const std::string& path);
 /// Reads any of kBitmapFormats by its extension (EXR and RGBE linear, the others sRGB unless
 /// linearize = false). An unknown extension throws InputError.
 Image readBitmapFile(const std::string& path, bool linearize = true);

@@ -188,6 +188,11 @@ bool isBitmapFile(const std::string& path) {
     return false;
 }
 
+bool isFloatBitmapFile(const std::string& path) {
+    const std::string ext = extensionOf(path);
+    return ext == ".exr" || ext == ".hdr" || ext == ".rgbe";
+}
+
 Image readBitmapFile(const std::string& path, bool linearize) {
     const std::string ext = extensionOf(path);
     if (ext == ".png") return readPng(path, linearize);

@@ -1,5 +1,4 @@
 // Mitsuba <bsdf> plugins -> unibeam materials (docs/mitsuba.md lists the mapping).
-#include <cctype>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -65,13 +64,7 @@ int buildMitsubaTexture(MitsubaBuild& b, const XmlObject& t) {
         if (file.empty()) {
             r.error(t.pos, t.label() + ": needs <string name=\"filename\">");
         } else if (std::string path = b.resolveFile(t, "filename", file); !path.empty()) {
-            std::string lower = path;
-            for (char& c : lower) c = char(std::tolower(static_cast<unsigned char>(c)));
-            auto endsWith = [&](const char* e) {
-                const size_t n = std::char_traits<char>::length(e);
-                return lower.size() >= n && lower.compare(lower.size() - n, n, e) == 0;
-            };
-            if (format == "uint8" && (endsWith(".exr") || endsWith(".hdr") || endsWith(".rgbe")))
+            if (format == "uint8" && isFloatBitmapFile(path))
                 r.error(t.find("format")->pos,
                         t.label() +
                             ": format 'uint8' on a floating-point image (Mitsuba would "
