@@ -1,19 +1,26 @@
 /* The BVH of the beam estimators (src/estimators/bvh.h builds it): its flat node
- * record and the two node tests of a traversal, shared by the host walk and the
- * OpenCL kernels so both visit the same leaves in the same order (depth first,
- * left child first). */
+ * record and the node tests of a traversal, shared by the host walk and the OpenCL
+ * kernels so both visit the same leaves in the same order.
+ *
+ * Four children per node, their boxes stored as a structure of arrays in the node itself,
+ * so that one node fetch tests all four (the walk is bound by the latency of its node
+ * loads: measured, docs/performance.md). Walk order (UB_BVH_WALK in kernels/beams.cl,
+ * Bvh::traverse on the host): pop a node; test its four children; visit the primitives of
+ * the leaf children that pass, child 0 first; push the inner children that pass, child 3
+ * first, so that child 0 is walked next. */
 #ifndef UB_BVH_H
 #define UB_BVH_H
 
 #include "ub_vec3.h"
 
-/* count > 0: a leaf holding prims[first .. first + count); count == 0: an inner node whose
- * left child is the next node and right child node `first`. 32 bytes. */
+/* count[c] == UB_BVH_NONE: no child c; count[c] == 0: child c is the inner node child[c];
+ * else child c is a leaf holding prims[child[c] .. child[c] + count[c]). 128 bytes. */
+#define UB_BVH_NONE 0xFFFFFFFFu
 typedef struct {
-    float lo[3];
-    ub_uint first;
-    float hi[3];
-    ub_uint count;
+    float loX[4], loY[4], loZ[4];
+    float hiX[4], hiY[4], hiZ[4];
+    ub_uint child[4];
+    ub_uint count[4];
 } ub_bvh_node;
 
 /* A piece of a photon beam diced for the BVH: parameters [t0, t1] of beam `beam`, with a
@@ -30,34 +37,54 @@ typedef struct {
     ub_uint pathLength;
 } ub_beam_part;
 
-UB_INLINE int ub_bvh_contains(ub_bvh_node n, ub_float3 p) {
-    return p.x >= n.lo[0] && p.x <= n.hi[0] && p.y >= n.lo[1] && p.y <= n.hi[1] && p.z >= n.lo[2] &&
-           p.z <= n.hi[2];
+/* Bit c set when child c exists and its box contains p. */
+UB_INLINE ub_uint ub_bvh_contains(UB_PRIVATE const ub_bvh_node* n, ub_float3 p) {
+    ub_uint mask = 0u;
+    for (int c = 0; c < 4; ++c) {
+        int in = p.x >= n->loX[c] && p.x <= n->hiX[c] && p.y >= n->loY[c] && p.y <= n->hiY[c] &&
+                 p.z >= n->loZ[c] && p.z <= n->hiZ[c] && n->count[c] != UB_BVH_NONE;
+        mask |= in ? (1u << c) : 0u;
+    }
+    return mask;
 }
 
-/* Slab test of the segment o + t d, t in [0, len], against the node's box (invD = 1 / d per
- * axis). NaN (0 * inf, an origin on a slab plane of a flat box) keeps the interval. */
-UB_INLINE int ub_bvh_meets(ub_bvh_node n, ub_float3 o, ub_float3 invD, float len) {
+/* Slab test of the segment o + t d, t in [0, len], against one box (invD = 1 / d per axis).
+ * NaN (0 * inf, an origin on a slab plane of a flat box) keeps the interval: the selects
+ * below pick the other operand when a comparison with NaN is false. No branches: every
+ * axis narrows [t0, t1] and one comparison decides. */
+UB_INLINE int ub_bvh_box_meets(float loX, float loY, float loZ, float hiX, float hiY, float hiZ,
+                               ub_float3 o, ub_float3 invD, float len) {
     float t0 = 0.0f, t1 = len;
-    float oa[3], ia[3];
-    oa[0] = o.x;
-    oa[1] = o.y;
-    oa[2] = o.z;
-    ia[0] = invD.x;
-    ia[1] = invD.y;
-    ia[2] = invD.z;
-    for (int a = 0; a < 3; ++a) {
-        float ta = (n.lo[a] - oa[a]) * ia[a], tb = (n.hi[a] - oa[a]) * ia[a];
-        if (ta > tb) {
-            float s = ta;
-            ta = tb;
-            tb = s;
-        }
-        if (ta > t0) t0 = ta;
-        if (tb < t1) t1 = tb;
-        if (t0 > t1) return 0;
+    float ta = (loX - o.x) * invD.x, tb = (hiX - o.x) * invD.x;
+    float near = ta > tb ? tb : ta, far = ta > tb ? ta : tb;
+    t0 = near > t0 ? near : t0;
+    t1 = far < t1 ? far : t1;
+    ta = (loY - o.y) * invD.y;
+    tb = (hiY - o.y) * invD.y;
+    near = ta > tb ? tb : ta;
+    far = ta > tb ? ta : tb;
+    t0 = near > t0 ? near : t0;
+    t1 = far < t1 ? far : t1;
+    ta = (loZ - o.z) * invD.z;
+    tb = (hiZ - o.z) * invD.z;
+    near = ta > tb ? tb : ta;
+    far = ta > tb ? ta : tb;
+    t0 = near > t0 ? near : t0;
+    t1 = far < t1 ? far : t1;
+    return t0 <= t1;
+}
+
+/* Bit c set when child c exists and its box meets the segment o + t d, t in [0, len]. */
+UB_INLINE ub_uint ub_bvh_meets(UB_PRIVATE const ub_bvh_node* n, ub_float3 o, ub_float3 invD,
+                               float len) {
+    ub_uint mask = 0u;
+    for (int c = 0; c < 4; ++c) {
+        int in = ub_bvh_box_meets(n->loX[c], n->loY[c], n->loZ[c], n->hiX[c], n->hiY[c], n->hiZ[c],
+                                  o, invD, len) &&
+                 n->count[c] != UB_BVH_NONE;
+        mask |= in ? (1u << c) : 0u;
     }
-    return 1;
+    return mask;
 }
 
 /* The photon beam part that counts a pair whose beam parameter is t (each pair once). */
@@ -67,6 +94,8 @@ UB_INLINE int ub_beam_part_holds(ub_beam_part p, float t, float beamLength) {
 
 #ifndef __OPENCL_C_VERSION__
 #include <cstddef>
+static_assert(sizeof(ub_bvh_node) == 128, "ub_bvh_node layout");
+static_assert(offsetof(ub_bvh_node, child) == 96, "ub_bvh_node layout");
 static_assert(sizeof(ub_beam_part) == 48, "ub_beam_part layout");
 static_assert(offsetof(ub_beam_part, dir) == 16, "ub_beam_part layout");
 static_assert(offsetof(ub_beam_part, beam) == 32, "ub_beam_part layout");

@@ -4,13 +4,15 @@
 // diced along their axis into boxes of the cylinder of radius r (traversed by
 // query points and query beams; src/estimators/volume_estimate.h).
 //
-// Built top-down: a node's primitives are split at the median of their box
-// centres along the axis of largest centre extent, down to leaves of at most
-// leafSize primitives (O(n log n) with nth_element; measured, docs/performance.md: 8
-// for the beam parts, faster than 4 and 16 for bb1d, whose candidates are cheap; 4 for the
-// photon spheres of pb2d, where 8 halved the kernel's speed). Median splits keep the
-// tree balanced whatever the beam distribution; for the long, thin boxes of
-// beams a SAH split would cut traversal cost further (not done).
+// Built top-down as a binary tree: a node's primitives are split at the median of their box
+// centres along the axis of largest centre extent, down to leaves of at most leafSize
+// primitives (O(n log n) with nth_element; the leaf sizes are measured, docs/performance.md).
+// Median splits keep the tree balanced whatever the beam distribution. The binary tree is
+// then collapsed into four-wide nodes (kernels/shared/ub_bvh.h): each node takes its
+// binary children and opens the inner one with the largest box surface until it holds four,
+// so one node load tests four boxes. A walk here is bound by the latency of its node loads
+// (bb1d on mirrorballs: about 300 nodes per query beam for 4.5 pairs), and the wide nodes
+// halve the loads and the depth (measured, docs/performance.md).
 //
 // Own code rather than Embree's user geometry: the nodes are a flat array of
 // fixed-size records, which the OpenCL backend uploads and traverses as they are
@@ -20,18 +22,55 @@
 #include <cstdint>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "core/vec.h"
 #include "kernels/shared/ub_bvh.h"
 
 namespace ub {
 
-/// The flat node (kernels/shared/ub_bvh.h): leaf count > 0 at prims[first ..], inner nodes
-/// count 0 with the left child next and the right child at `first`.
+/// The flat four-wide node (kernels/shared/ub_bvh.h); the root is node 0.
 using BvhNode = ub_bvh_node;
-static_assert(sizeof(BvhNode) == 32, "BvhNode layout");
+static_assert(sizeof(BvhNode) == 128, "BvhNode layout");
+
+/// ub_bvh_meets (kernels/shared/ub_bvh.h) with the four boxes tested at once in SSE: the same
+/// operations in the same order, and min/max with the operands ordered so that a NaN selects
+/// what the shared selects select (minps/maxps return the second operand on NaN), so the
+/// mask is the same bit for bit (tests/bvh_test.cpp). gcc does not vectorise the shared loop,
+/// and the scalar version made the host walk 15% slower than the binary tree's.
+inline uint32_t bvhMeets4(const BvhNode& n, const ub_float3& o, const ub_float3& invD, float len) {
+#if defined(__SSE2__)
+    const __m128 ox = _mm_set1_ps(o.x), oy = _mm_set1_ps(o.y), oz = _mm_set1_ps(o.z);
+    const __m128 ix = _mm_set1_ps(invD.x), iy = _mm_set1_ps(invD.y), iz = _mm_set1_ps(invD.z);
+    __m128 t0 = _mm_setzero_ps(), t1 = _mm_set1_ps(len);
+    auto axis = [&](const float* lo, const float* hi, __m128 oa, __m128 ia) {
+        const __m128 ta = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(lo), oa), ia);
+        const __m128 tb = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(hi), oa), ia);
+        const __m128 nearT = _mm_min_ps(tb, ta);  // ta > tb ? tb : ta
+        const __m128 farT = _mm_max_ps(ta, tb);   // ta > tb ? ta : tb
+        t0 = _mm_max_ps(nearT, t0);               // near > t0 ? near : t0
+        t1 = _mm_min_ps(farT, t1);                // far < t1 ? far : t1
+    };
+    axis(n.loX, n.hiX, ox, ix);
+    axis(n.loY, n.hiY, oy, iy);
+    axis(n.loZ, n.hiZ, oz, iz);
+    const __m128i none = _mm_set1_epi32(int(UB_BVH_NONE));
+    const __m128i exists = _mm_xor_si128(
+        _mm_cmpeq_epi32(_mm_loadu_si128((const __m128i*)n.count), none), _mm_set1_epi32(-1));
+    const __m128 hit = _mm_and_ps(_mm_cmple_ps(t0, t1), _mm_castsi128_ps(exists));
+    return uint32_t(_mm_movemask_ps(hit));
+#else
+    return ub_bvh_meets(&n, o, invD, len);
+#endif
+}
 
 class Bvh {
   public:
+    /// Node memory a build needs per box, at most: two binary nodes (32 bytes each; leaves
+    /// hold at least one box) and one four-wide node.
+    static constexpr size_t kNodeBytesPerBox = 2 * 32 + sizeof(BvhNode);
     /// Builds over boxes[i], i = 0..n-1, leaves of at most leafSize; visits report i.
     void build(const std::vector<Bounds3>& boxes, uint32_t leafSize = 4);
     bool empty() const { return nodes_.empty(); }
@@ -54,33 +93,40 @@ class Bvh {
     void querySegment(const Vec3& o, const Vec3& d, float len, Visit&& visit) const;
 
   private:
-    /// Depth-first walk: visit(i) for the primitives of every leaf whose path accept()s.
-    template <class Accept, class Visit>
-    void traverse(Accept&& accept, Visit&& visit) const;
+    /// The walk of kernels/shared/ub_bvh.h: visit(i) for the primitives of every leaf whose
+    /// path passes; childMask(node) gives the children that pass.
+    template <class ChildMask, class Visit>
+    void traverse(ChildMask&& childMask, Visit&& visit) const;
+    /// A node of the binary tree built first.
+    struct Node2 {
+        Bounds3 box;
+        uint32_t first = 0;  // leaf: first primitive; inner: the right child (left is next)
+        uint32_t count = 0;  // leaf: > 0
+    };
     uint32_t buildNode(const std::vector<Bounds3>& boxes, std::vector<Vec3>& centres,
-                       uint32_t begin, uint32_t end);
+                       std::vector<Node2>& tree, uint32_t begin, uint32_t end);
+    uint32_t collapse(const std::vector<Node2>& tree, uint32_t self);
     uint32_t leafSize_ = 4;
 
     std::vector<BvhNode> nodes_;
     std::vector<uint32_t> prims_;
 };
 
-template <class Accept, class Visit>
-void Bvh::traverse(Accept&& accept, Visit&& visit) const {
+template <class ChildMask, class Visit>
+void Bvh::traverse(ChildMask&& childMask, Visit&& visit) const {
     if (nodes_.empty()) return;
-    uint32_t stack[64];  // median splits: depth <= log2(n) + 1 (bvh.cpp)
+    uint32_t stack[64];  // depth <= 33 / 2 + 1 (median splits, bvh.cpp), 3 pushes a level
     int top = 0;
     stack[top++] = 0;
     while (top > 0) {
-        const uint32_t self = stack[--top];
-        const BvhNode& n = nodes_[self];
-        if (!accept(n)) continue;
-        if (n.count > 0) {
-            for (uint32_t i = n.first; i < n.first + n.count; ++i) visit(prims_[i]);
-        } else {
-            stack[top++] = n.first;
-            stack[top++] = self + 1;
-        }
+        const BvhNode& n = nodes_[stack[--top]];
+        const uint32_t mask = childMask(n);
+        if (mask == 0) continue;
+        for (int c = 0; c < 4; ++c)
+            if ((mask >> c) & 1u && n.count[c] != 0)
+                for (uint32_t i = n.child[c]; i < n.child[c] + n.count[c]; ++i) visit(prims_[i]);
+        for (int c = 3; c >= 0; --c)
+            if ((mask >> c) & 1u && n.count[c] == 0) stack[top++] = n.child[c];
     }
 }
 
@@ -97,14 +143,14 @@ void Bvh::permuteToLeafOrder(std::vector<T>* items) {
 template <class Visit>
 void Bvh::queryPoint(const Vec3& p, Visit&& visit) const {
     const ub_float3 q = ub_make_float3(p.x, p.y, p.z);
-    traverse([&](const BvhNode& n) { return ub_bvh_contains(n, q) != 0; }, visit);
+    traverse([&](const BvhNode& n) { return ub_bvh_contains(&n, q); }, visit);
 }
 
 template <class Visit>
 void Bvh::querySegment(const Vec3& o, const Vec3& d, float len, Visit&& visit) const {
     const ub_float3 oo = ub_make_float3(o.x, o.y, o.z);
     const ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
-    traverse([&](const BvhNode& n) { return ub_bvh_meets(n, oo, invD, len) != 0; }, visit);
+    traverse([&](const BvhNode& n) { return bvhMeets4(n, oo, invD, len); }, visit);
 }
 
 }  // namespace ub

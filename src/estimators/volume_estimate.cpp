@@ -77,7 +77,7 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     std::vector<ub_photon_point> sphereOrder;
     if (t.pb2d) {
         // Boxes, nodes (at most 2 n / leaf size + 1) and the primitive list.
-        reserve(photons.size() * (sizeof(Bounds3) + sizeof(Vec3) + 4 + 2 * sizeof(BvhNode)),
+        reserve(photons.size() * (sizeof(Bounds3) + sizeof(Vec3) + 4 + Bvh::kNodeBytesPerBox),
                 "pb2d lookup (photon-point BVH)");
         const float r = in.radius[UB_TECH_PB2D];
         std::vector<Bounds3> boxes(photons.size());
@@ -107,7 +107,7 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         size_t total = 0;
         for (const ub_beam& b : beams) total += size_t(partCount(b));
         reserve(
-            total * (sizeof(BeamPart) + sizeof(Bounds3) + sizeof(Vec3) + 4 + 2 * sizeof(BvhNode)),
+            total * (sizeof(BeamPart) + sizeof(Bounds3) + sizeof(Vec3) + 4 + Bvh::kNodeBytesPerBox),
             "bp2d/bb1d lookup (beam-part BVH)");
         std::vector<Bounds3> boxes;
         parts.reserve(total);

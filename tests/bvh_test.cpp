@@ -1,0 +1,160 @@
+// The beam estimators' four-wide BVH (src/estimators/bvh.h) against brute force: a walk reports
+// every primitive of the leaves whose boxes pass, each once, so with leaves of one box exactly
+// the boxes that contain a point or meet a segment, and with larger leaves a superset of them;
+// for thin diagonal boxes (beam parts), small cubes (photon spheres), a single box and
+// coincident centres; and the
+// host's SSE node test (bvhMeets4) gives the shared ub_bvh_meets mask bit for bit, NaN cases
+// (origins on slab planes, axis-parallel segments) included.
+#include "estimators/bvh.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/rng.h"
+
+using namespace ub;
+
+namespace {
+
+Vec3 randomIn(Rng& rng, float lo, float hi) {
+    return Vec3(lo + (hi - lo) * rng.uniform(), lo + (hi - lo) * rng.uniform(),
+                lo + (hi - lo) * rng.uniform());
+}
+
+// Slab test in double precision, as the reference of which boxes a segment meets.
+bool segmentMeetsBox(const Vec3& o, const Vec3& d, float len, const Bounds3& b) {
+    double t0 = 0.0, t1 = len;
+    for (int a = 0; a < 3; ++a) {
+        if (d[a] == 0.0f) {
+            if (o[a] < b.lo[a] || o[a] > b.hi[a]) return false;
+            continue;
+        }
+        double ta = (double(b.lo[a]) - o[a]) / d[a], tb = (double(b.hi[a]) - o[a]) / d[a];
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+    }
+    return t0 <= t1;
+}
+
+// Whether the test's rounding may differ from the double reference: the segment passes
+// within a relative 1e-4 of a box face.
+bool nearBoundary(const Vec3& o, const Vec3& d, float len, const Bounds3& b) {
+    Bounds3 grown = b, shrunk = b;
+    const Vec3 e = (b.hi - b.lo) * 1e-4f + Vec3(1e-5f, 1e-5f, 1e-5f);
+    grown.lo = b.lo - e;
+    grown.hi = b.hi + e;
+    shrunk.lo = b.lo + e;
+    shrunk.hi = b.hi - e;
+    return segmentMeetsBox(o, d, len * 1.0001f, grown) != segmentMeetsBox(o, d, len, shrunk);
+}
+
+std::vector<Bounds3> beamBoxes(Rng& rng, int n) {
+    std::vector<Bounds3> boxes;
+    for (int i = 0; i < n; ++i) {
+        const Vec3 a = randomIn(rng, 0.0f, 1.0f);
+        const Vec3 b = a + randomIn(rng, -0.2f, 0.2f);
+        Bounds3 box;
+        box.extend(a - Vec3(0.01f, 0.01f, 0.01f));
+        box.extend(b + Vec3(0.01f, 0.01f, 0.01f));
+        boxes.push_back(box);
+    }
+    return boxes;
+}
+
+void checkWalks(const std::vector<Bounds3>& boxes, uint32_t leafSize, uint64_t seed) {
+    Bvh bvh;
+    bvh.build(boxes, leafSize);
+    Rng rng(seed, 3);
+    for (int q = 0; q < 400; ++q) {
+        const Vec3 p = randomIn(rng, -0.1f, 1.1f);
+        std::vector<uint32_t> found, expected;
+        bvh.queryPoint(p, [&](uint32_t i) { found.push_back(i); });
+        for (uint32_t i = 0; i < boxes.size(); ++i)
+            if (p.x >= boxes[i].lo.x && p.x <= boxes[i].hi.x && p.y >= boxes[i].lo.y &&
+                p.y <= boxes[i].hi.y && p.z >= boxes[i].lo.z && p.z <= boxes[i].hi.z)
+                expected.push_back(i);
+        std::sort(found.begin(), found.end());
+        ASSERT_TRUE(std::adjacent_find(found.begin(), found.end()) == found.end());
+        if (leafSize == 1)
+            ASSERT_EQ(found, expected) << "point query " << q;
+        else
+            ASSERT_TRUE(std::includes(found.begin(), found.end(), expected.begin(), expected.end()))
+                << "point query " << q;
+
+        Vec3 d = randomIn(rng, -1.0f, 1.0f);
+        if (q % 5 == 0) d[q % 3] = 0.0f;  // axis-parallel segments: infinite 1 / d
+        d = normalize(d);
+        const float len = 0.05f + 1.5f * rng.uniform();
+        std::vector<uint32_t> hit;
+        bvh.querySegment(p, d, len, [&](uint32_t i) { hit.push_back(i); });
+        std::sort(hit.begin(), hit.end());
+        ASSERT_TRUE(std::adjacent_find(hit.begin(), hit.end()) == hit.end()) << "reported twice";
+        for (uint32_t i = 0; i < boxes.size(); ++i) {
+            if (nearBoundary(p, d, len, boxes[i])) continue;  // float and double may differ
+            const bool meets = segmentMeetsBox(p, d, len, boxes[i]);
+            const bool reported = std::binary_search(hit.begin(), hit.end(), i);
+            if (leafSize == 1 || meets)
+                ASSERT_EQ(meets, reported) << "segment query " << q << " box " << i;
+        }
+    }
+}
+
+}  // namespace
+
+TEST(Bvh, WalksReportExactlyTheBoxesOfThinBeamParts) {
+    Rng rng(11, 1);
+    const std::vector<Bounds3> boxes = beamBoxes(rng, 3000);
+    for (uint32_t leaf : {1u, 4u, 8u}) checkWalks(boxes, leaf, 100 + leaf);
+}
+
+TEST(Bvh, WalksReportExactlyTheBoxesOfSmallCubesAndDegenerateSets) {
+    Rng rng(12, 1);
+    std::vector<Bounds3> cubes;
+    for (int i = 0; i < 2000; ++i) {
+        const Vec3 c = randomIn(rng, 0.0f, 1.0f);
+        Bounds3 b;
+        b.extend(c - Vec3(0.03f, 0.03f, 0.03f));
+        b.extend(c + Vec3(0.03f, 0.03f, 0.03f));
+        cubes.push_back(b);
+    }
+    checkWalks(cubes, 1, 6);
+    checkWalks(cubes, 4, 7);
+    checkWalks({cubes[0]}, 1, 8);  // a leaf root: the only child of node 0
+    // Coincident centres become one leaf whatever its size.
+    checkWalks(std::vector<Bounds3>(50, cubes[1]), 4, 9);
+    Bvh empty;
+    empty.build({});
+    int visits = 0;
+    empty.querySegment(Vec3(0.0f), Vec3(1.0f, 0.0f, 0.0f), 1.0f, [&](uint32_t) { ++visits; });
+    EXPECT_EQ(visits, 0);
+}
+
+TEST(Bvh, SseNodeTestEqualsTheSharedOne) {
+    Rng rng(13, 1);
+    const float inf = std::numeric_limits<float>::infinity();
+    int nanCases = 0;
+    for (int k = 0; k < 200000; ++k) {
+        BvhNode n{};
+        for (int c = 0; c < 4; ++c) {
+            const Vec3 a = randomIn(rng, -1.0f, 1.0f), b = a + randomIn(rng, 0.0f, 0.5f);
+            n.loX[c] = a.x, n.loY[c] = a.y, n.loZ[c] = a.z;
+            n.hiX[c] = b.x, n.hiY[c] = b.y, n.hiZ[c] = b.z;
+            n.child[c] = uint32_t(c);
+            n.count[c] = rng.uniform() < 0.15f ? UB_BVH_NONE : uint32_t(rng.nextU32() % 3);
+        }
+        Vec3 o = randomIn(rng, -1.5f, 1.5f), d = normalize(randomIn(rng, -1.0f, 1.0f));
+        if (k % 3 == 0) d[k % 2] = 0.0f;
+        if (k % 7 == 0) o.x = n.loX[k % 4];  // on a slab plane: 0 * inf = NaN with d.x = 0
+        if (k % 11 == 0) o.y = n.hiY[k % 4];
+        const ub_float3 oo = ub_make_float3(o.x, o.y, o.z);
+        const ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+        const float len = k % 13 == 0 ? inf : 3.0f * rng.uniform();
+        nanCases += (d.x == 0.0f && k % 7 == 0) ? 1 : 0;
+        ASSERT_EQ(bvhMeets4(n, oo, invD, len), ub_bvh_meets(&n, oo, invD, len)) << "case " << k;
+    }
+    EXPECT_GT(nanCases, 1000);
+}
