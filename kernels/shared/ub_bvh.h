@@ -87,6 +87,44 @@ UB_INLINE ub_uint ub_bvh_meets(UB_PRIVATE const ub_bvh_node* n, ub_float3 o, ub_
     return mask;
 }
 
+#ifdef __OPENCL_C_VERSION__
+/* The kernels' ub_bvh_meets: the four children as float4 lanes, read in place from global
+ * memory. The vector selects are component-wise and use the scalar comparisons (false on
+ * NaN), so the mask equals ub_bvh_meets' bit for bit; written so because PoCL runs a
+ * work-item's walk as scalar code and does not vectorise the loop over the children
+ * (measured, docs/performance.md). */
+UB_INLINE ub_uint ub_bvh_meets_global(__global const ub_bvh_node* n, ub_float3 o, ub_float3 invD,
+                                      float len) {
+    float4 t0 = (float4)(0.0f), t1 = (float4)(len);
+    float4 ta = (vload4(0, n->loX) - o.x) * invD.x, tb = (vload4(0, n->hiX) - o.x) * invD.x;
+    float4 near = ta > tb ? tb : ta, far = ta > tb ? ta : tb;
+    t0 = near > t0 ? near : t0;
+    t1 = far < t1 ? far : t1;
+    ta = (vload4(0, n->loY) - o.y) * invD.y;
+    tb = (vload4(0, n->hiY) - o.y) * invD.y;
+    near = ta > tb ? tb : ta;
+    far = ta > tb ? ta : tb;
+    t0 = near > t0 ? near : t0;
+    t1 = far < t1 ? far : t1;
+    ta = (vload4(0, n->loZ) - o.z) * invD.z;
+    tb = (vload4(0, n->hiZ) - o.z) * invD.z;
+    near = ta > tb ? tb : ta;
+    far = ta > tb ? ta : tb;
+    t0 = near > t0 ? near : t0;
+    t1 = far < t1 ? far : t1;
+    int4 hit = (t0 <= t1) & (vload4(0, n->count) != (uint4)(UB_BVH_NONE));
+    return (ub_uint)((hit.x & 1) | (hit.y & 2) | (hit.z & 4) | (hit.w & 8));
+}
+
+/* The kernels' ub_bvh_contains, the same way. */
+UB_INLINE ub_uint ub_bvh_contains_global(__global const ub_bvh_node* n, ub_float3 p) {
+    int4 in = (vload4(0, n->loX) <= p.x) & (vload4(0, n->hiX) >= p.x) & (vload4(0, n->loY) <= p.y) &
+              (vload4(0, n->hiY) >= p.y) & (vload4(0, n->loZ) <= p.z) & (vload4(0, n->hiZ) >= p.z) &
+              (vload4(0, n->count) != (uint4)(UB_BVH_NONE));
+    return (ub_uint)((in.x & 1) | (in.y & 2) | (in.z & 4) | (in.w & 8));
+}
+#endif
+
 /* The photon beam part that counts a pair whose beam parameter is t (each pair once). */
 UB_INLINE int ub_beam_part_holds(ub_beam_part p, float t, float beamLength) {
     return !(t < p.t0 || (t >= p.t1 && p.t1 < beamLength));
