@@ -35,10 +35,10 @@ UB_INLINE int ub_bb1d_pair(ub_beam qb, ub_beam_part part, float radiusSqr, ub_ui
     if (part.mediumId != qb.mediumId) return 0;
     ub_uint length = part.pathLength + qb.pathLength;
     if (length > maxLength || length < minLength) return 0;
-    float d2 = ub_beam_beam_dist2(ub_f3_from(qb.origin), ub_f3_from(qb.dir),
-                                  ub_f3_from(part.origin), ub_f3_from(part.dir), tc, tl, sinTheta);
-    if (d2 < 0.0f || d2 > radiusSqr) return 0;
-    if (*tc < 0.0f || *tc > qb.length || *tl < 0.0f || *tl > part.length) return 0;
+    if (!ub_beam_beam_near(ub_f3_from(qb.origin), ub_f3_from(qb.dir), qb.length,
+                           ub_f3_from(part.origin), ub_f3_from(part.dir), part.length, radiusSqr,
+                           tc, tl, sinTheta))
+        return 0;
     return ub_beam_part_holds(part, *tl, part.length);
 }
 
