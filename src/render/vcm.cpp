@@ -582,10 +582,13 @@ std::string VertexCM::iterationSummary() const {
     std::snprintf(buf, sizeof(buf),
                   "upbp (%s), last iteration: %zu light vertices, %zu photon points, %zu photon "
                   "beam pieces (%d beam paths), %zu query points, %zu query beam pieces; kernel "
-                  "pairs %s; lookups %.3f s, estimates %.3f s",
+                  "pairs %s; lookups %.3f s, estimates %.3f s (%.3g queries/s)",
                   upbp_.describe().c_str(), lightVertices_.size(), photonPoints_.size(),
                   photonBeams_.size(), beamPaths_, queryPoints_.size(), queryBeams_.size(),
-                  pairs.c_str(), lastBuildSeconds_, lastEstimateSeconds_);
+                  pairs.c_str(), lastBuildSeconds_, lastEstimateSeconds_,
+                  lastEstimateSeconds_ > 0.0
+                      ? double(queryPoints_.size() + queryBeams_.size()) / lastEstimateSeconds_
+                      : 0.0);
     return buf + surf;
 }
 
