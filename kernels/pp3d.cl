@@ -60,6 +60,9 @@ __kernel void ub_layout_probe(__global uint* out) {
     ub_beam_part part;
     out[12] = (uint)sizeof(ub_beam_part);
     out[13] = (uint)((__private char*)&part.pathLength - (__private char*)&part);
+    ub_bvh_node node;
+    out[14] = (uint)sizeof(ub_bvh_node);
+    out[15] = (uint)((__private char*)&node.child - (__private char*)&node);
 }
 
 #ifdef UB_FORCE_BUILD_ERROR

@@ -337,7 +337,7 @@ ClRuntime::ClRuntime(int platform, int device, const std::string& cacheDir,
 }
 
 namespace {
-constexpr int kProbeEntries = 14;  // what kernels/pp3d.cl's ub_layout_probe writes
+constexpr int kProbeEntries = 16;  // what kernels/pp3d.cl's ub_layout_probe writes
 }  // namespace
 
 void ClRuntime::checkLayout() {
@@ -372,7 +372,9 @@ void ClRuntime::checkLayout() {
                                          cl_uint(offsetof(ub_surface_query, bsdf.tableIndex)),
                                          cl_uint(offsetof(ub_surface_query, pixel)),
                                          cl_uint(sizeof(ub_beam_part)),
-                                         cl_uint(offsetof(ub_beam_part, pathLength))};
+                                         cl_uint(offsetof(ub_beam_part, pathLength)),
+                                         cl_uint(sizeof(ub_bvh_node)),
+                                         cl_uint(offsetof(ub_bvh_node, child))};
     const char* what[kProbeEntries] = {"sizeof(ub_photon_point)",
                                        "sizeof(ub_query_point)",
                                        "sizeof(ub_beam)",
@@ -386,7 +388,9 @@ void ClRuntime::checkLayout() {
                                        "offsetof(ub_surface_query, bsdf.tableIndex)",
                                        "offsetof(ub_surface_query, pixel)",
                                        "sizeof(ub_beam_part)",
-                                       "offsetof(ub_beam_part, pathLength)"};
+                                       "offsetof(ub_beam_part, pathLength)",
+                                       "sizeof(ub_bvh_node)",
+                                       "offsetof(ub_bvh_node, child)"};
     for (int i = 0; i < kProbeEntries; ++i)
         if (device[i] != host[i])
             throw ClError("OpenCL: device '" + desc_.device +
