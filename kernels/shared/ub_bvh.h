@@ -48,29 +48,29 @@ UB_INLINE ub_uint ub_bvh_contains(UB_PRIVATE const ub_bvh_node* n, ub_float3 p) 
     return mask;
 }
 
-/* Slab test of the segment o + t d, t in [0, len], against one box (invD = 1 / d per axis).
- * NaN (0 * inf, an origin on a slab plane of a flat box) keeps the interval: the selects
- * below pick the other operand when a comparison with NaN is false. No branches: every
- * axis narrows [t0, t1] and one comparison decides. */
+/* One axis of the slab test of a segment against a box, for float or float4 operands (T):
+ * narrows [t0, t1] by the parameters where the segment (origin o, 1 / d = inv on this axis)
+ * crosses the planes lo and hi. NaN (0 * inf, an origin on a slab plane of a flat box) keeps
+ * the interval: the selects pick the other operand when a comparison with NaN is false, and
+ * compile to min/max instructions, so the test has no branches. Vector selects are
+ * component-wise with the same comparisons, so the float4 form gives the scalar result per
+ * lane. */
+#define UB_BVH_SLAB(T, lo, hi, o, inv, t0, t1)                                   \
+    {                                                                            \
+        T ubTa = ((lo) - (o)) * (inv), ubTb = ((hi) - (o)) * (inv);              \
+        T ubNear = ubTa > ubTb ? ubTb : ubTa, ubFar = ubTa > ubTb ? ubTa : ubTb; \
+        t0 = ubNear > t0 ? ubNear : t0;                                          \
+        t1 = ubFar < t1 ? ubFar : t1;                                            \
+    }
+
+/* Slab test of the segment o + t d, t in [0, len], against one box (invD = 1 / d per axis):
+ * every axis narrows [t0, t1] and one comparison decides. */
 UB_INLINE int ub_bvh_box_meets(float loX, float loY, float loZ, float hiX, float hiY, float hiZ,
                                ub_float3 o, ub_float3 invD, float len) {
     float t0 = 0.0f, t1 = len;
-    float ta = (loX - o.x) * invD.x, tb = (hiX - o.x) * invD.x;
-    float near = ta > tb ? tb : ta, far = ta > tb ? ta : tb;
-    t0 = near > t0 ? near : t0;
-    t1 = far < t1 ? far : t1;
-    ta = (loY - o.y) * invD.y;
-    tb = (hiY - o.y) * invD.y;
-    near = ta > tb ? tb : ta;
-    far = ta > tb ? ta : tb;
-    t0 = near > t0 ? near : t0;
-    t1 = far < t1 ? far : t1;
-    ta = (loZ - o.z) * invD.z;
-    tb = (hiZ - o.z) * invD.z;
-    near = ta > tb ? tb : ta;
-    far = ta > tb ? ta : tb;
-    t0 = near > t0 ? near : t0;
-    t1 = far < t1 ? far : t1;
+    UB_BVH_SLAB(float, loX, hiX, o.x, invD.x, t0, t1)
+    UB_BVH_SLAB(float, loY, hiY, o.y, invD.y, t0, t1)
+    UB_BVH_SLAB(float, loZ, hiZ, o.z, invD.z, t0, t1)
     return t0 <= t1;
 }
 
@@ -88,30 +88,16 @@ UB_INLINE ub_uint ub_bvh_meets(UB_PRIVATE const ub_bvh_node* n, ub_float3 o, ub_
 }
 
 #ifdef __OPENCL_C_VERSION__
-/* The kernels' ub_bvh_meets: the four children as float4 lanes, read in place from global
- * memory. The vector selects are component-wise and use the scalar comparisons (false on
- * NaN), so the mask equals ub_bvh_meets' bit for bit; written so because PoCL runs a
+/* The kernels' ub_bvh_meets: the four children as float4 lanes (UB_BVH_SLAB), read in place
+ * from global memory, so the mask equals ub_bvh_meets' bit for bit; written so because PoCL runs a
  * work-item's walk as scalar code and does not vectorise the loop over the children
  * (measured, docs/performance.md). */
 UB_INLINE ub_uint ub_bvh_meets_global(__global const ub_bvh_node* n, ub_float3 o, ub_float3 invD,
                                       float len) {
     float4 t0 = (float4)(0.0f), t1 = (float4)(len);
-    float4 ta = (vload4(0, n->loX) - o.x) * invD.x, tb = (vload4(0, n->hiX) - o.x) * invD.x;
-    float4 near = ta > tb ? tb : ta, far = ta > tb ? ta : tb;
-    t0 = near > t0 ? near : t0;
-    t1 = far < t1 ? far : t1;
-    ta = (vload4(0, n->loY) - o.y) * invD.y;
-    tb = (vload4(0, n->hiY) - o.y) * invD.y;
-    near = ta > tb ? tb : ta;
-    far = ta > tb ? ta : tb;
-    t0 = near > t0 ? near : t0;
-    t1 = far < t1 ? far : t1;
-    ta = (vload4(0, n->loZ) - o.z) * invD.z;
-    tb = (vload4(0, n->hiZ) - o.z) * invD.z;
-    near = ta > tb ? tb : ta;
-    far = ta > tb ? ta : tb;
-    t0 = near > t0 ? near : t0;
-    t1 = far < t1 ? far : t1;
+    UB_BVH_SLAB(float4, vload4(0, n->loX), vload4(0, n->hiX), o.x, invD.x, t0, t1)
+    UB_BVH_SLAB(float4, vload4(0, n->loY), vload4(0, n->hiY), o.y, invD.y, t0, t1)
+    UB_BVH_SLAB(float4, vload4(0, n->loZ), vload4(0, n->hiZ), o.z, invD.z, t0, t1)
     int4 hit = (t0 <= t1) & (vload4(0, n->count) != (uint4)(UB_BVH_NONE));
     return (ub_uint)((hit.x & 1) | (hit.y & 2) | (hit.z & 4) | (hit.w & 8));
 }
