@@ -247,6 +247,12 @@ const std::vector<Case> kCases = {
      {"mesh.obj:10:4: error: at /shapes/0: face corner '3/' ends with '/' (expected v, v/vt, "
       "v//vn or v/vt/vn)",
       "scene.json:3:", "mesh file 'mesh.obj' could not be loaded"}},
+    // Uncaught std::filesystem::filesystem_error: an mtllib name of 300 bytes made the
+    // one-argument is_regular_file throw ENAMETOOLONG (loaders now ask core/file_status.h).
+    {"fuzz_smallupbp_scene",
+     "mtllib-name-too-long.obj",
+     2,
+     {"scene.obj:1:8: error: material library '", "not found (looked for '"}},
     // UBSan (pointer overflow): a shape dictionary entry of 2^64 - 1 wrapped the bound check
     // (offset + 4 > end) and was used as the shape's offset.
     {"fuzz_serialized_mesh",

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "app/commands.h"
+#include "core/file_status.h"
 #include "core/image.h"
 #include "core/image_metrics.h"
 #include "core/ztest.h"
@@ -33,7 +34,7 @@ std::map<std::string, std::string> parseDefines(const std::vector<std::string>& 
 int runCompare(const CompareArgs& args) {
     for (const std::string* f :
          {&args.image, &args.reference, &args.referenceVariance, &args.imageVariance}) {
-        if (!f->empty() && !std::filesystem::is_regular_file(*f))
+        if (!f->empty() && !isRegularFile(*f))
             throw UsageError("compare: file '" + *f + "' does not exist");
     }
     if (args.referenceVariance.empty() &&

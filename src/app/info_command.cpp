@@ -4,12 +4,12 @@
 
 #include "app/commands.h"
 #include "app/scene_access.h"
+#include "core/file_status.h"
 
 namespace ub::app {
 
 int runInfo(const std::string& scenePath, const std::map<std::string, std::string>& defines) {
-    if (!std::filesystem::exists(scenePath))
-        throw UsageError("scene file '" + scenePath + "' does not exist");
+    if (!pathExists(scenePath)) throw UsageError("scene file '" + scenePath + "' does not exist");
     std::unique_ptr<Scene> scene = loadSceneFile(scenePath, defines);
     std::string text = sceneDescription(*scene);
     std::fputs(text.c_str(), stdout);

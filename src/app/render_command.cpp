@@ -14,6 +14,7 @@
 #include "app/progress_bar.h"
 #include "app/scene_access.h"
 #include "core/error.h"
+#include "core/file_status.h"
 #include "core/image.h"
 #include "core/memory_budget.h"
 #include "render/checkpoint.h"
@@ -178,7 +179,7 @@ int runRender(const RenderArgs& args) {
     if (args.pngLayers && args.pngPath.empty())
         throw UsageError("--png-layers: needs --png FILE.png (the layers go beside it)");
     if (!args.variancePath.empty()) checkOutputPath(args.variancePath, ".exr", "--variance");
-    if (!fs::exists(args.scene)) throw UsageError("scene file '" + args.scene + "' does not exist");
+    if (!pathExists(args.scene)) throw UsageError("scene file '" + args.scene + "' does not exist");
 
     std::unique_ptr<tbb::global_control> threadLimit;
     if (args.threads > 0)
@@ -212,7 +213,7 @@ int runRender(const RenderArgs& args) {
     }
     if (!checkpointPath.empty()) checkOutputPath(checkpointPath, "", "--checkpoint");
     if (!args.resumePath.empty()) {
-        if (!fs::is_regular_file(args.resumePath))
+        if (!isRegularFile(args.resumePath))
             throw UsageError("--resume: checkpoint '" + args.resumePath + "' does not exist");
         resumed = std::make_unique<ProgressiveState>(readCheckpoint(args.resumePath, header));
         std::fprintf(stderr, "unibeam: resuming %s: %d iterations, %.1f s done\n",

@@ -27,6 +27,7 @@
 #include "app/commands.h"
 #include "app/scene_access.h"
 #include "core/error.h"
+#include "core/file_status.h"
 #include "core/image.h"
 #include "core/image_metrics.h"
 #include "render/film.h"
@@ -302,8 +303,8 @@ int runStudy(const StudyArgs& args) {
     }
     if ((args.timeSeconds > 0) == (args.iterations > 0))
         throw UsageError("study: give exactly one of --time SECONDS and --iterations N");
-    if (!fs::exists(args.scene)) throw UsageError("scene file '" + args.scene + "' does not exist");
-    if (!args.reference.empty() && !fs::is_regular_file(args.reference))
+    if (!pathExists(args.scene)) throw UsageError("scene file '" + args.scene + "' does not exist");
+    if (!args.reference.empty() && !isRegularFile(args.reference))
         throw UsageError("--reference: file '" + args.reference + "' does not exist");
     const fs::path dir(args.outDir);
     std::error_code ec;
@@ -402,7 +403,7 @@ int runStudy(const StudyArgs& args) {
     std::string plotOutput;
     int status = -1;
     for (const char* python : {"/usr/bin/python3", "python3"}) {
-        if (python[0] == '/' && !fs::exists(python)) continue;
+        if (python[0] == '/' && !pathExists(python)) continue;
         const std::string cmd =
             std::string(python) + " '" + script.string() + "' '" + dir.string() + "' 2>&1";
         plotOutput.clear();
@@ -414,7 +415,7 @@ int runStudy(const StudyArgs& args) {
         if (status == 0) break;
     }
     fs::remove(script, ec);
-    const bool havePlot = status == 0 && fs::is_regular_file(dir / "convergence.png");
+    const bool havePlot = status == 0 && isRegularFile(dir / "convergence.png");
     std::string plotNote;
     if (!havePlot) {
         plotNote =

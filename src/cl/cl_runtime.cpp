@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "cl/embedded_kernels.h"
+#include "core/file_status.h"
 #include "estimators/bvh.h"
 #include "estimators/hash_grid.h"
 
@@ -292,7 +293,7 @@ ClRuntime::ClRuntime(int platform, int device, const std::string& cacheDir,
             if (program_) clReleaseProgram(program_);
             program_ = nullptr;  // a stale or corrupt entry: rebuilt and replaced below
         }
-    } else if (!cachePath.empty() && std::filesystem::exists(cachePath)) {
+    } else if (!cachePath.empty() && pathExists(cachePath)) {
         programNote_ = "corrupt program cache entry " + cachePath + " rebuilt";
     }
     if (!program_) {

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/file_status.h"
 
 namespace ub {
 
@@ -106,7 +107,7 @@ void checkExrHeader(const std::string& path) {
 }  // namespace
 
 Image readExr(const std::string& path, ImageMetadata* metadata) {
-    if (!std::filesystem::exists(path)) throw InputError(path, "image file does not exist");
+    if (!pathExists(path)) throw InputError(path, "image file does not exist");
     checkExrHeader(path);
     // OpenEXR sizes its line-offset table and buffers from the header's windows when the file
     // is opened, before our check below: bound them there too (found by fuzz_exr_image: a
@@ -269,8 +270,7 @@ void checkPngChunks(const std::string& path, FILE* fp) {
 }  // namespace
 
 Image readPng(const std::string& path, bool linearize) {
-    if (!std::filesystem::is_regular_file(path))
-        throw InputError(path, "image file does not exist");
+    if (!isRegularFile(path)) throw InputError(path, "image file does not exist");
     FILE* fp = std::fopen(path.c_str(), "rb");
     if (!fp) throw InputError(path, "cannot open the PNG image");
     unsigned char sig[8] = {};

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/file_status.h"
 #include "core/image.h"
 
 namespace ub {
@@ -45,8 +46,7 @@ void jpegEmitMessage(j_common_ptr cinfo, int level) {
 }  // namespace
 
 Image readJpeg(const std::string& path, bool linearize) {
-    if (!std::filesystem::is_regular_file(path))
-        throw InputError(path, "image file does not exist");
+    if (!isRegularFile(path)) throw InputError(path, "image file does not exist");
     std::ifstream f(path, std::ios::binary);
     if (!f) throw InputError(path, "cannot open the JPEG image");
     const std::vector<unsigned char> file((std::istreambuf_iterator<char>(f)),

@@ -42,6 +42,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/file_status.h"
 #include "core/image.h"
 
 namespace ub {
@@ -126,8 +127,7 @@ bool pnmHeaderNumbersFit(const std::vector<unsigned char>& d, std::string* why) 
 }  // namespace
 
 Image readStbImage(const std::string& path, bool linearize) {
-    if (!std::filesystem::is_regular_file(path))
-        throw InputError(path, "image file does not exist");
+    if (!isRegularFile(path)) throw InputError(path, "image file does not exist");
     std::ifstream f(path, std::ios::binary);
     std::vector<unsigned char> data((std::istreambuf_iterator<char>(f)),
                                     std::istreambuf_iterator<char>());

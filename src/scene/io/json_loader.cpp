@@ -12,6 +12,7 @@
 #include <limits>
 #include <sstream>
 
+#include "core/file_status.h"
 #include "core/image.h"
 #include "scene/io/json_scene_parts.h"
 
@@ -238,7 +239,7 @@ void readLight(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
         std::string filePtr = jsonPointerChild(ptr, "file");
         if (!file.empty()) {
             std::string path = resolveScenePath(parts.baseDir, file);
-            if (!fs::is_regular_file(path)) {
+            if (!isRegularFile(path)) {
                 r.error(filePtr, "environment map '" + file + "' not found (looked for '" + path +
                                      "'; paths are relative to the scene file)");
             } else {
@@ -406,7 +407,7 @@ std::unique_ptr<Scene> loadJsonSceneFromString(const std::string& text, const st
 
 std::unique_ptr<Scene> loadJsonScene(const std::string& path, std::vector<Diagnostic>* warnings) {
     std::ifstream in(path, std::ios::binary);
-    if (!fs::is_regular_file(path) || !in)
+    if (!isRegularFile(path) || !in)
         throw InputError(path, "cannot open the scene file (not found or not readable)");
     std::stringstream ss;
     ss << in.rdbuf();

@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 
+#include "core/file_status.h"
 #include "scene/albedo_grid.h"
 #include "scene/io/json_scene_parts.h"
 #include "scene/vdb_grid.h"
@@ -70,7 +71,7 @@ bool loadVdbFile(JsonReader& r, const JsonSceneParts& parts, const std::string& 
     std::string path = resolveScenePath(parts.baseDir, file);
     if (fs::path(file).extension() != ".vdb") {
         r.error(filePtr, "a heterogeneous medium needs a .vdb file, got '" + file + "'");
-    } else if (!fs::is_regular_file(path)) {
+    } else if (!isRegularFile(path)) {
         r.error(filePtr, "VDB file '" + file + "' not found (looked for '" + path +
                              "'; paths are relative to the scene file)");
     } else {

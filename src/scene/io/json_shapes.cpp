@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <utility>
 
+#include "core/file_status.h"
 #include "scene/io/json_scene_parts.h"
 #include "scene/mesh_io.h"
 #include "scene/shapes.h"
@@ -312,7 +313,7 @@ void readShape(JsonReader& r, const Json& v, const std::string& ptr, size_t inde
                 if (ext != "." + type) {
                     r.error(filePtr, "a shape of type '" + type + "' needs a ." + type +
                                          " file, got '" + file + "'");
-                } else if (!fs::is_regular_file(path)) {
+                } else if (!isRegularFile(path)) {
                     r.error(filePtr, "mesh file '" + file + "' not found (looked for '" + path +
                                          "'; paths are relative to the scene file)");
                 } else {

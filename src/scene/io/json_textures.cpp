@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "core/file_status.h"
 #include "core/image.h"
 #include "scene/io/json_scene_parts.h"
 
@@ -98,7 +99,7 @@ std::shared_ptr<const Image> loadBitmap(JsonReader& r, const std::string& file, 
                              "; EXR and RGBE are linear, the others sRGB unless raw)");
         return nullptr;
     }
-    if (!fs::is_regular_file(path)) {
+    if (!isRegularFile(path)) {
         r.error(filePtr, "bitmap '" + file + "' not found (looked for '" + path +
                              "'; paths are relative to the scene file)");
         return nullptr;

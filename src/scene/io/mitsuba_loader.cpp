@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <set>
 
+#include "core/file_status.h"
 #include "core/image.h"
 #include "scene/io/mitsuba_build.h"
 #include "scene/mesh_io.h"
@@ -1050,7 +1051,7 @@ std::unique_ptr<Scene> loadMitsubaScene(const std::string& path,
                                         const std::map<std::string, std::string>& defines,
                                         std::vector<Diagnostic>* warnings) {
     Diagnostics diags;
-    if (!fs::is_regular_file(path))
+    if (!isRegularFile(path))
         throw InputError(path, "cannot open the scene file (not found or not a file)");
     XmlScene xml = parseMitsubaXml(path, defines, diags);
     return buildFromXml(xml, diags, warnings);

@@ -3,6 +3,7 @@
 #include <cctype>
 #include <filesystem>
 
+#include "core/file_status.h"
 #include "scene/io/json_loader.h"
 #include "scene/io/mitsuba_loader.h"
 #include "scene/io/smallupbp_loader.h"
@@ -34,8 +35,7 @@ std::unique_ptr<Scene> loadScene(const std::string& path,
             throw InputError(path, "scene parameters (-D " + defines.begin()->first +
                                        "=...) apply only to Mitsuba .xml scenes");
         // A SmallUPBP scene: X.obj with X.obj.aux beside it (scene/io/smallupbp_loader.h).
-        if (std::filesystem::is_regular_file(path + ".aux"))
-            return loadSmallUpbpScene(path, warnings);
+        if (isRegularFile(path + ".aux")) return loadSmallUpbpScene(path, warnings);
         throw InputError(path,
                          "an .obj scene is read in SmallUPBP's format, which needs the file '" +
                              std::filesystem::path(path).filename().string() +

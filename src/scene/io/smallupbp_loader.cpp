@@ -30,6 +30,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "core/file_status.h"
 #include "core/image.h"
 #include "scene/io/json_reader.h"
 #include "scene/io/smallupbp_boundary.h"
@@ -225,7 +226,7 @@ bool buildAuxLight(const UpbpLight& u, Light* l, Context& ctx) {
             l->type = LightType::EnvMap;
             l->name = "light_background_em";
             l->radiance = Rgb(u.envScale);
-            if (!std::filesystem::is_regular_file(u.envMapPath)) {
+            if (!isRegularFile(u.envMapPath)) {
                 ctx.auxError(u.pos, "environment map '" + u.envMapName +
                                         "' not found (looked for '" + u.envMapPath +
                                         "'; relative paths start at the .aux file)");

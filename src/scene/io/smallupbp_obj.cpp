@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "core/file_status.h"
 #include "scene/io/json_reader.h"
 #include "scene/io/smallupbp_files.h"
 
@@ -151,7 +152,7 @@ void ObjParser::materialLibrary(const ObjLine& l, const char* p, const std::stri
     }
     namespace fs = std::filesystem;
     const std::string mtlPath = (fs::path(path_).parent_path() / name).string();
-    if (!fs::is_regular_file(mtlPath)) {
+    if (!isRegularFile(mtlPath)) {
         error(l, after - name.size(),
               "material library '" + name + "' not found (looked for '" + mtlPath +
                   "'; SmallUPBP reads it from the folder of the .obj)");
