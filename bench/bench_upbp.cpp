@@ -123,6 +123,15 @@ int main(int argc, char** argv) {
                 std::fprintf(stderr, "bench_upbp: --resolution expects WxH\n");
                 return 2;
             }
+        } else if (a == "--help" || a == "-h") {
+            std::printf(
+                "usage: bench_upbp [--runs N] [--sets s1,s2,...] [--backends host,opencl] "
+                "[--resolution WxH] [--radius-of media|scene] [SCENE ...]\n");
+            return 0;
+        } else if (!a.empty() && a[0] == '-') {
+            std::fprintf(stderr, "bench_upbp: unknown option '%s' (or missing value; --help)\n",
+                         a.c_str());
+            return 2;
         } else {
             scenes.push_back(a);
         }

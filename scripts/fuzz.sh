@@ -10,13 +10,17 @@
 #     input is in build-fuzz/artifacts/<target>/, the report in build-fuzz/logs/<target>.log.
 # Usage: scripts/fuzz.sh [SECONDS_PER_TARGET]   (default 30)
 # Environment: FUZZ_TARGETS (space-separated subset), JOBS (compile jobs, default 2),
-#   FUZZ_TIMEOUT (seconds one input may take before it counts as a hang, default 10).
+#   FUZZ_TIMEOUT (seconds one input may take before it counts as a hang, default 10),
+#   FUZZ_SEED (libFuzzer's -seed, default 1: the same inputs in the same order on every run
+#   from a fresh corpus, so that what CI's short run finds is found again by the same command;
+#   0 draws a new seed per run, for exploratory fuzzing).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 SECONDS_PER_TARGET="${1:-30}"
 JOBS="${JOBS:-2}"
 FUZZ_TIMEOUT="${FUZZ_TIMEOUT:-10}"
+FUZZ_SEED="${FUZZ_SEED:-1}"
 ALL_TARGETS="fuzz_json_scene fuzz_mitsuba_scene fuzz_smallupbp_scene fuzz_vol_grid fuzz_mesh_obj fuzz_mesh_ply fuzz_serialized_mesh fuzz_exr_image fuzz_png_image fuzz_jpeg_image fuzz_stb_image"
 TARGETS="${FUZZ_TARGETS:-$ALL_TARGETS}"
 
@@ -67,7 +71,7 @@ for t in $TARGETS; do
   # chunk or attribute header announced; the readers now check those sizes first,
   # docs/fuzzing.md.)
   rss=2048
-  if "$bin" -max_total_time="$SECONDS_PER_TARGET" -timeout="$FUZZ_TIMEOUT" -rss_limit_mb="$rss" \
+  if "$bin" -seed="$FUZZ_SEED" -max_total_time="$SECONDS_PER_TARGET" -timeout="$FUZZ_TIMEOUT" -rss_limit_mb="$rss" \
     -malloc_limit_mb=2048 \
     -print_final_stats=1 -artifact_prefix="build-fuzz/artifacts/$t/" \
     "build-fuzz/corpus/$t" "build-fuzz/seeds/$t" >>"$log" 2>&1; then

@@ -276,6 +276,14 @@ const std::vector<Case> kCases = {
      2,
      {"scene.json:3:", "cannot read bitmap 'image.ppm'",
       "PNM header height has 29 digits (expected at most 9)"}},
+    // Hang (CI's fuzz run, a timeout): stb_image's run-length RGBE decoder loops for ever on
+    // a packet of count 0, which is what it reads past the end of a truncated file.
+    {"fuzz_stb_image",
+     "rgbe-rle-truncated-hang.bin",
+     2,
+     {"scene.json:3:", "cannot read bitmap 'image.hdr'",
+      "the image data ends before the image does (truncated file; in the run-length data of "
+      "row 0)"}},
     // A seed (tests/data/mitsuba/media.xml with its include): UBSan's alignment check in
     // oneTBB's concurrent_hash_map under OpenVDB (fuzz/ubsan_ignorelist.txt); it loads.
     {"fuzz_mitsuba_scene", "tbb-hash-map-sentinel-downcast.xml", 0, {}},

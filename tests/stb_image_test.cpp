@@ -126,6 +126,85 @@ TEST(StbImage, TruncatedCorruptAndUnknownFilesAreErrors) {
     EXPECT_NE(e.find("image file does not exist"), std::string::npos) << e;
 }
 
+/// An 8-bit grey RLE TGA (image type 11) of w x h pixels whose data is `packets` run packets
+/// of 128 pixels of value 200 (a packet header byte 0xFF and one value byte).
+std::string greyRleTga(uint16_t w, uint16_t h, int packets) {
+    std::string s;
+    s.push_back(0);     // no image ID
+    s.push_back(0);     // no colour map
+    s.push_back(11);    // RLE grey
+    s.append(5, '\0');  // colour map specification
+    put16(&s, 0);       // x origin
+    put16(&s, 0);       // y origin
+    put16(&s, w);
+    put16(&s, h);
+    s.push_back(8);  // bits per pixel
+    s.push_back(0);  // descriptor
+    for (int i = 0; i < packets; ++i) s += "\xFF\xC8";
+    return s;
+}
+
+// The header's pixel count is checked against what the file can hold before stb allocates
+// and decodes: 64 pixels per byte (TGA's densest run packets) plus 4096. A run-length TGA at
+// that density reads; one announcing more pixels than its bytes can hold is an error, not
+// two decodes of millions of pixels of padding.
+TEST(StbImage, HeaderPixelCountIsBoundedByTheFileSize) {
+    // 1024 x 128 pixels in 1024 packets: 2066 bytes, 63 pixels per byte.
+    Image dense = readBitmapFile(writeTemp("dense.tga", greyRleTga(1024, 128, 1024)), false);
+    ASSERT_EQ(dense.width, 1024);
+    ASSERT_EQ(dense.height, 128);
+    EXPECT_NEAR(dense.at(1023, 127).x, 200.0f / 255.0f, 1e-6f);
+    // 1024 x 256 pixels announced by a 2066-byte file: at most 64 * 2066 + 4096 = 136320 can
+    // be held.
+    const std::string e = errorOf(writeTemp("sparse.tga", greyRleTga(1024, 256, 1024)));
+    EXPECT_NE(e.find("sparse.tga"), std::string::npos) << e;
+    EXPECT_NE(e.find("the header announces 1024 x 256 pixels, more than a 2066-byte file can "
+                     "hold"),
+              std::string::npos)
+        << e;
+}
+
+/// A Radiance RGBE file of one row of 8 pixels, stored run-length encoded: each of the four
+/// channel planes one run packet of 8 pixels (0x88, value), mantissas 128, 64, 32 and
+/// exponent 129 (so RGB 1, 0.5, 0.25).
+std::string rleRgbeRow8() {
+    std::string s = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 8\n";
+    for (int v : {2, 2, 0, 8}) s.push_back(char(v));  // a run-length row of width 8
+    for (int v : {128, 64, 32, 129}) {
+        s.push_back(char(0x88));
+        s.push_back(char(v));
+    }
+    return s;
+}
+
+// stb_image v2.27 loops for ever on a run-length packet of count 0, and it reads zeros past
+// the end of the data: a truncated run-length RGBE file hung the reader (fuzz_stb_image in
+// CI). The run lengths are walked first; a run-length file that ends early or holds a zero
+// packet is an error, and a whole one still reads.
+TEST(StbImage, RunLengthRgbeThatEndsEarlyOrHasAZeroPacketIsAnError) {
+    const std::string full = rleRgbeRow8();
+    Image img = readBitmapFile(writeTemp("row.hdr", full), true);
+    ASSERT_EQ(img.width, 8);
+    expectRgb(img.at(7, 0), 1.0f, 0.5f, 0.25f);
+    // Cut inside the third channel plane (its count byte is the last one left).
+    std::string e = errorOf(writeTemp("cut.hdr", full.substr(0, full.size() - 3)));
+    EXPECT_NE(e.find("cut.hdr"), std::string::npos) << e;
+    EXPECT_NE(e.find("the image data ends before the image does (truncated file; in the "
+                     "run-length data of row 0)"),
+              std::string::npos)
+        << e;
+    // The second plane's packet replaced by a dump of 0 bytes.
+    std::string zero = full;
+    const size_t second = full.size() - 6;
+    zero[second] = 0;
+    e = errorOf(writeTemp("zero.hdr", zero));
+    EXPECT_NE(e.find("zero.hdr"), std::string::npos) << e;
+    EXPECT_NE(e.find("corrupt run-length data: a packet of length 0 at byte " +
+                     std::to_string(second) + " (row 0, channel 1)"),
+              std::string::npos)
+        << e;
+}
+
 TEST(StbImage, MitsubaBitmapTextureReadsBmp) {
     const std::string path = writeTemp("tex.bmp", bmp2x2());
     const std::string dir = fs::path(path).parent_path().string();

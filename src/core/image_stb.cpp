@@ -9,9 +9,10 @@
 // reported as truncated instead of becoming a texture with black rows.
 //
 // stb_image allocates the image a header announces before reading its data, so the size is
-// checked first (stbi_info): no format read here packs more than about 400 pixels into a
-// byte (BMP's RLE8 at best: 255 pixels in 2 bytes), so a header announcing more than 1024
-// pixels per byte of file is an error rather than a gigabyte allocation.
+// checked first (stbi_info) against the most pixels a byte of each format can hold in stb's
+// decoders (maxPixelsPerByte): a header announcing more is an error rather than a large
+// allocation and two long decodes of padding (a 4 KB TGA announcing 4 M pixels took 1.4 s
+// under the fuzz build, and the fuzz run's 10 s limit was hit on such an input in CI).
 #define STB_IMAGE_IMPLEMENTATION
 #define STB_IMAGE_STATIC
 #define STBI_ONLY_BMP
@@ -96,6 +97,73 @@ bool decode(const std::vector<unsigned char>& data, size_t size, bool isHdr, Dec
     return n >= 1 && n <= 4 ? true : (*why = "unexpected channel count", false);
 }
 
+/// The most pixels one byte of the file can hold in stb_image v2.27's decoders, by the
+/// format stb will find in it (stb goes by the content, not the name: BMP's "BM", PNM's
+/// "P5"/"P6", the RGBE signature, and TGA, which has none, last):
+///   * BMP: 1 bit per pixel (stb rejects BMP's RLE compression): 8;
+///   * PNM (P5/P6, 8 or 16 bits per sample): 1;
+///   * Radiance RGBE: a run of 127 pixels takes 2 bytes in each of the 4 channel planes,
+///     127 / 8 ≈ 16; 32 leaves room;
+///   * TGA: an RLE packet of 128 8-bit pixels takes 2 bytes: 64.
+double maxPixelsPerByte(const std::vector<unsigned char>& d, bool isHdr) {
+    if (isHdr) return 32.0;
+    if (d.size() >= 2 && d[0] == 'B' && d[1] == 'M') return 8.0;
+    if (d.size() >= 2 && d[0] == 'P' && (d[1] == '5' || d[1] == '6')) return 1.0;
+    return 64.0;
+}
+
+/// Radiance RGBE run-length data is walked here before stb decodes it: stb_image v2.27's RLE
+/// decoder loops for ever on a packet of count 0 (a "dump" of no bytes makes no progress),
+/// and it reads 0 past the end of the data, so every truncated run-length file hung the
+/// reader (found by fuzz_stb_image in CI: a timeout). This follows stb's reading exactly
+/// (header lines up to the first empty one, the resolution line, then per scanline the
+/// 2, 2, length header or flat data, and per channel the run and dump packets) and stops
+/// where stb would report an error or read flat pixels. True if stb will not meet a count
+/// of 0; otherwise *why says where. w is the width stbi_info reported.
+bool hdrRunLengthsEnd(const std::vector<unsigned char>& d, int w, int h, std::string* why) {
+    size_t pos = 0;
+    const size_t n = d.size();
+    auto get8 = [&]() -> int { return pos < n ? d[pos++] : (++pos, 0); };
+    // The data begin after the line that follows the first empty line.
+    size_t p = 0;
+    while (p + 1 < n && !(d[p] == '\n' && d[p + 1] == '\n')) ++p;
+    if (p + 1 >= n) return true;  // stb reports the header
+    p += 2;
+    while (p < n && d[p] != '\n') ++p;
+    pos = p + 1;
+    if (w < 8 || w >= 32768) return true;  // stored flat: read linearly
+    for (int j = 0; j < h; ++j) {
+        const int c1 = get8(), c2 = get8();
+        int len = get8();
+        if (c1 != 2 || c2 != 2 || (len & 0x80)) return true;  // flat from here on
+        len = (len << 8) | get8();
+        if (len != w) return true;  // stb: "invalid decoded scanline length"
+        for (int k = 0; k < 4; ++k) {
+            for (int i = 0; i < w;) {
+                const size_t at = pos;
+                int count = get8();
+                if (count > 128) {
+                    get8();
+                    count -= 128;
+                } else if (count == 0) {
+                    *why = at >= n ? "the image data ends before the image does (truncated "
+                                     "file; in the run-length data of row " +
+                                         std::to_string(j) + ")"
+                                   : "corrupt run-length data: a packet of length 0 at byte " +
+                                         std::to_string(at) + " (row " + std::to_string(j) +
+                                         ", channel " + std::to_string(k) + ")";
+                    return false;
+                } else {
+                    pos += size_t(count);
+                }
+                if (count > w - i) return true;  // stb: "bad RLE data in HDR"
+                i += count;
+            }
+        }
+    }
+    return true;
+}
+
 /// PNM (P5/P6) headers are checked before stb parses them: stb reads each header number
 /// into an int without an overflow check (signed overflow, undefined behaviour, found by
 /// fuzz_stb_image), so a number of more than 9 digits is an error here. True if the data
@@ -150,10 +218,11 @@ Image readStbImage(const std::string& path, bool linearize) {
     if (!stbi_info_from_memory(data.data(), int(size), &w, &h, &n))
         throw InputError(path, "cannot decode the " + ext.substr(ext.empty() ? 0 : 1) +
                                    " image: " + stbi_failure_reason());
-    if (double(w) * double(h) > 1024.0 * double(size) + 4096.0)
+    if (double(w) * double(h) > maxPixelsPerByte(data, isHdr) * double(size) + 4096.0)
         throw InputError(path, "the header announces " + std::to_string(w) + " x " +
                                    std::to_string(h) + " pixels, more than a " +
                                    std::to_string(size) + "-byte file can hold");
+    if (isHdr && !hdrRunLengthsEnd(data, w, h, &why)) throw InputError(path, why);
     Decoded plain, padded;
     // The second decode sees the same bytes followed by 0xFF (stb reads 0 past the end).
     std::vector<unsigned char> withPad(data);
