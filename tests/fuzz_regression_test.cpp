@@ -284,6 +284,14 @@ const std::vector<Case> kCases = {
      {"scene.json:3:", "cannot read bitmap 'image.hdr'",
       "the image data ends before the image does (truncated file; in the run-length data of "
       "row 0)"}},
+    // Out of memory (fuzz_stb_image with long inputs): stbi_info gives a top-down BMP's
+    // height negative, so the signed pixel count passed the size bound, and stb allocated
+    // 8192 x 50527 x 3 bytes for a 31-byte file.
+    {"fuzz_stb_image",
+     "bmp-negative-height-1gb.bin",
+     2,
+     {"scene.json:3:", "cannot read bitmap 'image.bmp'",
+      "the header announces 8192 x 50527 pixels, more than a 31-byte file can hold"}},
     // A seed (tests/data/mitsuba/media.xml with its include): UBSan's alignment check in
     // oneTBB's concurrent_hash_map under OpenVDB (fuzz/ubsan_ignorelist.txt); it loads.
     {"fuzz_mitsuba_scene", "tbb-hash-map-sentinel-downcast.xml", 0, {}},

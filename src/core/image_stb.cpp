@@ -34,6 +34,7 @@
 #endif
 
 #include <cctype>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -218,9 +219,13 @@ Image readStbImage(const std::string& path, bool linearize) {
     if (!stbi_info_from_memory(data.data(), int(size), &w, &h, &n))
         throw InputError(path, "cannot decode the " + ext.substr(ext.empty() ? 0 : 1) +
                                    " image: " + stbi_failure_reason());
-    if (double(w) * double(h) > maxPixelsPerByte(data, isHdr) * double(size) + 4096.0)
+    // stbi_info gives a top-down BMP's height as stored, negative; stb's decoder takes its
+    // absolute value (fuzz_stb_image: a 31-byte BMP announcing 8192 x -50527 pixels passed the
+    // bound signed and made stb allocate 1.2 GB).
+    if (std::fabs(double(w)) * std::fabs(double(h)) >
+        maxPixelsPerByte(data, isHdr) * double(size) + 4096.0)
         throw InputError(path, "the header announces " + std::to_string(w) + " x " +
-                                   std::to_string(h) + " pixels, more than a " +
+                                   std::to_string(std::llabs(h)) + " pixels, more than a " +
                                    std::to_string(size) + "-byte file can hold");
     if (isHdr && !hdrRunLengthsEnd(data, w, h, &why)) throw InputError(path, why);
     Decoded plain, padded;
