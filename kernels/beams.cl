@@ -26,9 +26,10 @@
 /* The walk of kernels/shared/ub_bvh.h, in the host twin's order (src/estimators/bvh.h): pop
  * a node; MASK (an expression of `n`, the node in global memory) gives the children that pass;
  * runs the block after it for the primitives of those that are leaves, child 0 first, with
- * `k` the index into prims (`continue` in it skips a primitive; variadic, so that commas in
- * the block are no macro argument separators); pushes those that are inner nodes, child 3
- * first. */
+ * `k` the index of the item (the items are in the BVH's leaf order, Bvh::permuteToLeafOrder,
+ * so a leaf's entries are items, read without an index array; `continue` in the block skips
+ * a primitive; variadic, so that commas in the block are no macro argument separators);
+ * pushes those that are inner nodes, child 3 first. */
 #define UB_BVH_WALK(nodes, MASK, ...)                                                            \
     {                                                                                            \
         uint ubStack[UB_BVH_STACK];                                                              \
@@ -50,7 +51,7 @@
 
 /* pb2d: query beams x photon points (BVH over the photons' kernel spheres). */
 __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
-                               __global const ub_bvh_node* nodes, __global const uint* prims,
+                               __global const ub_bvh_node* nodes,
                                __global const ub_grid_info* grids, __global const uchar* gridData,
                                __global const ub_beam* queries, uint queryCount,
                                __global const ub_medium_info* media, ub_mis_constants mis,
@@ -69,7 +70,7 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     ub_uint tableState = UB_TABLE_UNBUILT;
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     UB_BVH_WALK(nodes, ub_bvh_meets_global(n, o, invD, qb.length), {
-        ub_photon_point ph = photons[prims[k]];
+        ub_photon_point ph = photons[k];
         float t = 0.0f;
         if (!ub_pb2d_pair(ph, qb, radius * radius, minLength, maxLength, &t)) continue;
         ub_segment_eval s =
@@ -86,8 +87,7 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
 __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_beam_part* parts,
                                __global const ub_beam_piece* beamPieces,
                                __global const uint* beamRanges, __global const ub_bvh_node* nodes,
-                               __global const uint* prims, __global const ub_grid_info* grids,
-                               __global const uchar* gridData,
+                               __global const ub_grid_info* grids, __global const uchar* gridData,
                                __global const ub_query_point* queries, uint queryCount,
                                __global const ub_medium_info* media, ub_mis_constants mis,
                                float radius, float normalization, uint minLength, uint maxLength,
@@ -102,7 +102,7 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
     ub_float3 p = ub_f3_from(q.pos);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     UB_BVH_WALK(nodes, ub_bvh_contains_global(n, p), {
-        ub_beam_part part = parts[prims[k]];
+        ub_beam_part part = parts[k];
         float t = 0.0f;
         if (!ub_bp2d_pair(q, part, radius * radius, minLength, maxLength, &t)) continue;
         ub_beam pb = beams[part.beam];
@@ -121,11 +121,11 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
 __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_beam_part* parts,
                                __global const ub_beam_piece* beamPieces,
                                __global const uint* beamRanges, __global const ub_bvh_node* nodes,
-                               __global const uint* prims, __global const ub_grid_info* grids,
-                               __global const uchar* gridData, __global const ub_beam* queries,
-                               uint queryCount, __global const ub_medium_info* media,
-                               ub_mis_constants mis, float radius, float normalization,
-                               uint minLength, uint maxLength, __global float* out) {
+                               __global const ub_grid_info* grids, __global const uchar* gridData,
+                               __global const ub_beam* queries, uint queryCount,
+                               __global const ub_medium_info* media, ub_mis_constants mis,
+                               float radius, float normalization, uint minLength, uint maxLength,
+                               __global float* out) {
     uint i = get_global_id(0);
     if (i >= queryCount) return;
     ub_beam qb = queries[i];
@@ -139,7 +139,7 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
     ub_uint tableState = UB_TABLE_UNBUILT;
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     UB_BVH_WALK(nodes, ub_bvh_meets_global(n, o, invD, qb.length), {
-        ub_beam_part part = parts[prims[k]];
+        ub_beam_part part = parts[k];
         float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
         if (!ub_bb1d_pair(qb, part, radius * radius, minLength, maxLength, &tc, &tl, &sinTheta))
             continue;

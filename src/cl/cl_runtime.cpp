@@ -11,6 +11,8 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include "cl/embedded_kernels.h"
 #include "core/file_status.h"
@@ -598,6 +600,16 @@ void ClRuntime::estimateSurf(const std::vector<LightVertex>& photons, const Hash
                 bufferArg(queries), queries.size(), a, out);
 }
 
+namespace {
+/// The beam kernels read a leaf's entry k as item k (kernels/beams.cl): the items must be in
+/// the BVH's leaf order (Bvh::permuteToLeafOrder).
+void requireLeafOrder(const Bvh& bvh, const char* estimator) {
+    if (!bvh.leafOrdered())
+        throw std::logic_error(std::string(estimator) +
+                               " kernel given a BVH whose items are not in leaf order");
+}
+}  // namespace
+
 void ClRuntime::estimatePP3D(const std::vector<ub_photon_point>& photons, const HashGrid& grid,
                              const std::vector<ub_query_point>& queries, const EstimateArgs& a,
                              std::vector<Rgb>* out) {
@@ -612,11 +624,10 @@ void ClRuntime::estimatePB2D(const std::vector<ub_photon_point>& photons, const 
                              const std::vector<ub_beam>& queries, const EstimateArgs& a,
                              std::vector<Rgb>* out) {
     if (photons.empty() || spheres.empty()) return out->assign(queries.size(), Rgb(0.0f));
-    runEstimate(
-        pb2d_, "clEnqueueNDRangeKernel(ub_pb2d_estimate)",
-        withGrids({bufferArg(photons), bufferArg(spheres.nodes()), bufferArg(spheres.prims())},
-                  gridArgs(a)),
-        bufferArg(queries), queries.size(), a, out);
+    requireLeafOrder(spheres, "pb2d");
+    runEstimate(pb2d_, "clEnqueueNDRangeKernel(ub_pb2d_estimate)",
+                withGrids({bufferArg(photons), bufferArg(spheres.nodes())}, gridArgs(a)),
+                bufferArg(queries), queries.size(), a, out);
 }
 
 void ClRuntime::estimateBP2D(const std::vector<ub_beam>& beams,
@@ -626,9 +637,10 @@ void ClRuntime::estimateBP2D(const std::vector<ub_beam>& beams,
                              const std::vector<ub_query_point>& queries, const EstimateArgs& a,
                              std::vector<Rgb>* out) {
     if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
+    requireLeafOrder(bvh, "bp2d");
     runEstimate(bp2d_, "clEnqueueNDRangeKernel(ub_bp2d_estimate)",
                 withGrids({bufferArg(beams), bufferArg(parts), bufferArg(pieces), bufferArg(ranges),
-                           bufferArg(bvh.nodes()), bufferArg(bvh.prims())},
+                           bufferArg(bvh.nodes())},
                           gridArgs(a)),
                 bufferArg(queries), queries.size(), a, out);
 }
@@ -640,9 +652,10 @@ void ClRuntime::estimateBB1D(const std::vector<ub_beam>& beams,
                              const std::vector<ub_beam>& queries, const EstimateArgs& a,
                              std::vector<Rgb>* out) {
     if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
+    requireLeafOrder(bvh, "bb1d");
     runEstimate(bb1d_, "clEnqueueNDRangeKernel(ub_bb1d_estimate)",
                 withGrids({bufferArg(beams), bufferArg(parts), bufferArg(pieces), bufferArg(ranges),
-                           bufferArg(bvh.nodes()), bufferArg(bvh.prims())},
+                           bufferArg(bvh.nodes())},
                           gridArgs(a)),
                 bufferArg(queries), queries.size(), a, out);
 }

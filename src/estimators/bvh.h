@@ -79,11 +79,14 @@ class Bvh {
     const std::vector<BvhNode>& nodes() const { return nodes_; }
     const std::vector<uint32_t>& prims() const { return prims_; }
 
-    /// Reorders items (one per box given to build) into leaf order and makes prims() the
-    /// identity, so that a walk reads the items of a leaf one after the other; visits then
-    /// report positions in the reordered items.
+    /// Reorders items (one per box given to build) into leaf order, so that a walk reads the
+    /// items of a leaf one after the other; visits then report positions in the reordered
+    /// items, and prims() is emptied: a leaf's entry k is item k, read without the
+    /// indirection (the OpenCL kernels require this order, src/cl/cl_runtime.cpp).
     template <class T>
     void permuteToLeafOrder(std::vector<T>* items);
+    /// Whether permuteToLeafOrder has run since the last build.
+    bool leafOrdered() const { return leafOrdered_; }
 
     /// visit(i) for every primitive whose box contains p.
     template <class Visit>
@@ -110,6 +113,7 @@ class Bvh {
 
     std::vector<BvhNode> nodes_;
     std::vector<uint32_t> prims_;
+    bool leafOrdered_ = false;
 };
 
 template <class ChildMask, class Visit>
@@ -124,7 +128,8 @@ void Bvh::traverse(ChildMask&& childMask, Visit&& visit) const {
         if (mask == 0) continue;
         for (int c = 0; c < 4; ++c)
             if ((mask >> c) & 1u && n.count[c] != 0)
-                for (uint32_t i = n.child[c]; i < n.child[c] + n.count[c]; ++i) visit(prims_[i]);
+                for (uint32_t i = n.child[c]; i < n.child[c] + n.count[c]; ++i)
+                    visit(leafOrdered_ ? i : prims_[i]);
         for (int c = 3; c >= 0; --c)
             if ((mask >> c) & 1u && n.count[c] == 0) stack[top++] = n.child[c];
     }
@@ -135,9 +140,11 @@ void Bvh::permuteToLeafOrder(std::vector<T>* items) {
     std::vector<T> sorted(items->size());
     for (size_t i = 0; i < prims_.size(); ++i) {
         sorted[i] = (*items)[prims_[i]];
-        prims_[i] = uint32_t(i);
     }
     items->swap(sorted);
+    prims_.clear();
+    prims_.shrink_to_fit();
+    leafOrdered_ = true;
 }
 
 template <class Visit>
