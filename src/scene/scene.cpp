@@ -519,12 +519,6 @@ void Scene::commit() {
 }
 
 bool Scene::intersect(const Ray& ray, Hit* hit) const {
-    if (!intersectGeometry(ray, hit)) return false;
-    completeHit(hit);
-    return true;
-}
-
-bool Scene::intersectGeometry(const Ray& ray, Hit* hit) const {
     if (!impl_->committed) throw std::logic_error("Scene::intersect called before commit()");
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -556,8 +550,6 @@ bool Scene::intersectGeometry(const Ray& ray, Hit* hit) const {
     hit->materialId = shapes[id].materialId;
     hit->lightId = shapes[id].lightId;
     hit->attribute = Rgb(0.0f);
-    hit->b1 = rh.hit.u;
-    hit->b2 = rh.hit.v;
 
     if (g.isSphere) {
         // Re-project the hit onto the sphere (double precision) so that the point
@@ -587,7 +579,6 @@ bool Scene::intersectGeometry(const Ray& ray, Hit* hit) const {
             hit->tangent = shadingTangent(hit->shadingNormal, dpdu);
             if (perturbs(hit->materialId)) perturbShadingNormal(hit, dpdu, dpdv);
         }
-        hit->complete = true;  // a sphere's shading data cost no memory reads
         return true;
     }
 
@@ -602,18 +593,6 @@ bool Scene::intersectGeometry(const Ray& ray, Hit* hit) const {
     // A zero-area triangle cannot be hit by Embree's test; guard anyway.
     hit->geoNormal = ngLen > 0.0f ? ng / ngLen : -ray.dir;
     hit->shadingNormal = hit->geoNormal;
-    hit->uv = Vec2(0.0f, 0.0f);
-    hit->tangent = Vec3(0.0f);
-    hit->complete = false;
-    return true;
-}
-
-void Scene::completeHit(Hit* hit) const {
-    if (hit->complete) return;
-    hit->complete = true;
-    const ShapeGeom& g = impl_->geoms[hit->shapeId];
-    const uint32_t* tri = g.indices + 3 * size_t(hit->primId);
-    const float b1 = hit->b1, b2 = hit->b2, b0 = 1.0f - b1 - b2;
     if (!g.normals.empty()) {
         Vec3 ns = b0 * g.normals[tri[0]] + b1 * g.normals[tri[1]] + b2 * g.normals[tri[2]];
         float nsLen = length(ns);
@@ -635,15 +614,13 @@ void Scene::completeHit(Hit* hit) const {
         float rgb[3];
         for (int k = 0; k < c; ++k)
             rgb[k] = a.perFace
-                         ? value(hit->primId, k)
+                         ? value(rh.hit.primID, k)
                          : b0 * value(tri[0], k) + b1 * value(tri[1], k) + b2 * value(tri[2], k);
         hit->attribute = c == 1 ? Rgb(rgb[0]) : Rgb(rgb[0], rgb[1], rgb[2]);
     }
     hit->tangent = Vec3(0.0f);
     if (needsTangent(hit->materialId)) {
         // Tangents of the uv parameterisation (scene/normal_perturbation.h).
-        const Vec3 p0 = impl_->vertex(g, tri[0]), p1 = impl_->vertex(g, tri[1]),
-                   p2 = impl_->vertex(g, tri[2]);
         const Vec3 e1 = p1 - p0, e2 = p2 - p0;
         Vec3 dpdu = e1, dpdv = e2;
         if (!g.uvs.empty()) {
@@ -663,6 +640,7 @@ void Scene::completeHit(Hit* hit) const {
         hit->tangent = shadingTangent(hit->shadingNormal, dpdu);
         if (perturbs(hit->materialId)) perturbShadingNormal(hit, dpdu, dpdv);
     }
+    return true;
 }
 
 bool Scene::perturbs(int materialId) const {

@@ -65,12 +65,6 @@ struct Hit {
     Vec3 tangent{0.0f, 0.0f, 0.0f};
     uint32_t shapeId = 0;
     uint32_t primId = 0;
-    /// Embree's barycentrics of a triangle hit (p = (1-b1-b2) p0 + b1 p1 + b2 p2), kept so
-    /// that Scene::completeHit can add the shading data to a hit of intersectGeometry.
-    float b1 = 0.0f, b2 = 0.0f;
-    /// Whether shadingNormal, uv, attribute and tangent are set (false after
-    /// intersectGeometry on a triangle, until completeHit).
-    bool complete = false;
     int materialId = -1;
     int lightId = -1;  ///< index into Scene::lights if the shape is emissive, else -1
 };
@@ -184,16 +178,6 @@ class Scene {
     // ---- queries (thread-safe after commit) ----
     /// Closest hit along ray in (ray.tMin, ray.tMax). Returns false on a miss.
     bool intersect(const Ray& ray, Hit* hit) const;
-    /// As intersect, but for a triangle only the hit's geometry (dist, pos, geoNormal, ids and
-    /// barycentrics; shadingNormal = geoNormal): what the medium walks need at the boundaries
-    /// they cross. The shading data of a mesh (normals, uvs, attributes) lie in other arrays
-    /// than its positions, each a cache miss at an incoherent hit, so the walks skip them
-    /// (measured: 1.3 M hits per bpt iteration on the SmallUPBP bunny, about 90% on meshes
-    /// with normals, and 30-45% of the hits in shadow walks, docs/performance.md).
-    bool intersectGeometry(const Ray& ray, Hit* hit) const;
-    /// Adds the shading data (shadingNormal, uv, attribute, tangent) to a hit of
-    /// intersectGeometry; intersect = intersectGeometry + completeHit.
-    void completeHit(Hit* hit) const;
     /// True if anything blocks the open segment between the two points. Each end is
     /// offset along its geometric normal (pass a zero vector for points not on a
     /// surface, e.g. the camera or a point light) towards the other end.

@@ -348,7 +348,7 @@ void Scene::traceMedia(const Ray& ray, MediumStack* stack, MediumTrace* trace, H
         seg.crossingShape = -1;
         seg.crossingEntering = 0;
         Hit h;
-        if (!intersectGeometry(r, &h)) {
+        if (!intersect(r, &h)) {
             seg.length = kMediumFarDistance;
             trace->distance = kInf;
             ++trace->count;
@@ -362,7 +362,6 @@ void Scene::traceMedia(const Ray& ray, MediumStack* stack, MediumTrace* trace, H
             !s.isMediumBoundary || (!s.imaginary && s.mediumPriority >= stack->priority());
         if (real) {
             trace->hitSurface = true;
-            completeHit(&h);
             *hit = h;
             return;
         }
@@ -439,7 +438,7 @@ MediumShadow walkShadow(const Scene& scene, Vec3 from, Vec3 dir, float maxDist, 
         r.tMin = 0.0f;
         r.tMax = remaining;
         Hit h;
-        if (!scene.intersectGeometry(r, &h)) {
+        if (!scene.intersect(r, &h)) {
             float len = remaining >= kInf ? kMediumFarDistance : remaining;
             chain.add(scene, stack.mediumId(), from, dir, len);
             return chain.result();
