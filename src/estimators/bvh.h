@@ -100,6 +100,9 @@ class Bvh {
     /// path passes; childMask(node) gives the children that pass.
     template <class ChildMask, class Visit>
     void traverse(ChildMask&& childMask, Visit&& visit) const;
+    /// The walk itself: visit(i) with i the leaf-order position.
+    template <class ChildMask, class Visit>
+    void walk(ChildMask&& childMask, Visit&& visit) const;
     /// A node of the binary tree built first.
     struct Node2 {
         Bounds3 box;
@@ -118,6 +121,15 @@ class Bvh {
 
 template <class ChildMask, class Visit>
 void Bvh::traverse(ChildMask&& childMask, Visit&& visit) const {
+    // The order is decided once per walk, not per item (two instances of the loop).
+    if (leafOrdered_)
+        walk(childMask, [&](uint32_t i) { visit(i); });
+    else
+        walk(childMask, [&](uint32_t i) { visit(prims_[i]); });
+}
+
+template <class ChildMask, class Visit>
+void Bvh::walk(ChildMask&& childMask, Visit&& visit) const {
     if (nodes_.empty()) return;
     uint32_t stack[64];  // depth <= 33 / 2 + 1 (median splits, bvh.cpp), 3 pushes a level
     int top = 0;
@@ -128,8 +140,7 @@ void Bvh::traverse(ChildMask&& childMask, Visit&& visit) const {
         if (mask == 0) continue;
         for (int c = 0; c < 4; ++c)
             if ((mask >> c) & 1u && n.count[c] != 0)
-                for (uint32_t i = n.child[c]; i < n.child[c] + n.count[c]; ++i)
-                    visit(leafOrdered_ ? i : prims_[i]);
+                for (uint32_t i = n.child[c]; i < n.child[c] + n.count[c]; ++i) visit(i);
         for (int c = 3; c >= 0; --c)
             if ((mask >> c) & 1u && n.count[c] == 0) stack[top++] = n.child[c];
     }
