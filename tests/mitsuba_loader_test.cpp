@@ -430,6 +430,26 @@ TEST(MitsubaXml, TexturedAreaEmitters) {
         EXPECT_EQ(l.radianceTexture->type, TextureType::Checkerboard);
         EXPECT_EQ(l.triangleUvs.size(), l.isSphere ? 0u : l.triangles.size()) << l.name;
     }
+    // As radiance, a checkerboard's colours are not bounded by 1 (Mitsuba's rgb variants read
+    // them as plain textures); in a BSDF they are reflectances.
+    const std::string bright =
+        "<texture name=\"radiance\" type=\"checkerboard\"><rgb name=\"color0\" value=\"5, 4, 3\"/>"
+        "<spectrum name=\"color1\" value=\"2\"/></texture>";
+    auto lit = load(scene("<shape type=\"rectangle\"><emitter type=\"area\">" + bright +
+                          "</emitter></shape>\n"));
+    ASSERT_EQ(lit->lights.size(), 1u);
+    ASSERT_TRUE(lit->lights[0].radianceTexture != nullptr);
+    const Texture& t = *lit->lights[0].radianceTexture;
+    EXPECT_EQ(t.color0.x, 5.0f);
+    EXPECT_EQ(t.color0.y, 4.0f);
+    EXPECT_EQ(t.color0.z, 3.0f);
+    EXPECT_EQ(t.color1.x, 2.0f);
+    EXPECT_EQ(t.color1.z, 2.0f);
+    std::string reflect = errorsOf(
+        scene("<shape type=\"sphere\"><bsdf type=\"diffuse\"><texture name=\"reflectance\" "
+              "type=\"checkerboard\"><rgb name=\"color0\" value=\"5, 4, 3\"/></texture></bsdf>"
+              "</shape>\n"));
+    EXPECT_TRUE(contains(reflect, "reflectance 'color0' = 5, 4, 3 exceeds 1")) << reflect;
     std::string e = errorsOf(
         scene("<shape type=\"rectangle\"><emitter type=\"area\"><texture name=\"radiance\" "
               "type=\"mesh_attribute\"><string name=\"name\" value=\"vertex_color\"/></texture>"

@@ -25,8 +25,9 @@ constexpr float kPolypropyleneIor = 1.49f;  // Mitsuba's default int_ior of plas
 
 }  // namespace
 
-int buildMitsubaTexture(MitsubaBuild& b, const XmlObject& t) {
-    auto cached = b.textureIds.find(&t);
+int buildMitsubaTexture(MitsubaBuild& b, const XmlObject& t, ColorUse use) {
+    const std::pair<const XmlObject*, ColorUse> key(&t, use);
+    auto cached = b.textureIds.find(key);
     if (cached != b.textureIds.end()) return cached->second;
     XmlReader& r = b.r;
     const size_t before = r.errorCount();
@@ -34,8 +35,8 @@ int buildMitsubaTexture(MitsubaBuild& b, const XmlObject& t) {
     tex.name = t.id.empty() ? t.type : t.id;
     if (t.type == "checkerboard") {
         tex.type = TextureType::Checkerboard;
-        tex.color0 = r.getColor(t, "color0", Rgb(0.4f), ColorUse::Reflectance);
-        tex.color1 = r.getColor(t, "color1", Rgb(0.2f), ColorUse::Reflectance);
+        tex.color0 = r.getColor(t, "color0", Rgb(0.4f), use);
+        tex.color1 = r.getColor(t, "color1", Rgb(0.2f), use);
     } else if (t.type == "bitmap") {
         tex.type = TextureType::Bitmap;
         std::string filter = r.getString(t, "filter_type", "bilinear");
@@ -114,7 +115,7 @@ int buildMitsubaTexture(MitsubaBuild& b, const XmlObject& t) {
         tex.name = "mesh_attribute '" + tex.attributeName + "'";
     } else {
         r.unsupportedPlugin(t, kTextures);
-        b.textureIds[&t] = -1;
+        b.textureIds[key] = -1;
         return -1;
     }
     if (t.find("to_uv")) tex.toUv = UvTransform::fromMatrix4(r.getTransform(t, "to_uv"));
@@ -128,7 +129,7 @@ int buildMitsubaTexture(MitsubaBuild& b, const XmlObject& t) {
                 r.error(t.pos, t.label() + ": " + d.message);
         }
     }
-    b.textureIds[&t] = id;
+    b.textureIds[key] = id;
     return id;
 }
 

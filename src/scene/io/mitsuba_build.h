@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -82,8 +83,9 @@ struct MitsubaBuild {
     const XmlScene& xml;
     Scene& scene;
     std::map<const XmlObject*, int> materialIds;  ///< bsdf object -> material id
-    std::map<const XmlObject*, int> textureIds;   ///< texture object -> texture id
-    std::map<const XmlObject*, int> mediumIds;    ///< medium object -> Scene::media index
+    /// (texture object, ColorUse of its colours) -> texture id
+    std::map<std::pair<const XmlObject*, ColorUse>, int> textureIds;
+    std::map<const XmlObject*, int> mediumIds;  ///< medium object -> Scene::media index
     /// Media (volscene's Scene::media is not in main yet): objects seen, for messages.
     bool cameraSet = false;
     int nullPassId = -1;  ///< the pass-through material of masks and null emitters (or -1)
@@ -102,9 +104,11 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& bsdf);
 /// added once per scene.
 int nullPassMaterial(MitsubaBuild& b);
 
-/// A <texture> (checkerboard, bitmap) -> index into Scene::textures (cached per object); -1
-/// on an error (already reported).
-int buildMitsubaTexture(MitsubaBuild& b, const XmlObject& t);
+/// A <texture> (checkerboard, bitmap) -> index into Scene::textures (cached per object and
+/// use); -1 on an error (already reported). `use` reads a checkerboard's colours: reflectance
+/// (at most 1) in a BSDF; ColorUse::Unbounded as an emitter's radiance, where Mitsuba's rgb
+/// variants take any value (its checkerboard reads color0/color1 as plain textures).
+int buildMitsubaTexture(MitsubaBuild& b, const XmlObject& t, ColorUse use = ColorUse::Reflectance);
 
 /// Builds a medium from a <medium>; false on an error (already reported).
 bool buildMitsubaMedium(MitsubaBuild& b, const XmlObject& medium, Medium* out);

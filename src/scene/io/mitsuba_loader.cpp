@@ -697,7 +697,7 @@ void Builder::readShape(const XmlObject& o) {
             light.name = name;
             // A `radiance` texture (Mitsuba: the emitted radiance at the shape's uv) or a colour.
             if (const XmlObject* tex = r_.child(*em, "texture", "radiance")) {
-                const int id = buildMitsubaTexture(b_, *tex);
+                const int id = buildMitsubaTexture(b_, *tex, ColorUse::Unbounded);
                 if (id >= 0) {
                     const Texture& t = b_.scene.textures[size_t(id)];
                     if (t.type == TextureType::MeshAttribute)
