@@ -259,6 +259,50 @@ TEST(JsonLoader, MultiLobeMaterialAndItsEnergyCheck) {
         << d[0].format();
 }
 
+// Textured roughness (rough_conductor, rough_dielectric): "alpha" and "alpha_v" take a
+// texture; its value at the hit's uv (the luminance of an RGB one) is the roughness there.
+// A texture on a material without a microfacet lobe, and a value outside [0, 1], are errors.
+TEST(JsonLoader, TexturedRoughness) {
+    const std::string mats = R"json(
+"brushed": {"type": "rough_conductor", "metal": "gold", "alpha": {"type": "checkerboard", "color0": 0.05, "color1": 0.5}},
+"aniso": {"type": "rough_dielectric", "ior": 1.5, "alpha": 0.2, "alpha_v": {"type": "checkerboard", "color0": 0.3, "color1": 0.6}})json";
+    const std::string shapes = R"json({"type": "rectangle", "material": "brushed"},
+{"type": "sphere", "radius": 0.5, "material": "aniso"})json";
+    auto s = loadJsonSceneFromString(sceneWith(mats, shapes, kPoint), "scene.json", ".");
+    ASSERT_EQ(s->materials.size(), 2u);
+    const Material& brushed = s->materials[0];
+    ASSERT_GE(brushed.textures.alpha, 0);
+    EXPECT_LT(brushed.alphaV, 0.0f);  // isotropic: alpha_v follows the texture
+    // The checkerboard's cells (texture.cpp): color0 where both uv halves agree.
+    SurfaceColors c = s->surfaceColors(brushed, Vec2(0.25f, 0.25f), Rgb(0.0f));
+    EXPECT_FLOAT_EQ(c.alphaU, 0.05f);
+    EXPECT_FLOAT_EQ(c.alphaV, 0.05f);
+    c = s->surfaceColors(brushed, Vec2(0.75f, 0.25f), Rgb(0.0f));
+    EXPECT_FLOAT_EQ(c.alphaU, 0.5f);
+    const Material& aniso = s->materials[1];
+    EXPECT_EQ(aniso.textures.alpha, -1);
+    ASSERT_GE(aniso.textures.alphaV, 0);
+    EXPECT_TRUE(aniso.anisotropic());
+    c = s->surfaceColors(aniso, Vec2(0.75f, 0.25f), Rgb(0.0f));
+    EXPECT_FLOAT_EQ(c.alphaU, 0.2f);
+    EXPECT_FLOAT_EQ(c.alphaV, 0.6f);
+
+    auto d = errorsOf(
+        sceneWith(R"json("p": {"type": "rough_plastic", "alpha": {"type": "checkerboard"}})json",
+                  R"json({"type": "rectangle", "material": "p"})json", kPoint),
+        ".");
+    ASSERT_FALSE(d.empty());
+    EXPECT_TRUE(contains(allErrors(d), "at /materials/p/alpha: expected a number in (0, 1]"))
+        << allErrors(d);
+    d = errorsOf(
+        sceneWith(
+            R"json("c": {"type": "rough_conductor", "alpha": {"type": "checkerboard", "color0": 1.5}})json",
+            R"json({"type": "rectangle", "material": "c"})json", kPoint),
+        ".");
+    ASSERT_FALSE(d.empty());
+    EXPECT_TRUE(contains(allErrors(d), "/materials/c/alpha")) << allErrors(d);
+}
+
 TEST(JsonLoaderErrors, PlasticAndThinDielectricErrors) {
     const std::string materials = R"json(
 "r": {"type": "rough_plastic", "int_ior": 1.3, "ext_ior": 1.3, "alpha": 0},

@@ -118,6 +118,21 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
     auto colour = [&](const std::string& key, const Rgb& fallback, Rgb* value, int* texture) {
         *texture = readJsonTexturedRgb(r, m, ptr, key, kReflectance, fallback, parts, value);
     };
+    // A microfacet roughness (rough_conductor, rough_dielectric): a number in (0, 1], or a
+    // texture whose value at the hit's uv (the luminance of an RGB texture, each value in
+    // [0, 1]) is the roughness there, clamped below at 1e-4 (scene/scene_textures.cpp).
+    auto roughness = [&](const std::string& key, Presence presence, float fallback, float* value,
+                         int* texture) {
+        const Json* v = r.member(m, ptr, key, Presence::Optional, "");
+        if (v && v->is_object()) {
+            Rgb mean;
+            *texture =
+                readJsonTexturedRgb(r, m, ptr, key, kReflectance, Rgb(fallback), parts, &mean);
+            *value = luminance(mean);
+        } else {
+            *value = r.getNumber(m, ptr, key, presence, NumberRange::leftOpen(0.0, 1.0), fallback);
+        }
+    };
     if (!r.isObject(m, ptr, "a material object with a \"type\" key")) return;
     const Json* typeJson = r.member(m, ptr, "type", Presence::Required,
                                     "a material type: one of " + joinNames(kMaterialTypes));
@@ -215,10 +230,8 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         if (rough) mat.distribution = readDistribution(r, m, ptr);
         colour("tint", Rgb(1.0f), &mat.specular, &mat.textures.specular);
         if (rough) {
-            mat.alpha = r.getNumber(m, ptr, "alpha", Presence::Required,
-                                    NumberRange::leftOpen(0.0, 1.0), 0.1f);
-            mat.alphaV = r.getNumber(m, ptr, "alpha_v", Presence::Optional,
-                                     NumberRange::leftOpen(0.0, 1.0), -1.0f);
+            roughness("alpha", Presence::Required, 0.1f, &mat.alpha, &mat.textures.alpha);
+            roughness("alpha_v", Presence::Optional, -1.0f, &mat.alphaV, &mat.textures.alphaV);
         }
         mat.twoSided = false;  // the inside of a dielectric is defined by its normal
     } else if (type == "rough_conductor") {
@@ -229,10 +242,8 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         mat.separableMasking = readMasking(r, m, ptr);
         mat.distribution = readDistribution(r, m, ptr);
         readConductorIor(r, m, ptr, mat, true);
-        mat.alpha =
-            r.getNumber(m, ptr, "alpha", Presence::Required, NumberRange::leftOpen(0.0, 1.0), 0.1f);
-        mat.alphaV = r.getNumber(m, ptr, "alpha_v", Presence::Optional,
-                                 NumberRange::leftOpen(0.0, 1.0), -1.0f);
+        roughness("alpha", Presence::Required, 0.1f, &mat.alpha, &mat.textures.alpha);
+        roughness("alpha_v", Presence::Optional, -1.0f, &mat.alphaV, &mat.textures.alphaV);
         colour("tint", Rgb(1.0f), &mat.specular, &mat.textures.specular);
     } else if (type == "plastic" || type == "rough_plastic") {
         const bool rough = type == "rough_plastic";
