@@ -152,5 +152,11 @@ TEST(Study, BadOptionsExitTwo) {
     EXPECT_NE(readFile(dir / "log.txt").find("missing.json"), std::string::npos);
     EXPECT_EQ(run("'" + scene + "' --techniques vpt --iterations 2 --reference none.exr" + o), 2);
     EXPECT_NE(readFile(dir / "log.txt").find("none.exr"), std::string::npos);
+    // An --out name the system refuses (a component over NAME_MAX): the folder check answers,
+    // it does not throw std::filesystem's "File name too long".
+    EXPECT_EQ(run("'" + scene + "' --techniques vpt --iterations 2 --out '" +
+                  (dir / std::string(300, 'x') / "o").string() + "'"),
+              2);
+    EXPECT_NE(readFile(dir / "log.txt").find("--out: cannot write to folder"), std::string::npos);
     fs::remove_all(dir);
 }

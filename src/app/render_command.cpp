@@ -40,16 +40,14 @@ void checkOutputPath(const std::string& path, const std::string& ext, const std:
         throw UsageError(flag + ": output file '" + path + "' must end in " + ext);
     fs::path dir = p.parent_path();
     if (dir.empty()) dir = ".";
-    std::error_code ec;
-    if (!fs::is_directory(dir, ec))
+    if (!isDirectory(dir))
         throw UsageError(flag + ": cannot write '" + path + "': directory '" + dir.string() +
                          "' does not exist");
-    if (fs::is_directory(p, ec))
-        throw UsageError(flag + ": cannot write '" + path + "': it is a directory");
+    if (isDirectory(p)) throw UsageError(flag + ": cannot write '" + path + "': it is a directory");
     if (::access(dir.c_str(), W_OK) != 0)
         throw UsageError(flag + ": cannot write '" + path + "': directory '" + dir.string() +
                          "' is not writable");
-    if (fs::exists(p, ec) && ::access(p.c_str(), W_OK) != 0)
+    if (pathExists(p) && ::access(p.c_str(), W_OK) != 0)
         throw UsageError(flag + ": cannot write '" + path + "': file is not writable");
 }
 

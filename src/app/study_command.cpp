@@ -309,7 +309,7 @@ int runStudy(const StudyArgs& args) {
     const fs::path dir(args.outDir);
     std::error_code ec;
     fs::create_directories(dir, ec);
-    if (!fs::is_directory(dir) || ::access(dir.c_str(), W_OK) != 0)
+    if (!isDirectory(dir) || ::access(dir.c_str(), W_OK) != 0)
         throw UsageError("--out: cannot write to folder '" + args.outDir + "'");
     std::unique_ptr<tbb::global_control> threadLimit;
     if (args.render.threads > 0)

@@ -7,7 +7,6 @@ namespace ub {
 
 void Bvh::build(const std::vector<Bounds3>& boxes, uint32_t leafSize) {
     leafSize_ = std::max(1u, leafSize);
-    leafOrdered_ = false;
     nodes_.clear();
     prims_.resize(boxes.size());
     if (boxes.empty()) return;

@@ -77,16 +77,16 @@ class Bvh {
     size_t nodeCount() const { return nodes_.size(); }
     size_t bytes() const { return nodes_.size() * sizeof(BvhNode) + prims_.size() * 4; }
     const std::vector<BvhNode>& nodes() const { return nodes_; }
-    const std::vector<uint32_t>& prims() const { return prims_; }
 
     /// Reorders items (one per box given to build) into leaf order, so that a walk reads the
     /// items of a leaf one after the other; visits then report positions in the reordered
-    /// items, and prims() is emptied: a leaf's entry k is item k, read without the
+    /// items, and the index array is emptied: a leaf's entry k is item k, read without the
     /// indirection (the OpenCL kernels require this order, src/cl/cl_runtime.cpp).
     template <class T>
     void permuteToLeafOrder(std::vector<T>* items);
-    /// Whether permuteToLeafOrder has run since the last build.
-    bool leafOrdered() const { return leafOrdered_; }
+    /// Whether permuteToLeafOrder has run since the last build (it empties the index array,
+    /// which build fills with one entry per box).
+    bool leafOrdered() const { return prims_.empty(); }
 
     /// visit(i) for every primitive whose box contains p.
     template <class Visit>
@@ -115,14 +115,13 @@ class Bvh {
     uint32_t leafSize_ = 4;
 
     std::vector<BvhNode> nodes_;
-    std::vector<uint32_t> prims_;
-    bool leafOrdered_ = false;
+    std::vector<uint32_t> prims_;  ///< leaf entry -> box index; empty once leaf-ordered
 };
 
 template <class ChildMask, class Visit>
 void Bvh::traverse(ChildMask&& childMask, Visit&& visit) const {
     // The order is decided once per walk, not per item (two instances of the loop).
-    if (leafOrdered_)
+    if (leafOrdered())
         walk(childMask, [&](uint32_t i) { visit(i); });
     else
         walk(childMask, [&](uint32_t i) { visit(prims_[i]); });
@@ -155,7 +154,6 @@ void Bvh::permuteToLeafOrder(std::vector<T>* items) {
     items->swap(sorted);
     prims_.clear();
     prims_.shrink_to_fit();
-    leafOrdered_ = true;
 }
 
 template <class Visit>

@@ -25,6 +25,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "core/file_status.h"
 #include "scene/ply_reader.h"
 
 namespace ub {
@@ -375,8 +376,7 @@ TriangleMesh loadMeshFile(const std::string& path, Diagnostics& diags, const std
                       : "unsupported mesh file extension '" + ext + "' (expected .obj or .ply)");
         return {};
     }
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec)) {
+    if (isDirectory(path)) {
         rep.error("cannot open mesh file (it is a directory)");
         return {};
     }

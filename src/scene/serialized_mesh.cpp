@@ -10,6 +10,8 @@
 #include <sstream>
 #include <vector>
 
+#include "core/file_status.h"
+
 namespace ub {
 
 namespace {
@@ -260,9 +262,7 @@ TriangleMesh loadSerializedMesh(const std::string& path, int shapeIndex, bool fa
         diags.error(Diagnostic{path, 0, 0, where, msg});
         return TriangleMesh();
     };
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec))
-        return fail("cannot open the .serialized file (it is a directory)");
+    if (isDirectory(path)) return fail("cannot open the .serialized file (it is a directory)");
     std::ifstream f(path, std::ios::binary);
     if (!f)
         return fail(std::string("cannot open the .serialized file (") + std::strerror(errno) + ")");

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/file_status.h"
 
 namespace ub {
 
@@ -107,9 +108,8 @@ template <typename Fail>
 openvdb::GridBase::Ptr readNamedGrid(const std::string& path, const std::string& gridName,
                                      Fail&& fail) {
     initOpenVdb();
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) fail("file not found");
-    if (std::filesystem::is_directory(path, ec)) fail("is a directory, expected a .vdb file");
+    if (!pathExists(path)) fail("file not found");
+    if (isDirectory(path)) fail("is a directory, expected a .vdb file");
 
     openvdb::io::File file(path);
     openvdb::GridPtrVecPtr metadata;

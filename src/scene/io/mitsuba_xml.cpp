@@ -10,6 +10,7 @@
 #include <pugixml.hpp>
 #include <sstream>
 
+#include "core/file_status.h"
 #include "scene/io/mitsuba_spectra.h"
 
 namespace ub {
@@ -183,9 +184,8 @@ bool Parser::checkAttributes(const FileCtx& f, const pugi::xml_node& n,
 
 void Parser::parseFile(const std::string& path, const XmlPos& includedFrom, int depth) {
     std::ifstream in(path, std::ios::binary);
-    std::error_code regularEc;
     // Only regular files: a directory cannot be read and a device such as /dev/zero never ends.
-    if (!in || !fs::is_regular_file(path, regularEc)) {
+    if (!in || !isRegularFile(path)) {
         if (includedFrom.file.empty())
             diags_.error(Diagnostic{path, 0, 0, "", "cannot open the scene file"});
         else
@@ -294,19 +294,18 @@ void Parser::parseSceneChildren(const FileCtx& f, const pugi::xml_node& sceneNod
             std::string value;
             if (!attr(f, n, "value", &value, true)) continue;
             fs::path p(value);
-            std::error_code ec;
             if (p.is_relative()) {
                 // As Mitsuba: relative to this file's folder, else through the search path
                 // (an included file's <path> may be relative to the main scene's folder).
                 p = fs::path(f.dir) / p;
-                if (!fs::is_directory(p, ec))
+                if (!isDirectory(p))
                     for (const auto& dir : scene_.searchPath)
-                        if (fs::is_directory(fs::path(dir) / value, ec)) {
+                        if (isDirectory(fs::path(dir) / value)) {
                             p = fs::path(dir) / value;
                             break;
                         }
             }
-            if (!fs::is_directory(p, ec)) {
+            if (!isDirectory(p)) {
                 error(pos(f, n), "<path> '" + value + "' is not a directory (resolved to '" +
                                      p.lexically_normal().string() + "', and not found in " +
                                      joinList(scene_.searchPath) + ")");
@@ -751,11 +750,10 @@ XmlPos xmlPosOfOffset(const std::string& file, const std::string& text, size_t o
 
 std::string resolveXmlPath(const XmlScene& scene, const std::string& name) {
     fs::path p(name);
-    std::error_code ec;
-    if (p.is_absolute()) return fs::exists(p, ec) ? p.string() : std::string();
+    if (p.is_absolute()) return pathExists(p) ? p.string() : std::string();
     for (const auto& dir : scene.searchPath) {
         fs::path c = fs::path(dir) / p;
-        if (fs::exists(c, ec)) return c.lexically_normal().string();
+        if (pathExists(c)) return c.lexically_normal().string();
     }
     return {};
 }
