@@ -25,28 +25,31 @@
 
 /* The walk of kernels/shared/ub_bvh.h, in the host twin's order (src/estimators/bvh.h): pop
  * a node; MASK (an expression of `n`, the node in global memory) gives the children that pass;
- * runs the block after it for the primitives of those that are leaves, child 0 first, with
- * `k` the index of the item (the items are in the BVH's leaf order, Bvh::permuteToLeafOrder,
- * so a leaf's entries are items, read without an index array; `continue` in the block skips
- * a primitive; variadic, so that commas in the block are no macro argument separators);
- * pushes those that are inner nodes, child 3 first. */
-#define UB_BVH_WALK(nodes, MASK, ...)                                                            \
-    {                                                                                            \
-        uint ubStack[UB_BVH_STACK];                                                              \
-        int ubTop = 0;                                                                           \
-        ubStack[ubTop++] = 0u;                                                                   \
-        while (ubTop > 0) {                                                                      \
-            __global const ub_bvh_node* n = nodes + ubStack[--ubTop];                            \
-            uint ubMask = (MASK);                                                                \
-            if (ubMask == 0u) continue;                                                          \
-            for (int ubC = 0; ubC < 4; ++ubC) {                                                  \
-                if (!((ubMask >> ubC) & 1u) || n->count[ubC] == 0u) continue;                    \
-                for (uint k = n->child[ubC]; k < n->child[ubC] + n->count[ubC]; ++k) __VA_ARGS__ \
-            }                                                                                    \
-            for (int ubC = 3; ubC >= 0; --ubC)                                                   \
-                if (((ubMask >> ubC) & 1u) && n->count[ubC] == 0u)                               \
-                    ubStack[ubTop++] = n->child[ubC];                                            \
-        }                                                                                        \
+ * the statements between UB_BVH_WALK_BEGIN and UB_BVH_WALK_END run for the primitives of those
+ * that are leaves, child 0 first, with `k` the index of the item (the items are in the BVH's
+ * leaf order, Bvh::permuteToLeafOrder, so a leaf's entries are items, read without an index
+ * array; `continue` skips a primitive); then the walk pushes those that are inner nodes,
+ * child 3 first. A begin/end pair rather than one macro taking the block: a block with commas
+ * needs a variadic macro, which OpenCL C 1.2 does not have (NVIDIA's compiler rejects it:
+ * "variadic macros not supported in OpenCL", seen on an H200, docs/opencl.md). */
+#define UB_BVH_WALK_BEGIN(nodes, MASK)                                        \
+    {                                                                         \
+        uint ubStack[UB_BVH_STACK];                                           \
+        int ubTop = 0;                                                        \
+        ubStack[ubTop++] = 0u;                                                \
+        while (ubTop > 0) {                                                   \
+            __global const ub_bvh_node* n = nodes + ubStack[--ubTop];         \
+            uint ubMask = (MASK);                                             \
+            if (ubMask == 0u) continue;                                       \
+            for (int ubC = 0; ubC < 4; ++ubC) {                               \
+                if (!((ubMask >> ubC) & 1u) || n->count[ubC] == 0u) continue; \
+                for (uint k = n->child[ubC]; k < n->child[ubC] + n->count[ubC]; ++k) {
+#define UB_BVH_WALK_END                                                                      \
+    }                                                                                        \
+    }                                                                                        \
+    for (int ubC = 3; ubC >= 0; --ubC)                                                       \
+        if (((ubMask >> ubC) & 1u) && n->count[ubC] == 0u) ubStack[ubTop++] = n->child[ubC]; \
+    }                                                                                        \
     }
 
 /* pb2d: query beams x photon points (BVH over the photons' kernel spheres). */
@@ -69,7 +72,7 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     ub_beam_piece table[UB_QUERY_PIECES];
     ub_uint tableState = UB_TABLE_UNBUILT;
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    UB_BVH_WALK(nodes, ub_bvh_meets_global(n, o, invD, qb.length), {
+    UB_BVH_WALK_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qb.length)) {
         ub_photon_point ph = photons[k];
         float t = 0.0f;
         if (!ub_pb2d_pair(ph, qb, radius * radius, minLength, maxLength, &t)) continue;
@@ -79,7 +82,8 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
         sx += c.x;
         sy += c.y;
         sz += c.z;
-    })
+    }
+    UB_BVH_WALK_END
     ub_store_f3(out, i, sx, sy, sz);
 }
 
@@ -101,7 +105,7 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
     if (!m.homogeneous) ub_grid_accessor_init(&acc, gridData, gi);
     ub_float3 p = ub_f3_from(q.pos);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    UB_BVH_WALK(nodes, ub_bvh_contains_global(n, p), {
+    UB_BVH_WALK_BEGIN(nodes, ub_bvh_contains_global(n, p)) {
         ub_beam_part part = parts[k];
         float t = 0.0f;
         if (!ub_bp2d_pair(q, part, radius * radius, minLength, maxLength, &t)) continue;
@@ -113,7 +117,8 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
         sx += c.x;
         sy += c.y;
         sz += c.z;
-    })
+    }
+    UB_BVH_WALK_END
     ub_store_f3(out, i, sx, sy, sz);
 }
 
@@ -138,7 +143,7 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
     ub_beam_piece table[UB_QUERY_PIECES];
     ub_uint tableState = UB_TABLE_UNBUILT;
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    UB_BVH_WALK(nodes, ub_bvh_meets_global(n, o, invD, qb.length), {
+    UB_BVH_WALK_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qb.length)) {
         ub_beam_part part = parts[k];
         float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
         if (!ub_bb1d_pair(qb, part, radius * radius, minLength, maxLength, &tc, &tl, &sinTheta))
@@ -154,6 +159,7 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
         sx += c.x;
         sy += c.y;
         sz += c.z;
-    })
+    }
+    UB_BVH_WALK_END
     ub_store_f3(out, i, sx, sy, sz);
 }

@@ -29,6 +29,9 @@ done
 # The tests and the benchmark read scenes through the source folder compiled into them.
 src=$(sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' "$build/CMakeCache.txt")
 echo "$src" >"$stage/SOURCE_DIR"
+# The header test builds kernels/shared/*.h from source, with NanoVDB's C header beside them.
+cnanovdb=$(sed -n 's/^UB_CNANOVDB_DIR:PATH=//p' "$build/CMakeCache.txt")
+mkdir -p "$stage/cnanovdb" && cp "$cnanovdb/CNanoVDB.h" "$stage/cnanovdb/" && echo "$cnanovdb" >"$stage/CNANOVDB_DIR"
 git rev-parse HEAD >"$stage/COMMIT" 2>/dev/null || true
 mkdir -p "$(dirname "$archive")"
 tar -C "$stage" -cf - . | xz -T0 -6 >"$archive"

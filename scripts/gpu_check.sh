@@ -38,16 +38,23 @@ step() { echo "== $*" | tee -a "$logs/summary.txt"; }
     echo "cpus: $(nproc), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2)"
 } 2>&1 | tee "$logs/machine.txt"
 
-if ! ls /etc/OpenCL/vendors/*.icd >/dev/null 2>&1; then
-    lib=$( (ldconfig -p 2>/dev/null | awk '/libnvidia-opencl\.so\.1/ {print $NF; exit}'
-        find /usr/local/nvidia /usr/lib /usr/lib64 /lib /usr/local/cuda* -name 'libnvidia-opencl.so.1*' 2>/dev/null) | head -1)
-    if [[ -n $lib ]]; then
-        mkdir -p "$root/vendors" && echo "$lib" >"$root/vendors/nvidia.icd"
-        export OCL_ICD_VENDORS=$root/vendors
-        echo "ICD: $lib (OCL_ICD_VENDORS=$OCL_ICD_VENDORS)" | tee -a "$logs/machine.txt"
-    else
-        echo "ICD: no /etc/OpenCL/vendors and no libnvidia-opencl.so.1 found" | tee -a "$logs/machine.txt"
-    fi
+cnanovdb=$(cat "$root/CNANOVDB_DIR")
+[[ -e $cnanovdb/CNanoVDB.h ]] || { mkdir -p "$cnanovdb" && cp "$root/cnanovdb/CNanoVDB.h" "$cnanovdb/"; }
+
+# NVIDIA's OpenCL library, which its container runtimes mount without an ICD file. Where
+# it exists, the loader sees it alone (OCL_ICD_VENDORS), so the tests and the benchmark,
+# which take the first device listed, run on the GPU; GPU_CHECK_ALL_ICDS=1 keeps the others.
+echo "ICD files: $(ls /etc/OpenCL/vendors 2>/dev/null | tr '\n' ' ')" | tee -a "$logs/machine.txt"
+lib=$( (ldconfig -p 2>/dev/null | awk '/libnvidia-opencl\.so\.1/ {print $NF; exit}'
+    find /usr/local/nvidia /usr/lib /usr/lib64 /lib /usr/local/cuda* /opt -name 'libnvidia-opencl.so*' 2>/dev/null) | head -1)
+if [[ -n $lib ]]; then
+    mkdir -p "$root/vendors" && echo "$lib" >"$root/vendors/nvidia.icd"
+    [[ ${GPU_CHECK_ALL_ICDS:-0} == 1 ]] && cp /etc/OpenCL/vendors/*.icd "$root/vendors/" 2>/dev/null
+    export OCL_ICD_VENDORS=$root/vendors
+    echo "ICD: $lib (OCL_ICD_VENDORS=$OCL_ICD_VENDORS: $(ls "$root/vendors" | tr '\n' ' '))" | tee -a "$logs/machine.txt"
+else
+    echo "ICD: no libnvidia-opencl.so.1 found; nvidia libraries present:" | tee -a "$logs/machine.txt"
+    (ldconfig -p | grep -i nvidia; ls /usr/local/nvidia/lib* 2>/dev/null) | head -40 | tee -a "$logs/machine.txt"
 fi
 
 step devices
@@ -60,10 +67,10 @@ step tests
 step render
 for b in host opencl; do
     (cd "$src" && timeout 120 "$root/bin/unibeam" render scenes/cornell-smoke.json -a upbp -i 8 \
-        --seed 3 --backend $b -o "$logs/smoke-$b.exr" 2>&1) | tee "$logs/render-$b.txt" |
+        --seed 3 --backend $b -o "$root/smoke-$b.exr" 2>&1) | tee "$logs/render-$b.txt" |
         grep -iE 'device|kernel|backend|s/it|per iteration|error' | tee -a "$logs/summary.txt"
 done
-timeout 60 "$root/bin/unibeam" compare "$logs/smoke-opencl.exr" "$logs/smoke-host.exr" 2>&1 |
+timeout 60 "$root/bin/unibeam" compare "$root/smoke-opencl.exr" "$root/smoke-host.exr" 2>&1 |
     tee -a "$logs/summary.txt"
 
 step bench

@@ -4,7 +4,7 @@
  *
  * Four children per node, their boxes stored as a structure of arrays in the node itself,
  * so that one node fetch tests all four (the walk is bound by the latency of its node
- * loads: measured, docs/performance.md). Walk order (UB_BVH_WALK in kernels/beams.cl,
+ * loads: measured, docs/performance.md). Walk order (UB_BVH_WALK_BEGIN in kernels/beams.cl,
  * Bvh::traverse on the host): pop a node; test its four children; visit the primitives of
  * the leaf children that pass, child 0 first; push the inner children that pass, child 3
  * first, so that child 0 is walked next. */
