@@ -11,6 +11,8 @@
  * pdf (Heitz 2018) times the reflection Jacobian (Walter eq. 14); RoughDielectric  Walter et al.
  * 2007 eq. 20 (reflection) and eq. 21 (refraction, Jacobian eq. 17), Fresnel lobe selection;
  *   Plastic, RoughPlastic  Mitsuba 3's coated diffuse (kernels/shared/ub_plastic.h);
+ *   Principled       Mitsuba 3's principled BSDF (ub_principled.h); the record's fields hold
+ *                    its parameters as ub_bsdf_principled() reads them;
  *   MultiLobe        SmallUPBP's sum of lobes: its Lambert and Phong lobes here, picked
  *                    with probabilities proportional to the lobes' albedos, which depend on
  *                    the Fresnel weight of the delta lobes seen from the fixed direction
@@ -30,6 +32,7 @@
 #include "ub_microfacet.h"
 #include "ub_phong.h"
 #include "ub_plastic.h"
+#include "ub_principled.h"
 #include "ub_vec3.h"
 
 /* Material types (the values of ub::MaterialType, src/scene/material.h). */
@@ -43,6 +46,7 @@
 #define UB_MATERIAL_ROUGH_PLASTIC 7u
 #define UB_MATERIAL_THIN_DIELECTRIC 8u
 #define UB_MATERIAL_MULTI_LOBE 9u
+#define UB_MATERIAL_PRINCIPLED 11u
 
 #define UB_BSDF_EVALUABLE 1u       /* valid, not all-delta, not black: evaluation can be > 0 */
 #define UB_BSDF_FROM_LIGHT 2u      /* light subpath: importance transport (bsdf.h) */
@@ -351,6 +355,43 @@ UB_INLINE ub_float3 ub_bsdf_eval_rough_plastic(UB_PRIVATE const ub_bsdf* b,
                           b->specular[2] * glossy + b->plasticBase[2] * base);
 }
 
+/* Principled: its parameters, stored in the fields its lobes do not otherwise use
+ * (Bsdf::packShared): diffuse = base colour, alpha/alphaV = GGX alpha_x/alpha_y, ior = eta, glossy
+ * = (metallic, spec_trans, spec_tint), specular = (sheen, sheen_tint, flatness), eta = (clearcoat,
+ * clearcoat_gloss, roughness), k = sampling rates (diffuse, main specular, clearcoat). */
+UB_INLINE ub_principled ub_bsdf_principled(UB_PRIVATE const ub_bsdf* b) {
+    ub_principled p;
+    for (int c = 0; c < 3; ++c) p.base[c] = b->diffuse[c];
+    p.alphaX = b->alpha;
+    p.alphaY = b->alphaV;
+    p.roughness = b->eta[2];
+    p.metallic = b->glossy[0];
+    p.specTrans = b->glossy[1];
+    p.specTint = b->glossy[2];
+    p.sheen = b->specular[0];
+    p.sheenTint = b->specular[1];
+    p.flatness = b->specular[2];
+    p.clearcoat = b->eta[0];
+    p.clearcoatGloss = b->eta[1];
+    p.eta = b->ior;
+    p.rateDiffuse = b->k[0];
+    p.rateSpecular = b->k[1];
+    p.rateClearcoat = b->k[2];
+    return p;
+}
+
+/* Principled: f_s = Mitsuba's eval / |cos dirGen|; the pdfs are its pdf both ways. */
+UB_INLINE ub_float3 ub_bsdf_eval_principled(UB_PRIVATE const ub_bsdf* b, ub_float3 gen,
+                                            UB_PRIVATE float* directPdfW,
+                                            UB_PRIVATE float* reversePdfW) {
+    ub_principled p = ub_bsdf_principled(b);
+    ub_float3 fix = ub_f3_from(b->localFix);
+    *directPdfW = ub_principled_pdf(&p, fix, gen);
+    *reversePdfW = ub_principled_pdf(&p, gen, fix);
+    ub_float3 v = ub_principled_value(&p, fix, gen, (b->flags & UB_BSDF_FROM_LIGHT) != 0u);
+    return ub_f3_scale(v, 1.0f / ub_fabs(gen.z));
+}
+
 /* f_s(dirFix, dirGen) and both pdfs for dirGen given in the shading frame; cosGeoGen =
  * dot(dirGen, geoNormal). Applies the geometric guard, the perturbed-normal rule and factor,
  * and, for light subpaths, the shading-normal factor. coating: the rough plastic's coating table
@@ -383,6 +424,9 @@ UB_INLINE ub_float3 ub_bsdf_eval_local(UB_PRIVATE const ub_bsdf* b, UB_GLOBAL co
             break;
         case UB_MATERIAL_MULTI_LOBE:
             f = ub_bsdf_eval_multilobe(b, gen, directPdfW, reversePdfW);
+            break;
+        case UB_MATERIAL_PRINCIPLED:
+            f = ub_bsdf_eval_principled(b, gen, directPdfW, reversePdfW);
             break;
         default:
             break;

@@ -111,7 +111,8 @@ bool isDielectric(MaterialType t) {
 /// Materials whose normals are never flipped to dirFix's side (the normal tells inside).
 bool keepsNormalSide(const Material& m) {
     return isDielectric(m.type) || m.type == MaterialType::ThinDielectric ||
-           (m.type == MaterialType::MultiLobe && m.refract);
+           (m.type == MaterialType::MultiLobe && m.refract) ||
+           (m.type == MaterialType::Principled && !m.twoSided);
 }
 
 }  // namespace
@@ -153,7 +154,9 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
         }
     }
     frame_ = Frame(ns);
-    if (colors_.alphaU != colors_.alphaV && lengthSqr(tangent) > 0.0f) {
+    if ((colors_.alphaU != colors_.alphaV ||
+         (mat.type == MaterialType::Principled && mat.principled.anisotropic != 0.0f)) &&
+        lengthSqr(tangent) > 0.0f) {
         // Anisotropic roughness: alpha_u along Mitsuba's shading tangent s, the tangent made
         // orthogonal to the (perturbed, possibly flipped) shading normal; t = n x s. The
         // distribution is even in s and t, so the frame's handedness does not matter.
@@ -214,6 +217,15 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
         case MaterialType::MultiLobe:
             setupMultiLobe();
             break;
+        case MaterialType::Principled:
+            // Russian roulette: any probability in (0, 1] is unbiased; the largest base
+            // colour channel, at least 1/2 (a black base still has its specular lobes).
+            contProb_ = std::max(0.5f, maxComponent(colors_.diffuse));
+            // From the back without transmission nothing scatters (Mitsuba's sample() fails).
+            if (localDirFix_.z < 0.0f &&
+                !((1.0f - mat.principled.metallic) * mat.principled.specTrans > 0.0f))
+                black_ = true;
+            break;
         case MaterialType::Blend:
             // The parts come from Scene::setupBsdf (setupBlend); alone it is not evaluable.
             packShared();
@@ -239,7 +251,8 @@ void Bsdf::packShared() {
                       uint32_t(MaterialType::Plastic) == UB_MATERIAL_PLASTIC &&
                       uint32_t(MaterialType::RoughPlastic) == UB_MATERIAL_ROUGH_PLASTIC &&
                       uint32_t(MaterialType::ThinDielectric) == UB_MATERIAL_THIN_DIELECTRIC &&
-                      uint32_t(MaterialType::MultiLobe) == UB_MATERIAL_MULTI_LOBE,
+                      uint32_t(MaterialType::MultiLobe) == UB_MATERIAL_MULTI_LOBE &&
+                      uint32_t(MaterialType::Principled) == UB_MATERIAL_PRINCIPLED,
                   "MaterialType values are the UB_MATERIAL_* of kernels/shared/ub_bsdf.h");
     ub_bsdf& b = shared_;
     const Material& m = *mat_;
@@ -281,6 +294,16 @@ void Bsdf::packShared() {
     b.tableIndex = 0;  // the surface-merging pass sets the material's index
     b.terminatorAlpha2 = terminatorAlpha2_;
     coating_ = m.type == MaterialType::RoughPlastic ? m.coatingTransmittance.data() : nullptr;
+    if (m.type == MaterialType::Principled) {
+        // The parameters in the fields ub_bsdf_principled reads (kernels/shared/ub_bsdf.h).
+        const PrincipledParams& q = m.principled;
+        const float roughness = colors_.alphaU;
+        ub_principled_alphas(roughness, q.anisotropic, &b.alpha, &b.alphaV);
+        put(b.glossy, Vec3(q.metallic, q.specTrans, q.specTint));
+        put(b.specular, Vec3(q.sheen, q.sheenTint, q.flatness));
+        put(b.eta, Vec3(q.clearcoat, q.clearcoatGloss, roughness));
+        put(b.k, Vec3(q.rateDiffuse, q.rateSpecular, q.rateClearcoat));
+    }
 }
 
 struct Bsdf::BlendParts {
@@ -409,6 +432,16 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
                 event = kEventDiffuse;
             }
             break;
+        case MaterialType::Principled: {
+            // Mitsuba's lobe selection and sampling (kernels/shared/ub_principled.h).
+            const ub_principled p = ub_bsdf_principled(&shared_);
+            ub_float3 wo;
+            if (!ub_principled_sample(&p, ub_make_float3(fix.x, fix.y, fix.z), rnd.x, rnd.y, rnd.z,
+                                      &wo))
+                return Rgb(0.0f);
+            gen = Vec3(wo.x, wo.y, wo.z);
+            break;
+        }
         case MaterialType::RoughDielectric: {
             // Work mirrored to dirFix's side (GGX is symmetric under z -> -z).
             const float side = fix.z < 0.0f ? -1.0f : 1.0f;

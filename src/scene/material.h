@@ -24,12 +24,25 @@ enum class MaterialType : uint32_t {
     RoughPlastic = 7,    ///< Mitsuba 3 `roughplastic`: GGX coating (`alpha`) over Lambert `diffuse`
     ThinDielectric = 8,  ///< Mitsuba 3 `thindielectric`: delta reflection `specular` + straight
                          ///< transmission `transmittance`; `ior` of the sheet
-    MultiLobe = 9,  ///< SmallUPBP's sum of lobes: Lambert `diffuse` + Phong `glossy`/`exponent` +
-                    ///< mirror `specular` (Fresnel-weighted with `refract`) + smooth untinted
-                    ///< refraction with `ior` when `refract` (scene/bsdf.cpp)
-    Blend = 10,     ///< Mitsuba 3 `blendbsdf` (and `mask`): (1 - w) f_a + w f_b of the materials
-                    ///< `blendParts`, w = `blendWeight` or the texture `textures.weight`
-                    ///< (scene/bsdf.cpp; not on the OpenCL device nor in upbp's batch pass)
+    MultiLobe = 9,    ///< SmallUPBP's sum of lobes: Lambert `diffuse` + Phong `glossy`/`exponent` +
+                      ///< mirror `specular` (Fresnel-weighted with `refract`) + smooth untinted
+                      ///< refraction with `ior` when `refract` (scene/bsdf.cpp)
+    Blend = 10,       ///< Mitsuba 3 `blendbsdf` (and `mask`): (1 - w) f_a + w f_b of the materials
+                      ///< `blendParts`, w = `blendWeight` or the texture `textures.weight`
+                      ///< (scene/bsdf.cpp; not on the OpenCL device nor in upbp's batch pass)
+    Principled = 11,  ///< Mitsuba 3 `principled` (kernels/shared/ub_principled.h): base colour
+                      ///< `diffuse`, roughness `alpha` (both texturable), `ior` = eta, the
+                      ///< other weights in `principled`
+};
+
+/// Mitsuba 3's `principled` parameters other than base colour (Material::diffuse), roughness
+/// (Material::alpha, not squared: the BSDF maps it) and eta (Material::ior); its defaults.
+struct PrincipledParams {
+    float anisotropic = 0.0f, metallic = 0.0f, specTrans = 0.0f, specTint = 0.0f;
+    float sheen = 0.0f, sheenTint = 0.0f, flatness = 0.0f;
+    float clearcoat = 0.0f, clearcoatGloss = 0.0f;
+    /// diffuse_reflectance_sampling_rate, main_specular_sampling_rate, clearcoat_sampling_rate
+    float rateDiffuse = 1.0f, rateSpecular = 1.0f, rateClearcoat = 1.0f;
 };
 
 /// Textured RGB parameters of a material, in Scene::textures (-1: the constant is used).
@@ -90,9 +103,12 @@ struct Material {
     MicrofacetDistribution distribution = MicrofacetDistribution::kGgx;
     /// Two-sided: if true (default for opaque materials), the back side of a surface
     /// behaves like the front. Dielectrics ignore it: their inside is defined by the normal.
+    /// Principled: false (its back side is the inside of its transmission lobe, as in
+    /// Mitsuba) unless wrapped in Mitsuba's `twosided`.
     /// ThinDielectric ignores it too: the sheet is the same from both sides.
     bool twoSided = true;
-    Rgb transmittance{1, 1, 1};  ///< ThinDielectric: tint of the transmitted light
+    Rgb transmittance{1, 1, 1};   ///< ThinDielectric: tint of the transmitted light
+    PrincipledParams principled;  ///< Principled
     /// MultiLobe: a refraction lobe with `ior` (SmallUPBP's ior >= 0); without it the mirror
     /// lobe has Fresnel weight 1 (SmallUPBP's ior < 0).
     bool refract = false;
@@ -129,6 +145,7 @@ struct Material {
     /// Anisotropic roughness (alphaV or its texture given): the BSDF needs the shading
     /// tangent of the hit (Hit::tangent).
     bool anisotropic() const {
+        if (type == MaterialType::Principled) return principled.anisotropic != 0.0f;
         return (type == MaterialType::RoughConductor || type == MaterialType::RoughDielectric) &&
                ((alphaV >= 0.0f && (alphaV != alpha || textures.alpha >= 0)) ||
                 textures.alphaV >= 0);

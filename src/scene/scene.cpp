@@ -267,7 +267,11 @@ int Scene::addMaterial(const Material& m) {
                                "' has a normal or bump map without a texture");
     const bool microfacet =
         m.type == MaterialType::RoughConductor || m.type == MaterialType::RoughDielectric;
-    if (!microfacet && (m.textures.alpha >= 0 || m.textures.alphaV >= 0 || m.alphaV >= 0.0f))
+    if (m.type == MaterialType::Principled && (m.textures.alphaV >= 0 || m.alphaV >= 0.0f))
+        throw std::logic_error("Scene::addMaterial: principled material '" + m.name +
+                               "' takes its anisotropy from principled.anisotropic, not alphaV");
+    if (!microfacet && m.type != MaterialType::Principled &&
+        (m.textures.alpha >= 0 || m.textures.alphaV >= 0 || m.alphaV >= 0.0f))
         throw std::logic_error("Scene::addMaterial: material '" + m.name +
                                "' has a textured or anisotropic roughness, which only rough "
                                "conductors and rough dielectrics take");

@@ -32,6 +32,8 @@ const char* materialTypeName(MaterialType t) {
             return "multi_lobe";
         case MaterialType::Blend:
             return "blend";
+        case MaterialType::Principled:
+            return "principled";
     }
     return "unknown";
 }
