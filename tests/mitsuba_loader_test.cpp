@@ -880,3 +880,57 @@ TEST(MitsubaLoader, MeshAttributeTexturesBindToTheirShape) {
         dir);
     EXPECT_TRUE(contains(e, "attribute name 'color' does not start with vertex_ or face_")) << e;
 }
+
+// Mitsuba's principled: parameters, defaults (eta from specular 0.5 is 1.5), one-sided unless
+// in twosided, and the errors: eta with specular, a textured weight, twosided around a
+// transmitting one.
+TEST(MitsubaXml, PrincipledParametersDefaultsAndErrors) {
+    auto s =
+        load(scene(std::string(kLight) +
+                   "<shape type=\"sphere\"><bsdf type=\"principled\">"
+                   "<rgb name=\"base_color\" value=\"0.2, 0.4, 0.6\"/>"
+                   "<float name=\"metallic\" value=\"0.3\"/><float name=\"sheen\" value=\"0.5\"/>"
+                   "<float name=\"clearcoat_sampling_rate\" value=\"0.25\"/>"
+                   "</bsdf></shape>\n"
+                   "<shape type=\"sphere\"><bsdf type=\"twosided\"><bsdf type=\"principled\">"
+                   "<float name=\"eta\" value=\"1.33\"/><float name=\"spec_trans\" value=\"0\"/>"
+                   "</bsdf></bsdf></shape>\n"));
+    const Material& a = s->materials[size_t(s->shapes[0].materialId)];
+    EXPECT_EQ(a.type, MaterialType::Principled);
+    EXPECT_FALSE(a.twoSided);
+    EXPECT_NEAR(a.diffuse.y, 0.4f, 1e-6f);
+    EXPECT_NEAR(a.alpha, 0.5f, 1e-6f);  // roughness default
+    EXPECT_NEAR(a.ior, 1.5f, 1e-5f);    // specular 0.5
+    EXPECT_NEAR(a.principled.metallic, 0.3f, 1e-6f);
+    EXPECT_NEAR(a.principled.sheen, 0.5f, 1e-6f);
+    EXPECT_NEAR(a.principled.rateClearcoat, 0.25f, 1e-6f);
+    const Material& b = s->materials[size_t(s->shapes[1].materialId)];
+    EXPECT_TRUE(b.twoSided);
+    EXPECT_NEAR(b.ior, 1.33f, 1e-6f);
+
+    std::string e = errorsOf(scene(std::string(kLight) +
+                                   "<shape type=\"sphere\"><bsdf type=\"principled\">\n"
+                                   "  <float name=\"eta\" value=\"1.4\"/>\n"
+                                   "  <float name=\"specular\" value=\"0.4\"/></bsdf></shape>\n"));
+    EXPECT_TRUE(contains(e,
+                         "scene.xml:11:3: error: <bsdf type=\"principled\">: give either "
+                         "'eta' or 'specular', not both"))
+        << e;
+    e = errorsOf(scene(std::string(kLight) +
+                       "<shape type=\"sphere\"><bsdf type=\"principled\">\n"
+                       "  <texture name=\"metallic\" type=\"checkerboard\"/></bsdf></shape>\n"));
+    EXPECT_TRUE(contains(e,
+                         "scene.xml:10:3: error: <bsdf type=\"principled\">: a textured "
+                         "'metallic' is not supported"))
+        << e;
+    e = errorsOf(scene(std::string(kLight) +
+                       "<shape type=\"sphere\"><bsdf type=\"twosided\">\n"
+                       "  <bsdf type=\"principled\"><float name=\"spec_trans\" value=\"0.5\"/>"
+                       "</bsdf></bsdf></shape>\n"));
+    EXPECT_TRUE(contains(e, "cannot wrap a 'principled' BSDF with spec_trans")) << e;
+    e = errorsOf(scene(std::string(kLight) +
+                       "<shape type=\"sphere\"><bsdf type=\"principled\">\n"
+                       "  <float name=\"sheen\" value=\"1.5\"/></bsdf></shape>\n"));
+    EXPECT_TRUE(contains(e, "scene.xml:10:3: error")) << e;
+    EXPECT_TRUE(contains(e, "'sheen'")) << e;
+}

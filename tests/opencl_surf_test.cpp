@@ -7,11 +7,13 @@
 // differ in the last ulp). The queries cover every material type with a density (diffuse,
 // Phong, rough conductor with both masking forms, rough dielectric from both sides, plastic,
 // rough plastic with its coating table, Beckmann conductor and plastic, SmallUPBP's multi-lobe
-// material with and without refraction) and a delta one (mirror:
+// material with and without refraction, Mitsuba's principled with every lobe and anisotropic)
+// and a delta one (mirror:
 // zero), with the geometric guard on and off and perturbed shading normals. A missing OpenCL
 // platform fails the test.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "cl/cl_runtime.h"
@@ -31,7 +33,7 @@ Vec3 randomUnit(Rng& rng) {
 }
 
 std::vector<Material> testMaterials() {
-    std::vector<Material> mats(13);
+    std::vector<Material> mats(15);
     mats[0].type = MaterialType::Diffuse;
     mats[0].diffuse = Rgb(0.7f, 0.5f, 0.3f);
     mats[1].type = MaterialType::Phong;
@@ -72,6 +74,23 @@ std::vector<Material> testMaterials() {
     mats[12].type = MaterialType::MultiLobe;  // and without
     mats[12].diffuse = Rgb(0.4f);
     mats[12].specular = Rgb(0.3f);
+    mats[13].type = MaterialType::Principled;  // Mitsuba's principled, every lobe
+    mats[13].twoSided = false;
+    mats[13].diffuse = Rgb(0.7f, 0.5f, 0.3f);
+    mats[13].alpha = 0.4f;
+    mats[13].ior = 1.45f;
+    mats[13].principled.metallic = 0.3f;
+    mats[13].principled.specTrans = 0.4f;
+    mats[13].principled.specTint = 0.2f;
+    mats[13].principled.sheen = 0.5f;
+    mats[13].principled.sheenTint = 0.3f;
+    mats[13].principled.flatness = 0.4f;
+    mats[13].principled.clearcoat = 0.7f;
+    mats[13].principled.clearcoatGloss = 0.4f;
+    mats[14] = mats[13];  // anisotropic, two-sided, without transmission
+    mats[14].twoSided = true;
+    mats[14].principled.specTrans = 0.0f;
+    mats[14].principled.anisotropic = 0.6f;
     for (Material& m : mats) prepareMaterial(m);
     return mats;
 }
@@ -163,6 +182,12 @@ TEST(OpenClSurf, KernelEqualsHostTwinPerQueryForEveryMaterial) {
         if (t == MaterialType::RoughConductor || t == MaterialType::RoughDielectric ||
             t == MaterialType::RoughPlastic)
             bound[m] = std::max(1e-5f, 0x1p-22f * 4.0f / (mats[m].alpha * mats[m].alpha));
+        if (t == MaterialType::Principled) {  // its sharpest lobe: GGX r^2 or the clearcoat
+            const float r2 = mats[m].alpha * mats[m].alpha;
+            const float cc = 0.1f + (0.001f - 0.1f) * mats[m].principled.clearcoatGloss;
+            const float a = std::min(std::max(0.001f, r2), cc);
+            bound[m] = std::max(1e-5f, 0x1p-22f * 4.0f / (a * a));
+        }
         std::printf("material %zu: max relative difference %.3g (bound %.3g)\n", m, maxRel[m],
                     double(bound[m]));
     }

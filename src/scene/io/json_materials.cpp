@@ -45,7 +45,8 @@ const MetalPreset kMetals[] = {
 
 const std::vector<std::string> kMaterialTypes = {
     "diffuse",          "phong",   "mirror",        "dielectric",      "rough_conductor",
-    "rough_dielectric", "plastic", "rough_plastic", "thin_dielectric", "multi_lobe"};
+    "rough_dielectric", "plastic", "rough_plastic", "thin_dielectric", "multi_lobe",
+    "principled"};
 
 /// Mitsuba 3's default IORs: polypropylene (plastics), BK7 glass (thin_dielectric), air.
 constexpr float kPolypropyleneIor = 1.49f, kBk7Ior = 1.5046f, kAirIor = 1.000277f;
@@ -268,6 +269,61 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         if (rough)
             mat.alpha = r.getNumber(m, ptr, "alpha", Presence::Optional,
                                     NumberRange::leftOpen(0.0, 1.0), 0.1f);
+    } else if (type == "principled") {
+        // Mitsuba 3's principled (kernels/shared/ub_principled.h), its parameter names and
+        // defaults; one-sided unless "two_sided" (Mitsuba's twosided) and without spec_trans.
+        mat.type = MaterialType::Principled;
+        const std::vector<std::string> weights = {"anisotropic", "metallic",  "spec_trans",
+                                                  "spec_tint",   "sheen",     "sheen_tint",
+                                                  "flatness",    "clearcoat", "clearcoat_gloss"};
+        keys.insert(keys.end(), {"base_color", "roughness", "eta", "specular", "two_sided",
+                                 "diffuse_reflectance_sampling_rate", "main_specular_sampling_rate",
+                                 "clearcoat_sampling_rate"});
+        keys.insert(keys.end(), weights.begin(), weights.end());
+        r.checkKeys(m, ptr, keys, "principled material");
+        colour("base_color", Rgb(0.5f), &mat.diffuse, &mat.textures.diffuse);
+        const Json* rough = r.member(m, ptr, "roughness", Presence::Optional, "");
+        if (rough && rough->is_object()) {
+            Rgb mean;
+            mat.textures.alpha =
+                readJsonTexturedRgb(r, m, ptr, "roughness", kReflectance, Rgb(0.5f), parts, &mean);
+            mat.alpha = luminance(mean);
+        } else {
+            mat.alpha = r.getNumber(m, ptr, "roughness", Presence::Optional,
+                                    NumberRange::closed(0.0, 1.0), 0.5f);
+        }
+        PrincipledParams& q = mat.principled;
+        float* fields[] = {&q.anisotropic, &q.metallic, &q.specTrans, &q.specTint,      &q.sheen,
+                           &q.sheenTint,   &q.flatness, &q.clearcoat, &q.clearcoatGloss};
+        for (size_t i = 0; i < weights.size(); ++i)
+            *fields[i] = r.getNumber(m, ptr, weights[i], Presence::Optional,
+                                     NumberRange::closed(0.0, 1.0), 0.0f);
+        q.rateDiffuse = r.getNumber(m, ptr, "diffuse_reflectance_sampling_rate", Presence::Optional,
+                                    NumberRange::nonNegative(), 1.0f);
+        q.rateSpecular = r.getNumber(m, ptr, "main_specular_sampling_rate", Presence::Optional,
+                                     NumberRange::nonNegative(), 1.0f);
+        q.rateClearcoat = r.getNumber(m, ptr, "clearcoat_sampling_rate", Presence::Optional,
+                                      NumberRange::nonNegative(), 1.0f);
+        if (m.contains("eta") && m.contains("specular")) {
+            r.error(jsonPointerChild(ptr, "specular"),
+                    "give either \"eta\" or \"specular\", not both");
+        } else if (m.contains("eta")) {
+            mat.ior = r.getNumber(m, ptr, "eta", Presence::Required, NumberRange::positive(), 1.5f);
+            if (q.specTrans > 0.0f && mat.ior == 1.0f) mat.ior = 1.001f;  // Mitsuba's nudge
+        } else {
+            float specular = r.getNumber(m, ptr, "specular", Presence::Optional,
+                                         NumberRange::closed(0.0, 1.0), 0.5f);
+            if (q.specTrans > 0.0f && specular == 0.0f) specular = 1e-3f;  // Mitsuba's nudge
+            mat.ior = 2.0f / (1.0f - std::sqrt(0.08f * specular)) - 1.0f;
+        }
+        if (q.rateDiffuse + q.rateSpecular + q.rateClearcoat <= 0.0f)
+            r.error(ptr, "every sampling rate is zero (nothing can be sampled)");
+        mat.twoSided = r.getBool(m, ptr, "two_sided", false);
+        if (mat.twoSided && q.specTrans > 0.0f)
+            r.error(jsonPointerChild(ptr, "two_sided"),
+                    "a two-sided principled material cannot transmit (spec_trans > 0): its "
+                    "back side is the inside of the transmission lobe");
+        return;
     } else if (type == "thin_dielectric") {
         mat.type = MaterialType::ThinDielectric;
         keys.insert(keys.end(),

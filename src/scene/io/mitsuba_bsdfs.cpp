@@ -1,5 +1,6 @@
 // Mitsuba <bsdf> plugins -> unibeam materials (docs/mitsuba.md lists the mapping).
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -15,7 +16,7 @@ namespace {
 const std::vector<std::string> kBsdfs = {
     "diffuse",        "conductor", "roughconductor", "dielectric", "roughdielectric",
     "thindielectric", "plastic",   "roughplastic",   "null",       "twosided",
-    "normalmap",      "bumpmap",   "blendbsdf",      "mask"};
+    "normalmap",      "bumpmap",   "blendbsdf",      "mask",       "principled"};
 const std::vector<std::string> kTextures = {"checkerboard", "bitmap", "mesh_attribute",
                                             "rawconstant"};
 
@@ -244,6 +245,58 @@ void readMicrofacetRoughness(MitsubaBuild& b, const XmlObject& o, Material* m, b
     read("alpha", &m->alpha, &m->textures.alpha);
 }
 
+/// Mitsuba 3's `principled` (kernels/shared/ub_principled.h): base_color and roughness are
+/// floats, colours or textures; the other weights floats in [0, 1] (a texture is an error
+/// naming it); eta or specular (not both, as Mitsuba), with Mitsuba's nudges of eta = 1 and
+/// specular = 0 when spec_trans is given; the three sampling rates.
+void readPrincipled(MitsubaBuild& b, const XmlObject& o, Material* m) {
+    XmlReader& r = b.r;
+    m->type = MaterialType::Principled;
+    readReflectance(b, o, "base_color", Rgb(0.5f), &m->diffuse, &m->textures.diffuse);
+    if (const XmlObject* tex = r.child(o, "texture", "roughness"))
+        m->textures.alpha = floatTexture(b, *tex);
+    else
+        m->alpha = r.getFloatIn(o, "roughness", 0.5f, 0.0f, 1.0f);
+    PrincipledParams& q = m->principled;
+    auto weight = [&](const char* name, float* v) {
+        if (const XmlObject* tex = r.child(o, "texture", name)) {
+            r.error(tex->pos, o.label() + ": a textured '" + name +
+                                  "' is not supported (unibeam's principled takes textures "
+                                  "for base_color and roughness only; expected a float)");
+            return;
+        }
+        *v = r.getFloatIn(o, name, 0.0f, 0.0f, 1.0f);
+    };
+    weight("anisotropic", &q.anisotropic);
+    weight("metallic", &q.metallic);
+    weight("spec_trans", &q.specTrans);
+    weight("spec_tint", &q.specTint);
+    weight("sheen", &q.sheen);
+    weight("sheen_tint", &q.sheenTint);
+    weight("flatness", &q.flatness);
+    weight("clearcoat", &q.clearcoat);
+    weight("clearcoat_gloss", &q.clearcoatGloss);
+    const float inf = std::numeric_limits<float>::infinity();
+    q.rateDiffuse = r.getFloatIn(o, "diffuse_reflectance_sampling_rate", 1.0f, 0.0f, inf);
+    q.rateSpecular = r.getFloatIn(o, "main_specular_sampling_rate", 1.0f, 0.0f, inf);
+    q.rateClearcoat = r.getFloatIn(o, "clearcoat_sampling_rate", 1.0f, 0.0f, inf);
+    const bool hasSpecTrans = r.has(o, "spec_trans") && q.specTrans != 0.0f;
+    if (r.has(o, "eta") && r.has(o, "specular")) {
+        r.error(o.find("specular")->pos,
+                o.label() + ": give either 'eta' or 'specular', not both (as Mitsuba requires)");
+    } else if (r.has(o, "eta")) {
+        m->ior = r.getFloatIn(o, "eta", 1.5f, 0.0f, inf, /*loOpen=*/true);
+        if (hasSpecTrans && m->ior == 1.0f) m->ior = 1.001f;  // Mitsuba: eta 1 cannot refract
+    } else {
+        float specular = r.getFloatIn(o, "specular", 0.5f, 0.0f, 1.0f);
+        if (hasSpecTrans && specular == 0.0f) specular = 1e-3f;  // Mitsuba's nudge
+        // Burley 2015: specular 0.5 is eta 1.5 (Mitsuba's mapping)
+        m->ior = 2.0f / (1.0f - std::sqrt(0.08f * specular)) - 1.0f;
+    }
+    if (q.rateDiffuse + q.rateSpecular + q.rateClearcoat <= 0.0f)
+        r.error(o.pos, o.label() + ": every sampling rate is zero (nothing can be sampled)");
+}
+
 /// Dielectric tints: unibeam has one `specular` tint for reflection and transmission.
 Rgb readDielectricTint(XmlReader& r, const XmlObject& o) {
     Rgb sr = r.getColor(o, "specular_reflectance", Rgb(1.0f), ColorUse::Reflectance);
@@ -408,6 +461,11 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
                    inner[0]->type == "thindielectric" || inner[0]->type == "null" ||
                    inner[0]->type == "twosided") {
             r.error(inner[0]->pos, o.label() + ": cannot wrap a '" + inner[0]->type + "' BSDF");
+        } else if (inner[0]->type == "principled" && r.has(*inner[0], "spec_trans") &&
+                   r.getFloat(*inner[0], "spec_trans", 0.0f) != 0.0f) {
+            r.error(inner[0]->pos, o.label() +
+                                       ": cannot wrap a 'principled' BSDF with spec_trans (a "
+                                       "transmitting BSDF; Mitsuba refuses it too)");
         } else {
             int innerId = buildMitsubaBsdf(b, *inner[0]);
             if (innerId >= 0) {
@@ -488,6 +546,8 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
         readReflectance(b, o, "specular_reflectance", Rgb(1.0f), &m.specular, &m.textures.specular);
         m.nonlinear = r.getBool(o, "nonlinear", false);
         if (rough) readMicrofacetRoughness(b, o, &m, /*full=*/false);
+    } else if (o.type == "principled") {
+        readPrincipled(b, o, &m);
     } else if (o.type == "roughdielectric") {
         m.type = MaterialType::RoughDielectric;
         m.ior = readRelativeIor(r, o);
