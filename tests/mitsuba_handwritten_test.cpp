@@ -141,7 +141,9 @@ const HandCase kCases[] = {
     // lt reaches the pixels seen through the transmitting sphere only by connecting at its
     // near-specular surface (alpha 0.06): heavy-tailed, 512 iterations underestimate there
     // (z -14 on 10 pixels, their mean 4x low); 16384 iterations converge to the reference
-    // there (0.1087 against 0.1092), 4096 pass the test (2 s).
+    // there (0.1087 against 0.1092), 4096 pass the test (2 s). For the same reason the panel's
+    // roughness checkerboard is 0.3 / 0.7: at 0.15 (alpha 0.02) lt at 4096 iterations failed on
+    // 3 panel pixels (z -6) while pt, bpt, vcm and upbp passed.
     {"principled", "lt", 4096},
     {"principled", "vcm", 256},
     {"principled", "upbp", 128},
@@ -481,4 +483,21 @@ TEST(MitsubaHandWrittenPower, OrthographicRefusesLightTracingAndClipsAtTheNearPl
     const test::ReferenceCheck check =
         checkAgainst("orthographic", *unclipped, "pt", 512, "orthographic pt, near clip 0.01");
     EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the near clip plane";
+}
+
+// Power of the principled check: with its weight textures ignored (the panel's metallic and
+// clearcoat checkerboards replaced by 0), pt fails the reference test.
+TEST(MitsubaHandWrittenPower, PrincipledWeightTexturesAreDistinguished) {
+    std::unique_ptr<Scene> scene = loadMitsubaScene(kDir + "/principled.xml", {{"res", "48"}});
+    int cleared = 0;
+    for (Material& m : scene->materials)
+        for (int& t : m.textures.principled)
+            if (t >= 0) {
+                t = -1;
+                ++cleared;
+            }
+    ASSERT_EQ(cleared, 4);  // the panel and its two-sided copy, two weights each
+    const test::ReferenceCheck check =
+        checkAgainst("principled", *scene, "pt", 512, "principled pt, weight textures ignored");
+    EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the weight textures";
 }

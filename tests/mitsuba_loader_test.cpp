@@ -881,9 +881,9 @@ TEST(MitsubaLoader, MeshAttributeTexturesBindToTheirShape) {
     EXPECT_TRUE(contains(e, "attribute name 'color' does not start with vertex_ or face_")) << e;
 }
 
-// Mitsuba's principled: parameters, defaults (eta from specular 0.5 is 1.5), one-sided unless
-// in twosided, and the errors: eta with specular, a textured weight, twosided around a
-// transmitting one.
+// Mitsuba's principled: parameters, textured weights, defaults (eta from specular 0.5 is 1.5),
+// one-sided unless in twosided, and the errors: eta with specular, a weight outside [0, 1],
+// twosided around a transmitting one.
 TEST(MitsubaXml, PrincipledParametersDefaultsAndErrors) {
     auto s =
         load(scene(std::string(kLight) +
@@ -916,13 +916,16 @@ TEST(MitsubaXml, PrincipledParametersDefaultsAndErrors) {
                          "scene.xml:11:3: error: <bsdf type=\"principled\">: give either "
                          "'eta' or 'specular', not both"))
         << e;
-    e = errorsOf(scene(std::string(kLight) +
-                       "<shape type=\"sphere\"><bsdf type=\"principled\">\n"
-                       "  <texture name=\"metallic\" type=\"checkerboard\"/></bsdf></shape>\n"));
-    EXPECT_TRUE(contains(e,
-                         "scene.xml:10:3: error: <bsdf type=\"principled\">: a textured "
-                         "'metallic' is not supported"))
-        << e;
+    // textured weights (Mitsuba's float textures)
+    auto t = load(scene(std::string(kLight) +
+                        "<shape type=\"sphere\"><bsdf type=\"principled\">"
+                        "<texture name=\"metallic\" type=\"checkerboard\"/>"
+                        "<texture name=\"anisotropic\" type=\"checkerboard\"/></bsdf></shape>\n"));
+    const Material& c = t->materials[size_t(t->shapes[0].materialId)];
+    EXPECT_GE(c.textures.principled[1], 0);  // metallic
+    EXPECT_GE(c.textures.principled[0], 0);  // anisotropic
+    EXPECT_EQ(c.textures.principled[2], -1);
+    EXPECT_TRUE(c.anisotropic());
     e = errorsOf(scene(std::string(kLight) +
                        "<shape type=\"sphere\"><bsdf type=\"twosided\">\n"
                        "  <bsdf type=\"principled\"><float name=\"spec_trans\" value=\"0.5\"/>"

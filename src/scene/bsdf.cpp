@@ -155,7 +155,7 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
     }
     frame_ = Frame(ns);
     if ((colors_.alphaU != colors_.alphaV ||
-         (mat.type == MaterialType::Principled && mat.principled.anisotropic != 0.0f)) &&
+         (mat.type == MaterialType::Principled && colors_.principled.anisotropic != 0.0f)) &&
         lengthSqr(tangent) > 0.0f) {
         // Anisotropic roughness: alpha_u along Mitsuba's shading tangent s, the tangent made
         // orthogonal to the (perturbed, possibly flipped) shading normal; t = n x s. The
@@ -223,7 +223,7 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
             contProb_ = std::max(0.5f, maxComponent(colors_.diffuse));
             // From the back without transmission nothing scatters (Mitsuba's sample() fails).
             if (localDirFix_.z < 0.0f &&
-                !((1.0f - mat.principled.metallic) * mat.principled.specTrans > 0.0f))
+                !((1.0f - colors_.principled.metallic) * colors_.principled.specTrans > 0.0f))
                 black_ = true;
             break;
         case MaterialType::Blend:
@@ -296,7 +296,7 @@ void Bsdf::packShared() {
     coating_ = m.type == MaterialType::RoughPlastic ? m.coatingTransmittance.data() : nullptr;
     if (m.type == MaterialType::Principled) {
         // The parameters in the fields ub_bsdf_principled reads (kernels/shared/ub_bsdf.h).
-        const PrincipledParams& q = m.principled;
+        const PrincipledParams& q = colors_.principled;
         const float roughness = colors_.alphaU;
         ub_principled_alphas(roughness, q.anisotropic, &b.alpha, &b.alphaV);
         put(b.glossy, Vec3(q.metallic, q.specTrans, q.specTint));

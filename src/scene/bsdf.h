@@ -49,10 +49,13 @@ struct SurfaceColors {
     /// RoughConductor, RoughDielectric: the microfacet roughness along the shading tangent s
     /// and along t (equal: isotropic), textures resolved.
     float alphaU = 0.1f, alphaV = 0.1f;
+    /// Principled: its weights at the point (textures resolved).
+    PrincipledParams principled;
     /// The material's constants (no textures).
     static SurfaceColors of(const Material& m) {
         return {m.diffuse,       m.glossy, m.specular,
-                m.transmittance, m.alpha,  m.alphaV >= 0.0f ? m.alphaV : m.alpha};
+                m.transmittance, m.alpha,  m.alphaV >= 0.0f ? m.alphaV : m.alpha,
+                m.principled};
     }
 };
 

@@ -43,6 +43,21 @@ struct PrincipledParams {
     float clearcoat = 0.0f, clearcoatGloss = 0.0f;
     /// diffuse_reflectance_sampling_rate, main_specular_sampling_rate, clearcoat_sampling_rate
     float rateDiffuse = 1.0f, rateSpecular = 1.0f, rateClearcoat = 1.0f;
+    /// The nine weights above in order (anisotropic ... clearcoatGloss), for textures.
+    static constexpr int kWeights = 9;
+    float& weight(int i) {
+        float* w[kWeights] = {&anisotropic, &metallic, &specTrans, &specTint,      &sheen,
+                              &sheenTint,   &flatness, &clearcoat, &clearcoatGloss};
+        return *w[i];
+    }
+    float weight(int i) const { return const_cast<PrincipledParams*>(this)->weight(i); }
+    /// Mitsuba's names of the weights, in weight() order.
+    static const char* weightName(int i) {
+        static const char* names[kWeights] = {"anisotropic", "metallic",  "spec_trans",
+                                              "spec_tint",   "sheen",     "sheen_tint",
+                                              "flatness",    "clearcoat", "clearcoat_gloss"};
+        return names[i];
+    }
 };
 
 /// Textured RGB parameters of a material, in Scene::textures (-1: the constant is used).
@@ -56,6 +71,9 @@ struct MaterialTextures {
     /// texture's luminance, Mitsuba's float textures). alphaV -1 with alpha >= 0: isotropic.
     int alpha = -1;
     int alphaV = -1;
+    /// Principled: textures of its weights, in PrincipledParams::weight order (the
+    /// texture's luminance, Mitsuba's float textures).
+    std::array<int, PrincipledParams::kWeights> principled{-1, -1, -1, -1, -1, -1, -1, -1, -1};
 };
 
 /// Mitsuba 3's `normalmap` and `bumpmap` wrappers: the shading normal of a hit perturbed by a
@@ -145,7 +163,8 @@ struct Material {
     /// Anisotropic roughness (alphaV or its texture given): the BSDF needs the shading
     /// tangent of the hit (Hit::tangent).
     bool anisotropic() const {
-        if (type == MaterialType::Principled) return principled.anisotropic != 0.0f;
+        if (type == MaterialType::Principled)
+            return principled.anisotropic != 0.0f || textures.principled[0] >= 0;
         return (type == MaterialType::RoughConductor || type == MaterialType::RoughDielectric) &&
                ((alphaV >= 0.0f && (alphaV != alpha || textures.alpha >= 0)) ||
                 textures.alphaV >= 0);

@@ -255,8 +255,16 @@ Scene::Scene() : impl_(std::make_unique<Impl>()) {
 Scene::~Scene() = default;
 
 int Scene::addMaterial(const Material& m) {
-    for (int t : {m.textures.diffuse, m.textures.glossy, m.textures.specular,
-                  m.textures.transmittance, m.textures.weight, m.textures.alpha, m.textures.alphaV})
+    std::vector<int> ids = {m.textures.diffuse,       m.textures.glossy, m.textures.specular,
+                            m.textures.transmittance, m.textures.weight, m.textures.alpha,
+                            m.textures.alphaV};
+    ids.insert(ids.end(), m.textures.principled.begin(), m.textures.principled.end());
+    if (m.type != MaterialType::Principled)
+        for (int t : m.textures.principled)
+            if (t >= 0)
+                throw std::logic_error("Scene::addMaterial: material '" + m.name +
+                                       "' has principled weight textures but is not principled");
+    for (int t : ids)
         if (t >= int(textures.size()))
             throw std::logic_error("Scene::addMaterial: material '" + m.name +
                                    "' refers to texture " + std::to_string(t) +

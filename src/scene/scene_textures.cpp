@@ -23,6 +23,9 @@ SurfaceColors Scene::surfaceColors(const Material& m, const Vec2& uv, const Rgb&
     lookup(m.textures.glossy, &c.glossy);
     lookup(m.textures.specular, &c.specular);
     lookup(m.textures.transmittance, &c.transmittance);
+    for (int i = 0; i < PrincipledParams::kWeights; ++i)
+        if (const int t = m.textures.principled[size_t(i)]; t >= 0)
+            c.principled.weight(i) = luminance(textures[size_t(t)].eval(uv, attribute));
     // Roughness: Mitsuba's float textures, the luminance of an RGB one (as blend weights);
     // alpha_v follows alpha_u where only one is given (isotropic).
     if (m.textures.alpha >= 0) {

@@ -245,10 +245,10 @@ void readMicrofacetRoughness(MitsubaBuild& b, const XmlObject& o, Material* m, b
     read("alpha", &m->alpha, &m->textures.alpha);
 }
 
-/// Mitsuba 3's `principled` (kernels/shared/ub_principled.h): base_color and roughness are
-/// floats, colours or textures; the other weights floats in [0, 1] (a texture is an error
-/// naming it); eta or specular (not both, as Mitsuba), with Mitsuba's nudges of eta = 1 and
-/// specular = 0 when spec_trans is given; the three sampling rates.
+/// Mitsuba 3's `principled` (kernels/shared/ub_principled.h): base_color a colour or texture,
+/// roughness and the other weights floats in [0, 1] or float textures; eta or specular (not both,
+/// as Mitsuba), with Mitsuba's nudges of eta = 1 and specular = 0 when spec_trans is given; the
+/// three sampling rates.
 void readPrincipled(MitsubaBuild& b, const XmlObject& o, Material* m) {
     XmlReader& r = b.r;
     m->type = MaterialType::Principled;
@@ -258,29 +258,21 @@ void readPrincipled(MitsubaBuild& b, const XmlObject& o, Material* m) {
     else
         m->alpha = r.getFloatIn(o, "roughness", 0.5f, 0.0f, 1.0f);
     PrincipledParams& q = m->principled;
-    auto weight = [&](const char* name, float* v) {
+    bool texturedSpecTrans = false;
+    for (int i = 0; i < PrincipledParams::kWeights; ++i) {
+        const char* name = PrincipledParams::weightName(i);
         if (const XmlObject* tex = r.child(o, "texture", name)) {
-            r.error(tex->pos, o.label() + ": a textured '" + name +
-                                  "' is not supported (unibeam's principled takes textures "
-                                  "for base_color and roughness only; expected a float)");
-            return;
+            m->textures.principled[size_t(i)] = floatTexture(b, *tex);
+            texturedSpecTrans |= &q.weight(i) == &q.specTrans;
+        } else {
+            q.weight(i) = r.getFloatIn(o, name, 0.0f, 0.0f, 1.0f);
         }
-        *v = r.getFloatIn(o, name, 0.0f, 0.0f, 1.0f);
-    };
-    weight("anisotropic", &q.anisotropic);
-    weight("metallic", &q.metallic);
-    weight("spec_trans", &q.specTrans);
-    weight("spec_tint", &q.specTint);
-    weight("sheen", &q.sheen);
-    weight("sheen_tint", &q.sheenTint);
-    weight("flatness", &q.flatness);
-    weight("clearcoat", &q.clearcoat);
-    weight("clearcoat_gloss", &q.clearcoatGloss);
+    }
     const float inf = std::numeric_limits<float>::infinity();
     q.rateDiffuse = r.getFloatIn(o, "diffuse_reflectance_sampling_rate", 1.0f, 0.0f, inf);
     q.rateSpecular = r.getFloatIn(o, "main_specular_sampling_rate", 1.0f, 0.0f, inf);
     q.rateClearcoat = r.getFloatIn(o, "clearcoat_sampling_rate", 1.0f, 0.0f, inf);
-    const bool hasSpecTrans = r.has(o, "spec_trans") && q.specTrans != 0.0f;
+    const bool hasSpecTrans = texturedSpecTrans || (r.has(o, "spec_trans") && q.specTrans != 0.0f);
     if (r.has(o, "eta") && r.has(o, "specular")) {
         r.error(o.find("specular")->pos,
                 o.label() + ": give either 'eta' or 'specular', not both (as Mitsuba requires)");
@@ -461,8 +453,10 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
                    inner[0]->type == "thindielectric" || inner[0]->type == "null" ||
                    inner[0]->type == "twosided") {
             r.error(inner[0]->pos, o.label() + ": cannot wrap a '" + inner[0]->type + "' BSDF");
-        } else if (inner[0]->type == "principled" && r.has(*inner[0], "spec_trans") &&
-                   r.getFloat(*inner[0], "spec_trans", 0.0f) != 0.0f) {
+        } else if (inner[0]->type == "principled" &&
+                   (r.child(*inner[0], "texture", "spec_trans") ||
+                    (r.has(*inner[0], "spec_trans") &&
+                     r.getFloat(*inner[0], "spec_trans", 0.0f) != 0.0f))) {
             r.error(inner[0]->pos, o.label() +
                                        ": cannot wrap a 'principled' BSDF with spec_trans (a "
                                        "transmitting BSDF; Mitsuba refuses it too)");

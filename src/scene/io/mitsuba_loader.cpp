@@ -214,6 +214,9 @@ void meshAttributeNames(const Scene& scene, int id, std::set<std::string>* names
                   m.textures.transmittance, m.textures.weight})
         if (t >= 0 && scene.textures[size_t(t)].type == TextureType::MeshAttribute)
             names->insert(scene.textures[size_t(t)].attributeName);
+    for (int t : m.textures.principled)
+        if (t >= 0 && scene.textures[size_t(t)].type == TextureType::MeshAttribute)
+            names->insert(scene.textures[size_t(t)].attributeName);
     if (m.type == MaterialType::Blend)
         for (int part : m.blendParts) meshAttributeNames(scene, part, names);
 }
