@@ -424,3 +424,42 @@ TEST(JsonLoader, ObjTextureCoordinatesAreFlippedPlyAreNot) {
     EXPECT_NEAR(uv.x, 0.25f, 1e-4f);
     EXPECT_NEAR(uv.y, 0.75f, 1e-4f);
 }
+
+// principled: Mitsuba's keys and defaults; one-sided by default; eta from specular; errors
+// for eta with specular, a weight outside [0, 1], and two_sided with spec_trans.
+TEST(JsonLoader, PrincipledMaterialAndItsErrors) {
+    const std::string ok = R"json(
+"paint": {"type": "principled", "base_color": [0.8, 0.3, 0.2], "roughness": 0.3, "clearcoat": 0.5, "sheen": 0.4},
+"glass": {"type": "principled", "spec_trans": 1, "eta": 1.33, "roughness": {"type": "checkerboard", "color0": 0.1, "color1": 0.5}})json";
+    const std::string shapes = R"json({"type": "rectangle", "material": "paint"},
+{"type": "sphere", "radius": 0.5, "material": "glass"})json";
+    auto s = loadJsonSceneFromString(sceneWith(ok, shapes, kPoint), "scene.json", ".");
+    ASSERT_EQ(s->materials.size(), 2u);
+    for (const Material& m : s->materials) {
+        EXPECT_EQ(m.type, MaterialType::Principled);
+        EXPECT_FALSE(m.twoSided);
+        if (m.name == "paint") {
+            EXPECT_FLOAT_EQ(m.alpha, 0.3f);
+            EXPECT_FLOAT_EQ(m.principled.clearcoat, 0.5f);
+            EXPECT_FLOAT_EQ(m.principled.sheen, 0.4f);
+            EXPECT_NEAR(m.ior, 1.5f, 1e-5f);  // specular 0.5
+        } else {
+            EXPECT_FLOAT_EQ(m.principled.specTrans, 1.0f);
+            EXPECT_FLOAT_EQ(m.ior, 1.33f);
+            EXPECT_GE(m.textures.alpha, 0);
+        }
+    }
+    const std::string bad = R"json(
+"a": {"type": "principled", "eta": 1.4, "specular": 0.3},
+"b": {"type": "principled", "sheen": 1.5},
+"c": {"type": "principled", "spec_trans": 0.5, "two_sided": true})json";
+    const std::string three = R"json({"type": "rectangle", "material": "a"},
+{"type": "rectangle", "material": "b"}, {"type": "rectangle", "material": "c"})json";
+    const std::string e = allErrors(errorsOf(sceneWith(bad, three, kPoint), "."));
+    EXPECT_TRUE(contains(e, "at /materials/a/specular: give either \"eta\" or \"specular\"")) << e;
+    EXPECT_TRUE(contains(e, "/materials/b/sheen")) << e;
+    EXPECT_TRUE(contains(e,
+                         "at /materials/c/two_sided: a two-sided principled material cannot "
+                         "transmit"))
+        << e;
+}
