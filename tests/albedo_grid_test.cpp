@@ -102,6 +102,44 @@ TEST(AlbedoGrid, NearestAndTrilinearLookupsClampToTheDomain) {
     EXPECT_TRUE(isFinite(albedoGridAt(*tri, Vec3(NAN, 1e30f, -INFINITY))));
 }
 
+// wrap_mode repeat and mirror (Mitsuba's texture address modes): voxel indices wrapped after
+// the filter picks them. Voxels centred at x = 0, 1, 2 (domain 0..2, period 3).
+TEST(AlbedoGrid, RepeatAndMirrorWrapTheVoxelIndices) {
+    const std::vector<Rgb> v = {Rgb(0.1f), Rgb(0.5f), Rgb(0.9f)};
+    auto at = [&](GridFilter f, GridWrap w, float x) {
+        auto g = AlbedoGrid::make(albedoAlongX(v, 1.0f, 0.0f, 1), f, Transform(), nullptr, nullptr,
+                                  "test", w);
+        return albedoGridAt(*g, Vec3(x, 0.0f, 0.0f)).x;
+    };
+    const GridFilter kN = GridFilter::kNearest, kT = GridFilter::kTrilinear;
+    // nearest, repeat: cell [3.5, 4.5) is voxel 4 mod 3 = 1; [-1.5, -0.5) is voxel 2
+    EXPECT_FLOAT_EQ(at(kN, GridWrap::kRepeat, 4.2f), v[1].x);
+    EXPECT_FLOAT_EQ(at(kN, GridWrap::kRepeat, -1.0f), v[2].x);
+    EXPECT_FLOAT_EQ(at(kN, GridWrap::kRepeat, 301.0f), v[1].x);
+    // nearest, mirror: 3 -> 2, 4 -> 1, 5 -> 0, 6 -> 0 (period 6), -1 -> 0, -2 -> 1
+    EXPECT_FLOAT_EQ(at(kN, GridWrap::kMirror, 3.0f), v[2].x);
+    EXPECT_FLOAT_EQ(at(kN, GridWrap::kMirror, 4.0f), v[1].x);
+    EXPECT_FLOAT_EQ(at(kN, GridWrap::kMirror, 6.0f), v[0].x);
+    EXPECT_FLOAT_EQ(at(kN, GridWrap::kMirror, -1.0f), v[0].x);
+    EXPECT_FLOAT_EQ(at(kN, GridWrap::kMirror, -2.0f), v[1].x);
+    // trilinear, repeat: between the last voxel (x = 2) and the first one repeated (x = 3)
+    EXPECT_NEAR(at(kT, GridWrap::kRepeat, 2.25f), 0.75f * v[2].x + 0.25f * v[0].x, 1e-6f);
+    EXPECT_NEAR(at(kT, GridWrap::kRepeat, -0.5f), 0.5f * v[2].x + 0.5f * v[0].x, 1e-6f);
+    EXPECT_NEAR(at(kT, GridWrap::kRepeat, 4.0f), v[1].x, 1e-6f);
+    // trilinear, mirror: beyond x = 2 the edge voxel repeats (2 -> 2), then 1
+    EXPECT_NEAR(at(kT, GridWrap::kMirror, 2.5f), v[2].x, 1e-6f);
+    EXPECT_NEAR(at(kT, GridWrap::kMirror, 3.5f), 0.5f * v[2].x + 0.5f * v[1].x, 1e-6f);
+    // inside the domain every mode agrees with clamp
+    for (float x : {0.2f, 0.9f, 1.7f})
+        for (GridFilter f : {kN, kT}) {
+            EXPECT_FLOAT_EQ(at(f, GridWrap::kRepeat, x), at(f, GridWrap::kClamp, x));
+            EXPECT_FLOAT_EQ(at(f, GridWrap::kMirror, x), at(f, GridWrap::kClamp, x));
+        }
+    // non-finite points do not crash
+    EXPECT_TRUE(std::isfinite(at(kT, GridWrap::kRepeat, NAN)));
+    EXPECT_TRUE(std::isfinite(at(kN, GridWrap::kMirror, INFINITY)));
+}
+
 TEST(AlbedoGrid, FreeFlightWeightCarriesTheAlbedoAtTheCollision) {
     // Tracking, transmittance and both distance pdfs are those of the medium without the
     // albedo grid, bit for bit; the weight T sigma_s / pdf uses the albedo at the collision.

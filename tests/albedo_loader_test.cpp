@@ -479,3 +479,40 @@ TEST(JsonChromatic, Vec3DensityGridIsAChromaticExtinction) {
                                 "scene.json", dir.path.string());
     EXPECT_FALSE(s->media[0].chromatic());
 }
+
+// wrap_mode on gridvolumes: repeat and mirror wrap an albedo volume (Mitsuba's address modes;
+// scene/albedo_grid.h), an extinction volume takes clamp only (an error naming the mode).
+TEST(MitsubaAlbedo, WrapModesOnAlbedoVolumesAndErrorOnExtinction) {
+    ScratchDir dir;
+    writeVolFiles(dir);
+    const std::string nearest = "<string name=\"filter_type\" value=\"nearest\"/>";
+    for (const char* mode : {"repeat", "mirror"}) {
+        auto s = loadXml(
+            xmlScene(heterogeneous(
+                gridVolume("sigma_t", "sigma.vol"),
+                gridVolume("albedo", "albedo.vol",
+                           nearest + "<string name=\"wrap_mode\" value=\"" + mode + "\"/>"))),
+            dir.path.string());
+        const Medium& m = s->media[0];
+        ASSERT_TRUE(m.albedoGrid);
+        EXPECT_EQ(m.albedoGrid->wrap,
+                  std::string(mode) == "repeat" ? GridWrap::kRepeat : GridWrap::kMirror);
+        // the unit cube holds voxels [0, 0.5) and [0.5, 1) along x; x = 1.25 is voxel 2:
+        // repeat -> voxel 0, mirror -> voxel 1
+        expectRgbNear(albedoGridAt(*m.albedoGrid, Vec3(1.25f, 0.5f, 0.5f)),
+                      std::string(mode) == "repeat" ? Rgb(0.1f, 0.2f, 0.3f) : Rgb(0.7f, 0.8f, 0.9f),
+                      mode);
+    }
+    const std::string text = xmlScene(heterogeneous(
+        gridVolume("sigma_t", "sigma.vol", "<string name=\"wrap_mode\" value=\"repeat\"/>"), ""));
+    const std::string e = xmlErrors(text, dir.path.string());
+    EXPECT_NE(e.find("wrap_mode 'repeat' is supported on albedo volumes only"), std::string::npos)
+        << e;
+    const std::string bad = xmlErrors(
+        xmlScene(heterogeneous(
+            gridVolume("sigma_t", "sigma.vol"),
+            gridVolume("albedo", "albedo.vol", "<string name=\"wrap_mode\" value=\"wrap\"/>"))),
+        dir.path.string());
+    EXPECT_NE(bad.find("wrap_mode 'wrap' is not one of clamp, repeat, mirror"), std::string::npos)
+        << bad;
+}

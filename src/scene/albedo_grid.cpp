@@ -17,6 +17,33 @@ inline int nearestIndex(float x, int lo, int hi) {
     return std::min(int(std::floor(x)), hi);
 }
 
+/// Voxel index k (any integer) mapped into [lo, hi] by the wrap mode (clamp, repeat, mirror).
+inline int wrapIndex(long long k, int lo, int hi, GridWrap wrap) {
+    const long long n = (long long)hi - lo + 1;
+    long long r = k - lo;
+    switch (wrap) {
+        case GridWrap::kRepeat:
+            r %= n;
+            if (r < 0) r += n;
+            break;
+        case GridWrap::kMirror:
+            r %= 2 * n;
+            if (r < 0) r += 2 * n;
+            if (r >= n) r = 2 * n - 1 - r;
+            break;
+        case GridWrap::kClamp:
+            r = std::clamp(r, 0LL, n - 1);
+            break;
+    }
+    return int(lo + r);
+}
+
+/// floor(x) as an integer, for finite x of any magnitude (NaN and infinities: 0).
+inline long long floorIndex(float x) {
+    if (!(std::fabs(x) < 4e18f)) return 0;
+    return (long long)std::floor(x);
+}
+
 inline float lerp(float a, float b, float w) {
     return a + (b - a) * w;
 }
@@ -26,7 +53,7 @@ inline float lerp(float a, float b, float w) {
 std::shared_ptr<const AlbedoGrid> AlbedoGrid::make(
     std::vector<std::shared_ptr<const VdbGrid>> channels, GridFilter filter,
     const Transform& localToWorld, const int domainLo[3], const int domainHi[3],
-    const std::string& label) {
+    const std::string& label, GridWrap wrap) {
     auto fail = [&](const std::string& what) { throw InputError(label, "albedo grid: " + what); };
     if (channels.size() != 1 && channels.size() != 3)
         fail(std::to_string(channels.size()) + " channels (expected 1: grey, or 3: RGB)");
@@ -35,6 +62,7 @@ std::shared_ptr<const AlbedoGrid> AlbedoGrid::make(
     auto out = std::make_shared<AlbedoGrid>();
     out->channelCount = int(channels.size());
     out->filter = filter;
+    out->wrap = wrap;
     out->localToWorld = localToWorld;
     out->label = label;
     const Transform& indexToLocal = channels[0]->indexToLocal();
@@ -67,7 +95,34 @@ std::shared_ptr<const AlbedoGrid> AlbedoGrid::make(
 Rgb albedoGridAt(const AlbedoGrid& a, const Vec3& p) {
     const Vec3 q = a.worldToCell.point(p);
     float v[3] = {0.0f, 0.0f, 0.0f};
-    if (a.filter == GridFilter::kNearest) {
+    if (a.wrap != GridWrap::kClamp) {
+        // Indices first, then wrapped (Mitsuba's texture address modes).
+        int k0[3], k1[3];
+        float w[3];
+        for (int i = 0; i < 3; ++i) {
+            const float d = a.filter == GridFilter::kNearest ? q[i] : q[i] - 0.5f;
+            const long long f = floorIndex(d);
+            w[i] = std::isfinite(d) ? d - float(f) : 0.0f;
+            k0[i] = wrapIndex(f, a.domainLo[i], a.domainHi[i], a.wrap);
+            k1[i] = wrapIndex(f + 1, a.domainLo[i], a.domainHi[i], a.wrap);
+        }
+        for (int c = 0; c < a.channelCount; ++c) {
+            auto acc = a.channels[c]->grid().getAccessor();
+            if (a.filter == GridFilter::kNearest) {
+                v[c] = acc.getValue(nanovdb::Coord(k0[0], k0[1], k0[2]));
+                continue;
+            }
+            auto at = [&](int x, int y, int z) {
+                return acc.getValue(
+                    nanovdb::Coord(x ? k1[0] : k0[0], y ? k1[1] : k0[1], z ? k1[2] : k0[2]));
+            };
+            const float x00 = lerp(at(0, 0, 0), at(1, 0, 0), w[0]);
+            const float x10 = lerp(at(0, 1, 0), at(1, 1, 0), w[0]);
+            const float x01 = lerp(at(0, 0, 1), at(1, 0, 1), w[0]);
+            const float x11 = lerp(at(0, 1, 1), at(1, 1, 1), w[0]);
+            v[c] = lerp(lerp(x00, x10, w[1]), lerp(x01, x11, w[1]), w[2]);
+        }
+    } else if (a.filter == GridFilter::kNearest) {
         const nanovdb::Coord ijk(nearestIndex(q.x, a.domainLo[0], a.domainHi[0]),
                                  nearestIndex(q.y, a.domainLo[1], a.domainHi[1]),
                                  nearestIndex(q.z, a.domainLo[2], a.domainHi[2]));

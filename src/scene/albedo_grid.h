@@ -16,8 +16,12 @@
 // Both clamp the lookup to the domain [domainLo, domainHi] (Mitsuba's
 // gridvolume default wrap_mode="clamp", which Mitsuba applies to any
 // evaluation point: outside the grid's box the albedo is that of the nearest
-// edge voxel, never 0). Inside the domain a voxel that is not stored in a
-// sparse .vdb grid has the grid's background value.
+// edge voxel, never 0), or wrap it (wrap_mode "repeat": the domain tiles space,
+// index modulo its size; "mirror": tiles mirrored at each face), voxel indices
+// wrapped after the filter picks them, as a texture's address mode does (the
+// interpolation across a face reaches the voxel on the opposite side). Inside the
+// domain a voxel that is not stored in a sparse .vdb grid has the grid's background
+// value.
 #pragma once
 
 #include <memory>
@@ -30,10 +34,14 @@
 
 namespace ub {
 
+/// How a lookup outside the domain finds its voxel (Mitsuba's gridvolume `wrap_mode`).
+enum class GridWrap : uint32_t { kClamp = 0, kRepeat = 1, kMirror = 2 };
+
 struct AlbedoGrid {
     int channelCount = 1;                        ///< 1 (grey) or 3 (RGB)
     std::shared_ptr<const VdbGrid> channels[3];  ///< [0] only when grey
     GridFilter filter = GridFilter::kNearest;
+    GridWrap wrap = GridWrap::kClamp;
     int domainLo[3] = {0, 0, 0}, domainHi[3] = {0, 0, 0};  ///< inclusive voxel range
     Transform localToWorld;  ///< grid-local space -> world (then the VDB's index -> local)
     Transform worldToCell;   ///< world -> cell space (index + 1/2)
@@ -45,7 +53,8 @@ struct AlbedoGrid {
     static std::shared_ptr<const AlbedoGrid> make(
         std::vector<std::shared_ptr<const VdbGrid>> channels, GridFilter filter,
         const Transform& localToWorld, const int domainLo[3] = nullptr,
-        const int domainHi[3] = nullptr, const std::string& label = "<albedo grid>");
+        const int domainHi[3] = nullptr, const std::string& label = "<albedo grid>",
+        GridWrap wrap = GridWrap::kClamp);
 };
 
 /// Reads an albedo from grid `gridName` of the OpenVDB file `path`: a float grid (grey) or a

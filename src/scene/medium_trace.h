@@ -63,6 +63,9 @@ struct MediumIssue {
     int32_t shapeId = -1;   ///< offending shape, or -1
     int32_t mediumId = -1;  ///< offending medium, or -1
     std::string message;    ///< names the shape/medium and what is wrong
+    /// Not an error: what the scene does is defined, but maybe not what was meant (an open
+    /// boundary mesh under Mitsuba's transitions). Scene::commit() does not refuse it.
+    bool warning = false;
 };
 
 }  // namespace ub

@@ -467,6 +467,7 @@ void Scene::commit() {
         if (!issues.empty()) {
             std::vector<Diagnostic> diags;
             for (const MediumIssue& i : issues) {
+                if (i.warning) continue;
                 Diagnostic d;
                 d.file = sourceFile;
                 d.where = i.shapeId >= 0 ? "shape '" + shapes[size_t(i.shapeId)].name + "'"
@@ -476,7 +477,7 @@ void Scene::commit() {
                 d.message = i.message;
                 diags.push_back(d);
             }
-            throw InputError(std::move(diags));
+            if (!diags.empty()) throw InputError(std::move(diags));
         }
     }
     // Coordinates the tracer handles: Embree asserts |origin| <= 1.8e18 on every ray, and

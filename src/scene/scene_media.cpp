@@ -199,14 +199,23 @@ std::vector<MediumIssue> Scene::mediumIssues() const {
         if (!sh.isSphere) {
             Vec3 a, b;
             size_t bad = countBadEdges(*this, uint32_t(s), sh.triangleCount, &a, &b);
-            if (bad > 0)
+            // Mitsuba's transitions are local to each crossing (the side of the face), so an
+            // open mesh is defined there, as in Mitsuba: a path that leaves through a gap keeps
+            // the interior medium. The priority stack needs closed boundaries.
+            const bool local = settings.mediumTransitions == MediumTransitions::kShapeSides;
+            if (bad > 0) {
                 add(int(s), -1,
                     name +
                         " is a medium boundary but its mesh is not closed: " + std::to_string(bad) +
                         " edges are not shared by exactly two triangles of opposite orientation "
                         "(first: " +
                         fmtPoint(a) + " - " + fmtPoint(b) +
-                        "); a medium boundary must be a closed, consistently oriented surface");
+                        (local ? "); as in Mitsuba, a path that leaves through a gap keeps its "
+                                 "interior medium"
+                               : "); a medium boundary must be a closed, consistently "
+                                 "oriented surface"));
+                issues.back().warning = local;
+            }
         }
     }
     // Mitsuba's transitions keep one medium and ignore priorities: overlaps are allowed.

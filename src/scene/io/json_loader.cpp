@@ -369,6 +369,7 @@ std::unique_ptr<Scene> buildScene(JsonSceneParts& parts, const std::string& file
     }
     // Media set-up errors (open boundary meshes, conflicting priorities), at the shape.
     for (const MediumIssue& issue : scene->mediumIssues()) {
+        if (issue.warning) continue;  // none arise under the priority stack
         std::string ptr = issue.shapeId >= 0    ? parts.shapes[size_t(issue.shapeId)].ptr
                           : issue.mediumId >= 0 ? parts.mediumPtrs[size_t(issue.mediumId)]
                                                 : std::string("/shapes");

@@ -1043,6 +1043,16 @@ std::unique_ptr<Scene> buildFromXml(const XmlScene& xml, Diagnostics& diags,
     MitsubaBuild b{reader, xml, *scene, {}, {}, {}, false};
     Builder(b).build();
     diags.throwIfErrors();
+    for (const MediumIssue& issue : scene->mediumIssues())
+        if (issue.warning) {
+            Diagnostic d;
+            d.file = xml.file;
+            d.where = issue.shapeId >= 0
+                          ? "shape '" + scene->shapes[size_t(issue.shapeId)].name + "'"
+                          : std::string();
+            d.message = issue.message;
+            diags.warning(d);
+        }
     if (warnings) *warnings = diags.warnings();
     scene->commit();
     return scene;

@@ -56,8 +56,9 @@ struct GridVolume {
     std::vector<std::shared_ptr<const VdbGrid>> grids;  ///< one per channel
     Transform localToWorld;
     GridMediumOptions options;
-    bool domainGiven = false;  ///< options.domainLo/Hi hold the full extent of a .vol grid
-    std::string label;         ///< file name as written in the scene, and the grid
+    bool domainGiven = false;          ///< options.domainLo/Hi hold the full extent of a .vol grid
+    GridWrap wrap = GridWrap::kClamp;  ///< albedo volumes: wrap_mode
+    std::string label;                 ///< file name as written in the scene, and the grid
 };
 
 bool readGridVolume(MitsubaBuild& b, const XmlObject& v, VolumeRole role, GridVolume* out) {
@@ -75,9 +76,20 @@ bool readGridVolume(MitsubaBuild& b, const XmlObject& v, VolumeRole role, GridVo
         r.error(v.find("filter_type")->pos,
                 v.label() + ": filter_type '" + filter + "' is not one of trilinear, nearest");
     std::string wrap = r.getString(v, "wrap_mode", "clamp");
-    if (wrap != "clamp")
-        r.error(v.find("wrap_mode")->pos, v.label() + ": wrap_mode '" + wrap +
-                                              "' is not supported (only clamp, the default)");
+    if (wrap == "repeat" || wrap == "mirror") {
+        // An albedo lookup wraps (scene/albedo_grid.h); an extinction grid's tracking is
+        // bounded by its box, where clamp and the other modes agree only inside.
+        if (albedo)
+            out->wrap = wrap == "repeat" ? GridWrap::kRepeat : GridWrap::kMirror;
+        else
+            r.error(v.find("wrap_mode")->pos,
+                    v.label() + ": wrap_mode '" + wrap +
+                        "' is supported on albedo volumes only (an extinction grid takes "
+                        "clamp, the default)");
+    } else if (wrap != "clamp") {
+        r.error(v.find("wrap_mode")->pos,
+                v.label() + ": wrap_mode '" + wrap + "' is not one of clamp, repeat, mirror");
+    }
     // raw only changes colour data in Mitsuba's spectral variants (no spectral upsampling);
     // the rgb variants, which unibeam follows, use the values as stored either way.
     r.getBool(v, "raw", false);
@@ -253,10 +265,10 @@ bool buildMitsubaMedium(MitsubaBuild& b, const XmlObject& o, Medium* out) {
         }
         if (albedoVol) {
             const GridMediumOptions& ao = albedoGrid.options;
-            out->albedoGrid =
-                AlbedoGrid::make(albedoGrid.grids, ao.filter, albedoGrid.localToWorld,
-                                 albedoGrid.domainGiven ? ao.domainLo : nullptr,
-                                 albedoGrid.domainGiven ? ao.domainHi : nullptr, albedoGrid.label);
+            out->albedoGrid = AlbedoGrid::make(albedoGrid.grids, ao.filter, albedoGrid.localToWorld,
+                                               albedoGrid.domainGiven ? ao.domainLo : nullptr,
+                                               albedoGrid.domainGiven ? ao.domainHi : nullptr,
+                                               albedoGrid.label, albedoGrid.wrap);
         }
     } catch (const std::invalid_argument& e) {
         r.error(o.pos, o.label() + ": " + e.what());

@@ -413,6 +413,7 @@ std::unique_ptr<Scene> loadSmallUpbpScene(const std::string& objPath,
     // Medium set-up problems, placed at the material block of the offending shape.
     if (!diags.hasErrors()) {
         for (const MediumIssue& issue : scene->mediumIssues()) {
+            if (issue.warning) continue;  // none arise under the priority stack
             UpbpPos at;
             if (issue.shapeId >= 0) {
                 const int mat = scene->shapes[size_t(issue.shapeId)].materialId;
