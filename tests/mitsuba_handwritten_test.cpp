@@ -486,7 +486,8 @@ TEST(MitsubaHandWrittenPower, OrthographicRefusesLightTracingAndClipsAtTheNearPl
 }
 
 // Power of the principled check: with its weight textures ignored (the panel's metallic and
-// clearcoat checkerboards replaced by 0), pt fails the reference test.
+// clearcoat checkerboards replaced by 0), pt fails the reference test; so does the thin leaf
+// without transmission.
 TEST(MitsubaHandWrittenPower, PrincipledWeightTexturesAreDistinguished) {
     std::unique_ptr<Scene> scene = loadMitsubaScene(kDir + "/principled.xml", {{"res", "48"}});
     int cleared = 0;
@@ -500,4 +501,17 @@ TEST(MitsubaHandWrittenPower, PrincipledWeightTexturesAreDistinguished) {
     const test::ReferenceCheck check =
         checkAgainst("principled", *scene, "pt", 512, "principled pt, weight textures ignored");
     EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see the weight textures";
+    // The thin leaf without its transmission lobes (diff_trans and spec_trans 0) fails too.
+    scene = loadMitsubaScene(kDir + "/principled.xml", {{"res", "48"}});
+    int thin = 0;
+    for (Material& m : scene->materials)
+        if (m.type == MaterialType::PrincipledThin) {
+            m.principled.diffTrans = 0.0f;
+            m.principled.specTrans = 0.0f;
+            ++thin;
+        }
+    ASSERT_EQ(thin, 1);
+    const test::ReferenceCheck opaque =
+        checkAgainst("principled", *scene, "pt", 512, "principled pt, thin leaf made opaque");
+    EXPECT_FALSE(opaque.perPixel.passed) << "the reference test cannot see the leaf's transmission";
 }

@@ -931,6 +931,27 @@ TEST(MitsubaXml, PrincipledParametersDefaultsAndErrors) {
                        "  <bsdf type=\"principled\"><float name=\"spec_trans\" value=\"0.5\"/>"
                        "</bsdf></bsdf></shape>\n"));
     EXPECT_TRUE(contains(e, "cannot wrap a 'principled' BSDF with spec_trans")) << e;
+    // principledthin: a sheet (two-sided), diff_trans in [0, 2], its own sampling rates; not
+    // inside twosided (it transmits)
+    auto thin = load(scene(std::string(kLight) +
+                           "<shape type=\"rectangle\"><bsdf type=\"principledthin\">"
+                           "<float name=\"diff_trans\" value=\"1.6\"/>"
+                           "<float name=\"eta\" value=\"1.33\"/>"
+                           "<float name=\"specular_transmittance_sampling_rate\" value=\"2\"/>"
+                           "</bsdf></shape>\n"));
+    const Material& d = thin->materials[size_t(thin->shapes[0].materialId)];
+    EXPECT_EQ(d.type, MaterialType::PrincipledThin);
+    EXPECT_TRUE(d.twoSided);
+    EXPECT_NEAR(d.principled.diffTrans, 1.6f, 1e-6f);
+    EXPECT_NEAR(d.principled.rateSpecTrans, 2.0f, 1e-6f);
+    EXPECT_NEAR(d.ior, 1.33f, 1e-6f);
+    e = errorsOf(scene(std::string(kLight) +
+                       "<shape type=\"rectangle\"><bsdf type=\"principledthin\">\n"
+                       "  <float name=\"metallic\" value=\"0.5\"/></bsdf></shape>\n"));
+    EXPECT_TRUE(contains(e, "unsupported parameter 'metallic'")) << e;
+    e = errorsOf(scene(std::string(kLight) + "<shape type=\"rectangle\"><bsdf type=\"twosided\">\n"
+                                             "  <bsdf type=\"principledthin\"/></bsdf></shape>\n"));
+    EXPECT_TRUE(contains(e, "cannot wrap a 'principledthin' BSDF")) << e;
     e = errorsOf(scene(std::string(kLight) +
                        "<shape type=\"sphere\"><bsdf type=\"principled\">\n"
                        "  <float name=\"sheen\" value=\"1.5\"/></bsdf></shape>\n"));

@@ -7,7 +7,8 @@
 // differ in the last ulp). The queries cover every material type with a density (diffuse,
 // Phong, rough conductor with both masking forms, rough dielectric from both sides, plastic,
 // rough plastic with its coating table, Beckmann conductor and plastic, SmallUPBP's multi-lobe
-// material with and without refraction, Mitsuba's principled with every lobe and anisotropic)
+// material with and without refraction, Mitsuba's principled with every lobe and anisotropic,
+// principledthin)
 // and a delta one (mirror:
 // zero), with the geometric guard on and off and perturbed shading normals. A missing OpenCL
 // platform fails the test.
@@ -33,7 +34,7 @@ Vec3 randomUnit(Rng& rng) {
 }
 
 std::vector<Material> testMaterials() {
-    std::vector<Material> mats(15);
+    std::vector<Material> mats(16);
     mats[0].type = MaterialType::Diffuse;
     mats[0].diffuse = Rgb(0.7f, 0.5f, 0.3f);
     mats[1].type = MaterialType::Phong;
@@ -91,6 +92,15 @@ std::vector<Material> testMaterials() {
     mats[14].twoSided = true;
     mats[14].principled.specTrans = 0.0f;
     mats[14].principled.anisotropic = 0.6f;
+    mats[15].type = MaterialType::PrincipledThin;  // Mitsuba's principledthin
+    mats[15].twoSided = true;
+    mats[15].diffuse = Rgb(0.4f, 0.7f, 0.3f);
+    mats[15].alpha = 0.4f;
+    mats[15].ior = 1.4f;
+    mats[15].principled.specTrans = 0.4f;
+    mats[15].principled.diffTrans = 0.8f;
+    mats[15].principled.sheen = 0.5f;
+    mats[15].principled.anisotropic = 0.3f;
     for (Material& m : mats) prepareMaterial(m);
     return mats;
 }
@@ -182,7 +192,8 @@ TEST(OpenClSurf, KernelEqualsHostTwinPerQueryForEveryMaterial) {
         if (t == MaterialType::RoughConductor || t == MaterialType::RoughDielectric ||
             t == MaterialType::RoughPlastic)
             bound[m] = std::max(1e-5f, 0x1p-22f * 4.0f / (mats[m].alpha * mats[m].alpha));
-        if (t == MaterialType::Principled) {  // its sharpest lobe: GGX r^2 or the clearcoat
+        if (t == MaterialType::Principled ||
+            t == MaterialType::PrincipledThin) {  // its sharpest lobe: GGX r^2 or the clearcoat
             const float r2 = mats[m].alpha * mats[m].alpha;
             const float cc = 0.1f + (0.001f - 0.1f) * mats[m].principled.clearcoatGloss;
             const float a = std::min(std::max(0.001f, r2), cc);

@@ -430,12 +430,20 @@ TEST(JsonLoader, ObjTextureCoordinatesAreFlippedPlyAreNot) {
 TEST(JsonLoader, PrincipledMaterialAndItsErrors) {
     const std::string ok = R"json(
 "paint": {"type": "principled", "base_color": [0.8, 0.3, 0.2], "roughness": 0.3, "clearcoat": 0.5, "sheen": 0.4},
-"glass": {"type": "principled", "spec_trans": 1, "eta": 1.33, "roughness": {"type": "checkerboard", "color0": 0.1, "color1": 0.5}})json";
+"glass": {"type": "principled", "spec_trans": 1, "eta": 1.33, "roughness": {"type": "checkerboard", "color0": 0.1, "color1": 0.5}},
+"leaf": {"type": "principled_thin", "diff_trans": 1.5, "spec_trans": 0.2, "eta": 1.4})json";
     const std::string shapes = R"json({"type": "rectangle", "material": "paint"},
-{"type": "sphere", "radius": 0.5, "material": "glass"})json";
+{"type": "sphere", "radius": 0.5, "material": "glass"}, {"type": "rectangle", "material": "leaf"})json";
     auto s = loadJsonSceneFromString(sceneWith(ok, shapes, kPoint), "scene.json", ".");
-    ASSERT_EQ(s->materials.size(), 2u);
+    ASSERT_EQ(s->materials.size(), 3u);
     for (const Material& m : s->materials) {
+        if (m.name == "leaf") {
+            EXPECT_EQ(m.type, MaterialType::PrincipledThin);
+            EXPECT_TRUE(m.twoSided);
+            EXPECT_FLOAT_EQ(m.principled.diffTrans, 1.5f);
+            EXPECT_FLOAT_EQ(m.ior, 1.4f);
+            continue;
+        }
         EXPECT_EQ(m.type, MaterialType::Principled);
         EXPECT_FALSE(m.twoSided);
         if (m.name == "paint") {
@@ -452,9 +460,11 @@ TEST(JsonLoader, PrincipledMaterialAndItsErrors) {
     const std::string bad = R"json(
 "a": {"type": "principled", "eta": 1.4, "specular": 0.3},
 "b": {"type": "principled", "sheen": 1.5},
-"c": {"type": "principled", "spec_trans": 0.5, "two_sided": true})json";
+"c": {"type": "principled", "spec_trans": 0.5, "two_sided": true},
+"d": {"type": "principled_thin", "metallic": 0.5})json";
     const std::string three = R"json({"type": "rectangle", "material": "a"},
-{"type": "rectangle", "material": "b"}, {"type": "rectangle", "material": "c"})json";
+{"type": "rectangle", "material": "b"}, {"type": "rectangle", "material": "c"},
+{"type": "rectangle", "material": "d"})json";
     const std::string e = allErrors(errorsOf(sceneWith(bad, three, kPoint), "."));
     EXPECT_TRUE(contains(e, "at /materials/a/specular: give either \"eta\" or \"specular\"")) << e;
     EXPECT_TRUE(contains(e, "/materials/b/sheen")) << e;

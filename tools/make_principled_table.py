@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Writes tests/data/mitsuba/principled_table.json: values of Mitsuba 3's own `principled` BSDF
-(eval, which includes |cos wo|, and pdf) for parameter sets and direction pairs, in both
+"""Writes tests/data/mitsuba/principled_table.json: values of Mitsuba 3's own `principled` and
+`principledthin` BSDFs (eval, which includes |cos wo|, and pdf) for parameter sets and direction pairs, in both
 transport modes. tests/bsdf_principled_test.cpp checks unibeam's implementation
 (kernels/shared/ub_principled.h) against them: an independent reference, made by Mitsuba.
 
@@ -34,6 +34,14 @@ PARAMS = [
     {"base_color": [0.5, 0.5, 0.5], "spec_trans": 0.6, "metallic": 0.2, "roughness": 0.6,
      "eta": 1.6, "main_specular_sampling_rate": 0.5, "diffuse_reflectance_sampling_rate": 2.0,
      "clearcoat": 0.3, "clearcoat_sampling_rate": 0.5},
+    # principledthin (the "type" key selects it)
+    {"type": "principledthin", "base_color": [0.7, 0.1, 0.1], "roughness": 0.15,
+     "spec_tint": 0.1, "anisotropic": 0.5, "spec_trans": 0.8, "diff_trans": 0.3, "eta": 1.33},
+    {"type": "principledthin", "base_color": [0.3, 0.8, 0.4], "roughness": 0.5,
+     "diff_trans": 1.4, "sheen": 0.7, "sheen_tint": 0.5, "flatness": 0.4},
+    {"type": "principledthin", "base_color": [0.9, 0.9, 0.6], "roughness": 0.35, "spec_trans": 0.5,
+     "diff_trans": 0.8, "eta": 1.6, "specular_transmittance_sampling_rate": 2.0,
+     "diffuse_transmittance_sampling_rate": 0.5},
 ]
 PAIRS = 48
 
@@ -49,7 +57,7 @@ def bsdf_dict(p):
     d = {"type": "principled"}
     for k, v in p.items():
         d[k] = {"type": "rgb", "value": v} if isinstance(v, list) else v
-    return d
+    return d  # p's "type", where given, replaces the default
 
 
 def main():

@@ -13,6 +13,7 @@
  *   Plastic, RoughPlastic  Mitsuba 3's coated diffuse (kernels/shared/ub_plastic.h);
  *   Principled       Mitsuba 3's principled BSDF (ub_principled.h); the record's fields hold
  *                    its parameters as ub_bsdf_principled() reads them;
+ *   PrincipledThin   Mitsuba 3's principledthin (ub_principled_thin.h), likewise;
  *   MultiLobe        SmallUPBP's sum of lobes: its Lambert and Phong lobes here, picked
  *                    with probabilities proportional to the lobes' albedos, which depend on
  *                    the Fresnel weight of the delta lobes seen from the fixed direction
@@ -33,6 +34,7 @@
 #include "ub_phong.h"
 #include "ub_plastic.h"
 #include "ub_principled.h"
+#include "ub_principled_thin.h"
 #include "ub_vec3.h"
 
 /* Material types (the values of ub::MaterialType, src/scene/material.h). */
@@ -47,6 +49,7 @@
 #define UB_MATERIAL_THIN_DIELECTRIC 8u
 #define UB_MATERIAL_MULTI_LOBE 9u
 #define UB_MATERIAL_PRINCIPLED 11u
+#define UB_MATERIAL_PRINCIPLED_THIN 12u
 
 #define UB_BSDF_EVALUABLE 1u       /* valid, not all-delta, not black: evaluation can be > 0 */
 #define UB_BSDF_FROM_LIGHT 2u      /* light subpath: importance transport (bsdf.h) */
@@ -392,6 +395,46 @@ UB_INLINE ub_float3 ub_bsdf_eval_principled(UB_PRIVATE const ub_bsdf* b, ub_floa
     return ub_f3_scale(v, 1.0f / ub_fabs(gen.z));
 }
 
+/* PrincipledThin: as ub_bsdf_principled, with anisotropic in exponent, diff_trans and the
+ * transmission sampling rates in plasticBase (Bsdf::packShared). */
+UB_INLINE ub_principled_thin ub_bsdf_principled_thin(UB_PRIVATE const ub_bsdf* b) {
+    ub_principled_thin p;
+    for (int c = 0; c < 3; ++c) p.base[c] = b->diffuse[c];
+    p.roughness = b->eta[2];
+    p.anisotropic = b->exponent;
+    p.specTrans = b->glossy[1];
+    p.specTint = b->glossy[2];
+    p.sheen = b->specular[0];
+    p.sheenTint = b->specular[1];
+    p.flatness = b->specular[2];
+    p.diffTrans = b->plasticBase[0];
+    p.eta = b->ior;
+    p.rateDiffRefl = b->k[0];
+    p.rateSpecRefl = b->k[1];
+    p.rateSpecTrans = b->plasticBase[1];
+    p.rateDiffTrans = b->plasticBase[2];
+    return p;
+}
+
+/* PrincipledThin: the frame is on dirFix's side (two-sided); the reverse pdf mirrors both
+ * directions to dirGen's side, as Mitsuba does for a wi below the sheet. Mitsuba's thin model
+ * is not reciprocal (its microsurface side tests differ when the two directions swap roles),
+ * so a light subpath evaluates the adjoint of the radiance BSDF, f(dirGen -> dirFix): every
+ * estimator then converges to what Mitsuba's path tracer renders. */
+UB_INLINE ub_float3 ub_bsdf_eval_principled_thin(UB_PRIVATE const ub_bsdf* b, ub_float3 gen,
+                                                 UB_PRIVATE float* directPdfW,
+                                                 UB_PRIVATE float* reversePdfW) {
+    ub_principled_thin p = ub_bsdf_principled_thin(b);
+    ub_float3 fix = ub_f3_from(b->localFix);
+    *directPdfW = ub_principled_thin_pdf(&p, fix, gen);
+    float s = gen.z < 0.0f ? -1.0f : 1.0f;
+    *reversePdfW = ub_principled_thin_pdf(&p, ub_f3_scale(gen, s), ub_f3_scale(fix, s));
+    if (b->flags & UB_BSDF_FROM_LIGHT)
+        return ub_f3_scale(ub_principled_thin_value(&p, ub_f3_scale(gen, s), ub_f3_scale(fix, s)),
+                           1.0f / ub_fabs(fix.z));
+    return ub_f3_scale(ub_principled_thin_value(&p, fix, gen), 1.0f / ub_fabs(gen.z));
+}
+
 /* f_s(dirFix, dirGen) and both pdfs for dirGen given in the shading frame; cosGeoGen =
  * dot(dirGen, geoNormal). Applies the geometric guard, the perturbed-normal rule and factor,
  * and, for light subpaths, the shading-normal factor. coating: the rough plastic's coating table
@@ -427,6 +470,9 @@ UB_INLINE ub_float3 ub_bsdf_eval_local(UB_PRIVATE const ub_bsdf* b, UB_GLOBAL co
             break;
         case UB_MATERIAL_PRINCIPLED:
             f = ub_bsdf_eval_principled(b, gen, directPdfW, reversePdfW);
+            break;
+        case UB_MATERIAL_PRINCIPLED_THIN:
+            f = ub_bsdf_eval_principled_thin(b, gen, directPdfW, reversePdfW);
             break;
         default:
             break;

@@ -146,7 +146,7 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
     perturbed_ = mat.perturbation != NormalPerturbation::kNone;
     terminatorAlpha2_ = perturbed_ && mat.shadowTerminator ? shadowTerminatorAlpha2(ns, ng) : 0.0f;
     if (!keepsNormalSide(mat) && dot(dirFix, ns) < 0.0f) {
-        if (mat.twoSided) {
+        if (mat.twoSided || mat.type == MaterialType::PrincipledThin) {  // a sheet: both sides
             ns = -ns;
             ng = -ng;
         } else {
@@ -155,7 +155,8 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
     }
     frame_ = Frame(ns);
     if ((colors_.alphaU != colors_.alphaV ||
-         (mat.type == MaterialType::Principled && colors_.principled.anisotropic != 0.0f)) &&
+         ((mat.type == MaterialType::Principled || mat.type == MaterialType::PrincipledThin) &&
+          colors_.principled.anisotropic != 0.0f)) &&
         lengthSqr(tangent) > 0.0f) {
         // Anisotropic roughness: alpha_u along Mitsuba's shading tangent s, the tangent made
         // orthogonal to the (perturbed, possibly flipped) shading normal; t = n x s. The
@@ -217,6 +218,9 @@ bool Bsdf::setup(const Material& mat, const SurfaceColors& colors, const Vec3& d
         case MaterialType::MultiLobe:
             setupMultiLobe();
             break;
+        case MaterialType::PrincipledThin:
+            contProb_ = std::max(0.5f, maxComponent(colors_.diffuse));  // as Principled
+            break;
         case MaterialType::Principled:
             // Russian roulette: any probability in (0, 1] is unbiased; the largest base
             // colour channel, at least 1/2 (a black base still has its specular lobes).
@@ -252,7 +256,8 @@ void Bsdf::packShared() {
                       uint32_t(MaterialType::RoughPlastic) == UB_MATERIAL_ROUGH_PLASTIC &&
                       uint32_t(MaterialType::ThinDielectric) == UB_MATERIAL_THIN_DIELECTRIC &&
                       uint32_t(MaterialType::MultiLobe) == UB_MATERIAL_MULTI_LOBE &&
-                      uint32_t(MaterialType::Principled) == UB_MATERIAL_PRINCIPLED,
+                      uint32_t(MaterialType::Principled) == UB_MATERIAL_PRINCIPLED &&
+                      uint32_t(MaterialType::PrincipledThin) == UB_MATERIAL_PRINCIPLED_THIN,
                   "MaterialType values are the UB_MATERIAL_* of kernels/shared/ub_bsdf.h");
     ub_bsdf& b = shared_;
     const Material& m = *mat_;
@@ -294,6 +299,16 @@ void Bsdf::packShared() {
     b.tableIndex = 0;  // the surface-merging pass sets the material's index
     b.terminatorAlpha2 = terminatorAlpha2_;
     coating_ = m.type == MaterialType::RoughPlastic ? m.coatingTransmittance.data() : nullptr;
+    if (m.type == MaterialType::PrincipledThin) {
+        // The parameters in the fields ub_bsdf_principled_thin reads (kernels/shared/ub_bsdf.h).
+        const PrincipledParams& q = colors_.principled;
+        b.exponent = q.anisotropic;
+        put(b.glossy, Vec3(0.0f, q.specTrans, q.specTint));
+        put(b.specular, Vec3(q.sheen, q.sheenTint, q.flatness));
+        put(b.eta, Vec3(0.0f, 0.0f, colors_.alphaU));
+        put(b.k, Vec3(q.rateDiffuse, q.rateSpecular, 0.0f));
+        put(b.plasticBase, Vec3(q.diffTrans, q.rateSpecTrans, q.rateDiffTrans));
+    }
     if (m.type == MaterialType::Principled) {
         // The parameters in the fields ub_bsdf_principled reads (kernels/shared/ub_bsdf.h).
         const PrincipledParams& q = colors_.principled;
@@ -438,6 +453,15 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
             ub_float3 wo;
             if (!ub_principled_sample(&p, ub_make_float3(fix.x, fix.y, fix.z), rnd.x, rnd.y, rnd.z,
                                       &wo))
+                return Rgb(0.0f);
+            gen = Vec3(wo.x, wo.y, wo.z);
+            break;
+        }
+        case MaterialType::PrincipledThin: {
+            const ub_principled_thin p = ub_bsdf_principled_thin(&shared_);
+            ub_float3 wo;
+            if (!ub_principled_thin_sample(&p, ub_make_float3(fix.x, fix.y, fix.z), rnd.x, rnd.y,
+                                           rnd.z, &wo))
                 return Rgb(0.0f);
             gen = Vec3(wo.x, wo.y, wo.z);
             break;

@@ -33,6 +33,8 @@ enum class MaterialType : uint32_t {
     Principled = 11,  ///< Mitsuba 3 `principled` (kernels/shared/ub_principled.h): base colour
                       ///< `diffuse`, roughness `alpha` (both texturable), `ior` = eta, the
                       ///< other weights in `principled`
+    PrincipledThin = 12,  ///< Mitsuba 3 `principledthin` (kernels/shared/ub_principled_thin.h):
+                          ///< as Principled; a sheet of no thickness, the same from both sides
 };
 
 /// Mitsuba 3's `principled` parameters other than base colour (Material::diffuse), roughness
@@ -41,21 +43,26 @@ struct PrincipledParams {
     float anisotropic = 0.0f, metallic = 0.0f, specTrans = 0.0f, specTint = 0.0f;
     float sheen = 0.0f, sheenTint = 0.0f, flatness = 0.0f;
     float clearcoat = 0.0f, clearcoatGloss = 0.0f;
-    /// diffuse_reflectance_sampling_rate, main_specular_sampling_rate, clearcoat_sampling_rate
+    /// PrincipledThin: the diffuse transmission, in [0, 2] as Mitsuba's diff_trans.
+    float diffTrans = 0.0f;
+    /// diffuse_reflectance_sampling_rate, main_specular_sampling_rate (PrincipledThin:
+    /// specular_reflectance_sampling_rate), clearcoat_sampling_rate; PrincipledThin's
+    /// specular_transmittance_sampling_rate and diffuse_transmittance_sampling_rate.
     float rateDiffuse = 1.0f, rateSpecular = 1.0f, rateClearcoat = 1.0f;
-    /// The nine weights above in order (anisotropic ... clearcoatGloss), for textures.
-    static constexpr int kWeights = 9;
+    float rateSpecTrans = 1.0f, rateDiffTrans = 1.0f;
+    /// The ten weights above in order (anisotropic ... diffTrans), for textures.
+    static constexpr int kWeights = 10;
     float& weight(int i) {
-        float* w[kWeights] = {&anisotropic, &metallic, &specTrans, &specTint,      &sheen,
-                              &sheenTint,   &flatness, &clearcoat, &clearcoatGloss};
+        float* w[kWeights] = {&anisotropic, &metallic, &specTrans, &specTint,       &sheen,
+                              &sheenTint,   &flatness, &clearcoat, &clearcoatGloss, &diffTrans};
         return *w[i];
     }
     float weight(int i) const { return const_cast<PrincipledParams*>(this)->weight(i); }
     /// Mitsuba's names of the weights, in weight() order.
     static const char* weightName(int i) {
-        static const char* names[kWeights] = {"anisotropic", "metallic",  "spec_trans",
-                                              "spec_tint",   "sheen",     "sheen_tint",
-                                              "flatness",    "clearcoat", "clearcoat_gloss"};
+        static const char* names[kWeights] = {
+            "anisotropic", "metallic", "spec_trans", "spec_tint",       "sheen",
+            "sheen_tint",  "flatness", "clearcoat",  "clearcoat_gloss", "diff_trans"};
         return names[i];
     }
 };
@@ -73,7 +80,7 @@ struct MaterialTextures {
     int alphaV = -1;
     /// Principled: textures of its weights, in PrincipledParams::weight order (the
     /// texture's luminance, Mitsuba's float textures).
-    std::array<int, PrincipledParams::kWeights> principled{-1, -1, -1, -1, -1, -1, -1, -1, -1};
+    std::array<int, PrincipledParams::kWeights> principled{-1, -1, -1, -1, -1, -1, -1, -1, -1, -1};
 };
 
 /// Mitsuba 3's `normalmap` and `bumpmap` wrappers: the shading normal of a hit perturbed by a
@@ -163,7 +170,7 @@ struct Material {
     /// Anisotropic roughness (alphaV or its texture given): the BSDF needs the shading
     /// tangent of the hit (Hit::tangent).
     bool anisotropic() const {
-        if (type == MaterialType::Principled)
+        if (type == MaterialType::Principled || type == MaterialType::PrincipledThin)
             return principled.anisotropic != 0.0f || textures.principled[0] >= 0;
         return (type == MaterialType::RoughConductor || type == MaterialType::RoughDielectric) &&
                ((alphaV >= 0.0f && (alphaV != alpha || textures.alpha >= 0)) ||

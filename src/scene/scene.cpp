@@ -259,7 +259,7 @@ int Scene::addMaterial(const Material& m) {
                             m.textures.transmittance, m.textures.weight, m.textures.alpha,
                             m.textures.alphaV};
     ids.insert(ids.end(), m.textures.principled.begin(), m.textures.principled.end());
-    if (m.type != MaterialType::Principled)
+    if (m.type != MaterialType::Principled && m.type != MaterialType::PrincipledThin)
         for (int t : m.textures.principled)
             if (t >= 0)
                 throw std::logic_error("Scene::addMaterial: material '" + m.name +
@@ -275,10 +275,12 @@ int Scene::addMaterial(const Material& m) {
                                "' has a normal or bump map without a texture");
     const bool microfacet =
         m.type == MaterialType::RoughConductor || m.type == MaterialType::RoughDielectric;
-    if (m.type == MaterialType::Principled && (m.textures.alphaV >= 0 || m.alphaV >= 0.0f))
+    const bool principled =
+        m.type == MaterialType::Principled || m.type == MaterialType::PrincipledThin;
+    if (principled && (m.textures.alphaV >= 0 || m.alphaV >= 0.0f))
         throw std::logic_error("Scene::addMaterial: principled material '" + m.name +
                                "' takes its anisotropy from principled.anisotropic, not alphaV");
-    if (!microfacet && m.type != MaterialType::Principled &&
+    if (!microfacet && !principled &&
         (m.textures.alpha >= 0 || m.textures.alphaV >= 0 || m.alphaV >= 0.0f))
         throw std::logic_error("Scene::addMaterial: material '" + m.name +
                                "' has a textured or anisotropic roughness, which only rough "

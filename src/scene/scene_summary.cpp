@@ -34,6 +34,8 @@ const char* materialTypeName(MaterialType t) {
             return "blend";
         case MaterialType::Principled:
             return "principled";
+        case MaterialType::PrincipledThin:
+            return "principled_thin";
     }
     return "unknown";
 }

@@ -269,18 +269,30 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
         if (rough)
             mat.alpha = r.getNumber(m, ptr, "alpha", Presence::Optional,
                                     NumberRange::leftOpen(0.0, 1.0), 0.1f);
-    } else if (type == "principled") {
-        // Mitsuba 3's principled (kernels/shared/ub_principled.h), its parameter names and
-        // defaults; one-sided unless "two_sided" (Mitsuba's twosided) and without spec_trans.
-        mat.type = MaterialType::Principled;
-        const std::vector<std::string> weights = {"anisotropic", "metallic",  "spec_trans",
-                                                  "spec_tint",   "sheen",     "sheen_tint",
-                                                  "flatness",    "clearcoat", "clearcoat_gloss"};
-        keys.insert(keys.end(), {"base_color", "roughness", "eta", "specular", "two_sided",
-                                 "diffuse_reflectance_sampling_rate", "main_specular_sampling_rate",
-                                 "clearcoat_sampling_rate"});
+    } else if (type == "principled" || type == "principled_thin") {
+        // Mitsuba 3's principled and principledthin (kernels/shared/ub_principled.h,
+        // ub_principled_thin.h), their parameter names and defaults. principled is one-sided
+        // unless "two_sided" (Mitsuba's twosided) and without spec_trans; principled_thin is a
+        // sheet, the same from both sides.
+        const bool thin = type == "principled_thin";
+        mat.type = thin ? MaterialType::PrincipledThin : MaterialType::Principled;
+        std::vector<std::string> weights = {"anisotropic", "spec_trans", "spec_tint",
+                                            "sheen",       "sheen_tint", "flatness"};
+        if (thin)
+            weights.push_back("diff_trans");
+        else
+            weights.insert(weights.end(), {"metallic", "clearcoat", "clearcoat_gloss"});
+        keys.insert(keys.end(),
+                    {"base_color", "roughness", "eta", "diffuse_reflectance_sampling_rate"});
+        if (thin)
+            keys.insert(keys.end(), {"specular_reflectance_sampling_rate",
+                                     "specular_transmittance_sampling_rate",
+                                     "diffuse_transmittance_sampling_rate"});
+        else
+            keys.insert(keys.end(), {"specular", "two_sided", "main_specular_sampling_rate",
+                                     "clearcoat_sampling_rate"});
         keys.insert(keys.end(), weights.begin(), weights.end());
-        r.checkKeys(m, ptr, keys, "principled material");
+        r.checkKeys(m, ptr, keys, type + " material");
         colour("base_color", Rgb(0.5f), &mat.diffuse, &mat.textures.diffuse);
         const Json* rough = r.member(m, ptr, "roughness", Presence::Optional, "");
         if (rough && rough->is_object()) {
@@ -293,17 +305,29 @@ void readMaterial(JsonReader& r, const Json& m, const std::string& ptr, Material
                                     NumberRange::closed(0.0, 1.0), 0.5f);
         }
         PrincipledParams& q = mat.principled;
-        float* fields[] = {&q.anisotropic, &q.metallic, &q.specTrans, &q.specTint,      &q.sheen,
-                           &q.sheenTint,   &q.flatness, &q.clearcoat, &q.clearcoatGloss};
-        for (size_t i = 0; i < weights.size(); ++i)
-            *fields[i] = r.getNumber(m, ptr, weights[i], Presence::Optional,
-                                     NumberRange::closed(0.0, 1.0), 0.0f);
-        q.rateDiffuse = r.getNumber(m, ptr, "diffuse_reflectance_sampling_rate", Presence::Optional,
-                                    NumberRange::nonNegative(), 1.0f);
-        q.rateSpecular = r.getNumber(m, ptr, "main_specular_sampling_rate", Presence::Optional,
-                                     NumberRange::nonNegative(), 1.0f);
-        q.rateClearcoat = r.getNumber(m, ptr, "clearcoat_sampling_rate", Presence::Optional,
-                                      NumberRange::nonNegative(), 1.0f);
+        for (int i = 0; i < PrincipledParams::kWeights; ++i) {
+            const std::string name = PrincipledParams::weightName(i);
+            if (std::find(weights.begin(), weights.end(), name) == weights.end()) continue;
+            q.weight(i) =
+                r.getNumber(m, ptr, name, Presence::Optional,
+                            NumberRange::closed(0.0, name == "diff_trans" ? 2.0 : 1.0), 0.0f);
+        }
+        auto rate = [&](const char* key) {
+            return r.getNumber(m, ptr, key, Presence::Optional, NumberRange::nonNegative(), 1.0f);
+        };
+        q.rateDiffuse = rate("diffuse_reflectance_sampling_rate");
+        if (thin) {
+            q.rateSpecular = rate("specular_reflectance_sampling_rate");
+            q.rateSpecTrans = rate("specular_transmittance_sampling_rate");
+            q.rateDiffTrans = rate("diffuse_transmittance_sampling_rate");
+            mat.ior = r.getNumber(m, ptr, "eta", Presence::Optional, NumberRange::positive(), 1.5f);
+            mat.twoSided = true;
+            if (q.rateDiffuse + q.rateSpecular + q.rateSpecTrans + q.rateDiffTrans <= 0.0f)
+                r.error(ptr, "every sampling rate is zero (nothing can be sampled)");
+            return;
+        }
+        q.rateSpecular = rate("main_specular_sampling_rate");
+        q.rateClearcoat = rate("clearcoat_sampling_rate");
         if (m.contains("eta") && m.contains("specular")) {
             r.error(jsonPointerChild(ptr, "specular"),
                     "give either \"eta\" or \"specular\", not both");

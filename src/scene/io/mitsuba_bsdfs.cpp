@@ -16,7 +16,8 @@ namespace {
 const std::vector<std::string> kBsdfs = {
     "diffuse",        "conductor", "roughconductor", "dielectric", "roughdielectric",
     "thindielectric", "plastic",   "roughplastic",   "null",       "twosided",
-    "normalmap",      "bumpmap",   "blendbsdf",      "mask",       "principled"};
+    "normalmap",      "bumpmap",   "blendbsdf",      "mask",       "principled",
+    "principledthin"};
 const std::vector<std::string> kTextures = {"checkerboard", "bitmap", "mesh_attribute",
                                             "rawconstant"};
 
@@ -151,8 +152,8 @@ void readReflectance(MitsubaBuild& b, const XmlObject& o, const std::string& nam
 /// evaluation (src/textures/checkerboard.cpp in 3.9.1: eval_1 takes color0 where exactly one
 /// of frac(u), frac(v) exceeds 1/2, eval where both or neither do), so a float use sees the
 /// colours swapped; measured against Mitsuba on tests/data/mitsuba/blend.xml.
-int floatTexture(MitsubaBuild& b, const XmlObject& tex) {
-    int id = buildMitsubaTexture(b, tex);
+int floatTexture(MitsubaBuild& b, const XmlObject& tex, ColorUse use = ColorUse::Reflectance) {
+    int id = buildMitsubaTexture(b, tex, use);
     if (id >= 0 && b.scene.textures[size_t(id)].type == TextureType::Checkerboard) {
         Texture swapped = b.scene.textures[size_t(id)];
         std::swap(swapped.color0, swapped.color1);
@@ -245,13 +246,14 @@ void readMicrofacetRoughness(MitsubaBuild& b, const XmlObject& o, Material* m, b
     read("alpha", &m->alpha, &m->textures.alpha);
 }
 
-/// Mitsuba 3's `principled` (kernels/shared/ub_principled.h): base_color a colour or texture,
-/// roughness and the other weights floats in [0, 1] or float textures; eta or specular (not both,
-/// as Mitsuba), with Mitsuba's nudges of eta = 1 and specular = 0 when spec_trans is given; the
-/// three sampling rates.
-void readPrincipled(MitsubaBuild& b, const XmlObject& o, Material* m) {
+/// Mitsuba 3's `principled` (kernels/shared/ub_principled.h) and `principledthin`
+/// (ub_principled_thin.h): base_color a colour or texture, roughness and the other weights
+/// floats in [0, 1] (diff_trans [0, 2]) or float textures; principled's eta or specular (not
+/// both, as Mitsuba), with Mitsuba's nudges of eta = 1 and specular = 0 when spec_trans is
+/// given; principledthin's eta (a float, default 1.5); the sampling rates.
+void readPrincipled(MitsubaBuild& b, const XmlObject& o, Material* m, bool thin) {
     XmlReader& r = b.r;
-    m->type = MaterialType::Principled;
+    m->type = thin ? MaterialType::PrincipledThin : MaterialType::Principled;
     readReflectance(b, o, "base_color", Rgb(0.5f), &m->diffuse, &m->textures.diffuse);
     if (const XmlObject* tex = r.child(o, "texture", "roughness"))
         m->textures.alpha = floatTexture(b, *tex);
@@ -260,16 +262,34 @@ void readPrincipled(MitsubaBuild& b, const XmlObject& o, Material* m) {
     PrincipledParams& q = m->principled;
     bool texturedSpecTrans = false;
     for (int i = 0; i < PrincipledParams::kWeights; ++i) {
-        const char* name = PrincipledParams::weightName(i);
+        const std::string name = PrincipledParams::weightName(i);
+        const bool thinOnly = name == "diff_trans";
+        const bool fullOnly =
+            name == "metallic" || name == "clearcoat" || name == "clearcoat_gloss";
+        if ((thin && fullOnly) || (!thin && thinOnly)) continue;  // checkUnused reports them
         if (const XmlObject* tex = r.child(o, "texture", name)) {
-            m->textures.principled[size_t(i)] = floatTexture(b, *tex);
-            texturedSpecTrans |= &q.weight(i) == &q.specTrans;
+            // diff_trans reaches 2: not a reflectance (its values are checked where used)
+            m->textures.principled[size_t(i)] =
+                floatTexture(b, *tex, thinOnly ? ColorUse::Unbounded : ColorUse::Reflectance);
+            texturedSpecTrans |= name == "spec_trans";
         } else {
-            q.weight(i) = r.getFloatIn(o, name, 0.0f, 0.0f, 1.0f);
+            q.weight(i) = r.getFloatIn(o, name, 0.0f, 0.0f, thinOnly ? 2.0f : 1.0f);
         }
     }
     const float inf = std::numeric_limits<float>::infinity();
     q.rateDiffuse = r.getFloatIn(o, "diffuse_reflectance_sampling_rate", 1.0f, 0.0f, inf);
+    if (thin) {
+        q.rateSpecular = r.getFloatIn(o, "specular_reflectance_sampling_rate", 1.0f, 0.0f, inf);
+        q.rateSpecTrans = r.getFloatIn(o, "specular_transmittance_sampling_rate", 1.0f, 0.0f, inf);
+        q.rateDiffTrans = r.getFloatIn(o, "diffuse_transmittance_sampling_rate", 1.0f, 0.0f, inf);
+        if (const XmlObject* tex = r.child(o, "texture", "eta"))
+            r.error(tex->pos, o.label() + ": a textured 'eta' is not supported (expected a float)");
+        m->ior = r.getFloatIn(o, "eta", 1.5f, 0.0f, inf, /*loOpen=*/true);
+        m->twoSided = true;  // a sheet, the same from both sides
+        if (q.rateDiffuse + q.rateSpecular + q.rateSpecTrans + q.rateDiffTrans <= 0.0f)
+            r.error(o.pos, o.label() + ": every sampling rate is zero (nothing can be sampled)");
+        return;
+    }
     q.rateSpecular = r.getFloatIn(o, "main_specular_sampling_rate", 1.0f, 0.0f, inf);
     q.rateClearcoat = r.getFloatIn(o, "clearcoat_sampling_rate", 1.0f, 0.0f, inf);
     const bool hasSpecTrans = texturedSpecTrans || (r.has(o, "spec_trans") && q.specTrans != 0.0f);
@@ -451,7 +471,7 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
                                std::to_string(inner.size()));
         } else if (inner[0]->type == "dielectric" || inner[0]->type == "roughdielectric" ||
                    inner[0]->type == "thindielectric" || inner[0]->type == "null" ||
-                   inner[0]->type == "twosided") {
+                   inner[0]->type == "twosided" || inner[0]->type == "principledthin") {
             r.error(inner[0]->pos, o.label() + ": cannot wrap a '" + inner[0]->type + "' BSDF");
         } else if (inner[0]->type == "principled" &&
                    (r.child(*inner[0], "texture", "spec_trans") ||
@@ -540,8 +560,8 @@ int buildMitsubaBsdf(MitsubaBuild& b, const XmlObject& o) {
         readReflectance(b, o, "specular_reflectance", Rgb(1.0f), &m.specular, &m.textures.specular);
         m.nonlinear = r.getBool(o, "nonlinear", false);
         if (rough) readMicrofacetRoughness(b, o, &m, /*full=*/false);
-    } else if (o.type == "principled") {
-        readPrincipled(b, o, &m);
+    } else if (o.type == "principled" || o.type == "principledthin") {
+        readPrincipled(b, o, &m, o.type == "principledthin");
     } else if (o.type == "roughdielectric") {
         m.type = MaterialType::RoughDielectric;
         m.ior = readRelativeIor(r, o);
