@@ -441,7 +441,7 @@ TEST(JsonLoaderErrors, UnknownTypesListValidTypes) {
     EXPECT_EQ(d[0].message,
               "unknown material type 'difuse' (did you mean 'diffuse'?); valid types: "
               "diffuse, phong, mirror, dielectric, rough_conductor, rough_dielectric, plastic, "
-              "rough_plastic, thin_dielectric, multi_lobe");
+              "rough_plastic, thin_dielectric, multi_lobe, principled, principled_thin");
     EXPECT_EQ(d[1].message,
               "unknown shape type 'cone' (did you mean 'cube'?); valid types: obj, ply, "
               "rectangle, cube, sphere, disk, cylinder");

@@ -44,9 +44,9 @@ const MetalPreset kMetals[] = {
 };
 
 const std::vector<std::string> kMaterialTypes = {
-    "diffuse",          "phong",   "mirror",        "dielectric",      "rough_conductor",
-    "rough_dielectric", "plastic", "rough_plastic", "thin_dielectric", "multi_lobe",
-    "principled"};
+    "diffuse",          "phong",          "mirror",        "dielectric",      "rough_conductor",
+    "rough_dielectric", "plastic",        "rough_plastic", "thin_dielectric", "multi_lobe",
+    "principled",       "principled_thin"};
 
 /// Mitsuba 3's default IORs: polypropylene (plastics), BK7 glass (thin_dielectric), air.
 constexpr float kPolypropyleneIor = 1.49f, kBk7Ior = 1.5046f, kAirIor = 1.000277f;
