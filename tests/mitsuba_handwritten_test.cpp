@@ -147,6 +147,9 @@ const HandCase kCases[] = {
     {"principled", "lt", 4096},
     {"principled", "vcm", 256},
     {"principled", "upbp", 128},
+    {"sdfgrid", "pt", 512},
+    {"sdfgrid", "bpt", 256},
+    {"sdfgrid", "vcm", 256},
     {"mesh_attributes", "pt", 512},
     {"mesh_attributes", "bpt", 256},
     {"mesh_attributes", "lt", 512},
@@ -514,4 +517,31 @@ TEST(MitsubaHandWrittenPower, PrincipledWeightTexturesAreDistinguished) {
     const test::ReferenceCheck opaque =
         checkAgainst("principled", *scene, "pt", 512, "principled pt, thin leaf made opaque");
     EXPECT_FALSE(opaque.perPixel.passed) << "the reference test cannot see the leaf's transmission";
+}
+
+// Power of the sdfgrid check: the instanced grid with smooth instead of analytic normals, the
+// first one with analytic instead of smooth, or the first grid moved by half a voxel (0.085),
+// each fails the reference test.
+TEST(MitsubaHandWrittenPower, SdfGridNormalsAndPlacementAreDistinguished) {
+    struct Edit {
+        const char* from;
+        const char* to;
+        const char* label;
+    };
+    const Edit edits[] = {
+        {R"(<string name="normals" value="analytic"/>)",
+         R"(<string name="normals" value="smooth"/>)",
+         "sdfgrid pt, smooth normals on the instanced grid"},
+        {"sdf.vol\"/>\n        <transform",
+         "sdf.vol\"/><string name=\"normals\" value=\"analytic\"/>\n        <transform",
+         "sdfgrid pt, analytic normals on the first grid"},
+        {R"(<translate x="-2.2" y="-0.33" z="-0.9"/>)",
+         R"(<translate x="-2.115" y="-0.33" z="-0.9"/>)",
+         "sdfgrid pt, the grid moved by half a voxel"},
+    };
+    for (const Edit& e : edits) {
+        std::unique_ptr<Scene> scene = loadEdited("sdfgrid", e.from, e.to);
+        const test::ReferenceCheck check = checkAgainst("sdfgrid", *scene, "pt", 512, e.label);
+        EXPECT_FALSE(check.perPixel.passed) << "the reference test cannot see: " << e.label;
+    }
 }

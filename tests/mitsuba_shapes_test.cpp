@@ -682,3 +682,55 @@ TEST(JsonLoaderMirror, MirrorTakesAMetalOrEtaAndK) {
                              R"({"type": "rectangle", "material": "m"})"));
     EXPECT_TRUE(contains(e, "unknown metal 'golf'")) << e;
 }
+
+// ---------------------------------------------------------------- sdfgrid
+
+// The sdfgrid shape (scene/sdf_grid.h; its images against Mitsuba: mitsuba_handwritten_test):
+// loads from a one-channel .vol, alone or through an instance; an emitter, a medium, a bad
+// `normals` value and a three-channel grid are errors naming the shape.
+TEST(MitsubaShapes, SdfGridLoadsAndItsErrorsNameTheShape) {
+    const std::string dir = std::string(UNIBEAM_TEST_DATA_DIR) + "/mitsuba";
+    auto errors = [&](const std::string& text) {
+        try {
+            loadMitsubaSceneFromString(text, "scene.xml", dir);
+        } catch (const InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    auto ok = loadMitsubaSceneFromString(scene(R"(<shape type="sdfgrid">
+  <string name="filename" value="volumes/sdf.vol"/>
+</shape>
+)"),
+                                         "scene.xml", dir);
+    ASSERT_EQ(ok->shapes.size(), 1u);
+    EXPECT_TRUE(ok->shapes[0].isSdfGrid);
+    std::string e = errors(scene(R"(<shape type="sdfgrid">
+  <string name="filename" value="volumes/sdf.vol"/>
+  <emitter type="area"><rgb name="radiance" value="1"/></emitter>
+</shape>
+)"));
+    EXPECT_TRUE(contains(e, "an sdfgrid cannot emit")) << e;
+    e = errors(scene(R"(<shape type="sdfgrid">
+  <string name="filename" value="volumes/sdf.vol"/>
+  <bsdf type="null"/>
+  <medium type="homogeneous" name="interior"><rgb name="sigma_t" value="1"/></medium>
+</shape>
+)"));
+    EXPECT_TRUE(contains(e, "an sdfgrid cannot bound a medium")) << e;
+    e = errors(scene(R"(<shape type="sdfgrid">
+  <string name="filename" value="volumes/sdf.vol"/>
+  <string name="normals" value="flat"/>
+</shape>
+)"));
+    EXPECT_TRUE(contains(e, "scene.xml:10:3: error")) << e;
+    EXPECT_TRUE(contains(e, "normals 'flat' is not one of smooth, analytic")) << e;
+    e = errors(scene(R"(<shape type="sdfgrid">
+  <string name="filename" value="volumes/albedo.vol"/>
+</shape>
+)"));
+    EXPECT_TRUE(contains(e, "has 3 channels (expected 1: signed distances)")) << e;
+    e = errors(scene(R"(<shape type="sdfgrid"/>
+)"));
+    EXPECT_TRUE(contains(e, "needs <string name=\"filename\">")) << e;
+}

@@ -8,7 +8,8 @@ var_sample = B * var(batch means of B samples)), 48x48, Mitsuba's `scalar_rgb` v
 and SCENE_ref.json with the Mitsuba version, sample count and batches.
 
 The scenes' inputs (textures/tiles.png, stripes.jpg, normalmap.png, heights.png, slide.png,
-volumes/density.vol, volumes/albedo.vol, volumes/chromatic.vol, meshes/attributes.ply) are
+volumes/density.vol, volumes/albedo.vol, volumes/chromatic.vol, volumes/sdf.vol,
+meshes/attributes.ply) are
 written by --make-inputs, with Mitsuba's own writers.
 
 Usage (not run by the tests; the outputs are committed):
@@ -93,6 +94,22 @@ def make_inputs(folder):
     make_chromatic_volume(folder)
     make_slide(folder)
     make_attribute_mesh(folder)
+    make_sdf(folder)
+
+
+def make_sdf(folder):
+    """sdfgrid.xml's distances: a torus and a sphere blended by min (a surface with saddles,
+    a thin hole and convex parts), sampled at 14^3 points over [0, 1]^3 (sample i at
+    i / 13, Mitsuba's sdfgrid convention; coarse, so that the analytic normals' facets and
+    the smooth normals differ visibly), one channel."""
+    n = 14
+    c = np.arange(n) / (n - 1)
+    Z, Y, X = np.meshgrid(c, c, c, indexing="ij")
+    qx, qy, qz = X - 0.5, Y - 0.45, Z - 0.5
+    torus = np.sqrt((np.sqrt(qx ** 2 + qz ** 2) - 0.27) ** 2 + qy ** 2) - 0.09
+    sphere = np.sqrt((X - 0.5) ** 2 + (Y - 0.68) ** 2 + (Z - 0.5) ** 2) - 0.17
+    d = np.minimum(torus, sphere)
+    mi.VolumeGrid(d[..., None].astype(np.float32)).write(str(folder / "volumes" / "sdf.vol"))
 
 
 def make_slide(folder):

@@ -46,6 +46,7 @@
 #include "core/error.h"
 #include "scene/bsdf.h"
 #include "scene/normal_perturbation.h"
+#include "scene/sdf_grid.h"
 
 namespace ub {
 
@@ -197,11 +198,65 @@ void sphereOccluded(const RTCOccludedFunctionNArguments* args) {
     }
 }
 
+void sdfBounds(const RTCBoundsFunctionArguments* args) {
+    const auto* g = static_cast<const SdfGrid*>(args->geometryUserPtr);
+    const Bounds3& b = g->voxelBounds[args->primID];
+    RTCBounds* o = args->bounds_o;
+    o->lower_x = b.lo.x;
+    o->lower_y = b.lo.y;
+    o->lower_z = b.lo.z;
+    o->upper_x = b.hi.x;
+    o->upper_y = b.hi.y;
+    o->upper_z = b.hi.z;
+}
+
+void sdfIntersect(const RTCIntersectFunctionNArguments* args) {
+    const auto* g = static_cast<const SdfGrid*>(args->geometryUserPtr);
+    const unsigned N = args->N;
+    RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, N);
+    RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, N);
+    for (unsigned i = 0; i < N; ++i) {
+        if (!args->valid[i]) continue;
+        const Vec3 o(RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i), RTCRayN_org_z(ray, N, i));
+        const Vec3 d(RTCRayN_dir_x(ray, N, i), RTCRayN_dir_y(ray, N, i), RTCRayN_dir_z(ray, N, i));
+        float t;
+        if (!g->intersect(args->primID, o, d, RTCRayN_tnear(ray, N, i), RTCRayN_tfar(ray, N, i),
+                          &t))
+            continue;
+        Vec3 ng, ns;
+        g->normals(args->primID, o + t * d, &ng, &ns);
+        RTCRayN_tfar(ray, N, i) = t;
+        RTCHitN_Ng_x(hit, N, i) = ng.x;
+        RTCHitN_Ng_y(hit, N, i) = ng.y;
+        RTCHitN_Ng_z(hit, N, i) = ng.z;
+        RTCHitN_u(hit, N, i) = 0.0f;
+        RTCHitN_v(hit, N, i) = 0.0f;
+        RTCHitN_primID(hit, N, i) = args->primID;
+        RTCHitN_geomID(hit, N, i) = args->geomID;
+        RTCHitN_instID(hit, N, i, 0) = args->context->instID[0];
+    }
+}
+
+void sdfOccluded(const RTCOccludedFunctionNArguments* args) {
+    const auto* g = static_cast<const SdfGrid*>(args->geometryUserPtr);
+    const unsigned N = args->N;
+    RTCRayN* ray = args->ray;
+    for (unsigned i = 0; i < N; ++i) {
+        if (!args->valid[i]) continue;
+        const Vec3 o(RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i), RTCRayN_org_z(ray, N, i));
+        const Vec3 d(RTCRayN_dir_x(ray, N, i), RTCRayN_dir_y(ray, N, i), RTCRayN_dir_z(ray, N, i));
+        float t;
+        if (g->intersect(args->primID, o, d, RTCRayN_tnear(ray, N, i), RTCRayN_tfar(ray, N, i), &t))
+            RTCRayN_tfar(ray, N, i) = -std::numeric_limits<float>::infinity();
+    }
+}
+
 /// Per-shape data needed to fill a Hit. Vertex and index arrays live in Embree's
 /// buffers (no second copy).
 struct ShapeGeom {
     bool isSphere = false;
     std::unique_ptr<SphereGeom> sphere;  // stable address: Embree's user data pointer
+    std::shared_ptr<const SdfGrid> sdf;  // sdfgrid shapes
     const float* vertices = nullptr;     // 3 floats per vertex (Embree buffer)
     const uint32_t* indices = nullptr;   // 3 per triangle (Embree buffer)
     std::vector<Vec3> normals;
@@ -426,6 +481,34 @@ uint32_t Scene::addSphere(const Vec3& center, float radius, int materialId, int 
     return id;
 }
 
+uint32_t Scene::addSdfGrid(std::shared_ptr<const SdfGrid> grid, int materialId,
+                           const std::string& name) {
+    if (impl_->committed) throw std::logic_error("Scene::addSdfGrid called after commit()");
+    if (!grid || grid->voxels.empty()) throw std::logic_error("Scene::addSdfGrid: empty grid");
+    ShapeGeom g;
+    g.sdf = std::move(grid);
+    const uint32_t id = uint32_t(impl_->geoms.size());
+    RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_USER);
+    impl_->check("creating an sdfgrid");
+    rtcSetGeometryUserPrimitiveCount(geom, unsigned(g.sdf->voxels.size()));
+    rtcSetGeometryUserData(geom, const_cast<SdfGrid*>(g.sdf.get()));
+    rtcSetGeometryBoundsFunction(geom, sdfBounds, nullptr);
+    rtcSetGeometryIntersectFunction(geom, sdfIntersect);
+    rtcSetGeometryOccludedFunction(geom, sdfOccluded);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(impl_->scene, geom, id);
+    rtcReleaseGeometry(geom);
+    impl_->check("adding an sdfgrid");
+    ShapeInfo info;
+    info.name = name;
+    info.isSdfGrid = true;
+    info.materialId = materialId;
+    for (const Bounds3& b : g.sdf->voxelBounds) info.bounds.extend(b);
+    impl_->geoms.push_back(std::move(g));
+    shapes.push_back(info);
+    return id;
+}
+
 int Scene::addMedium(const Medium& m, const std::string& name) {
     if (impl_->committed) throw std::logic_error("Scene::addMedium called after commit()");
     media.push_back(m);
@@ -453,7 +536,8 @@ void Scene::setExteriorMedium(uint32_t shapeId, int exteriorMediumId) {
 
 void Scene::meshTriangle(uint32_t shapeId, uint32_t tri, Vec3 p[3]) const {
     const ShapeGeom& g = impl_->geoms.at(shapeId);
-    if (g.isSphere) throw std::logic_error("Scene::meshTriangle called on a sphere");
+    if (g.isSphere || g.sdf)
+        throw std::logic_error("Scene::meshTriangle called on a sphere or an sdfgrid");
     const uint32_t* idx = g.indices + 3 * size_t(tri);
     for (int i = 0; i < 3; ++i) p[i] = impl_->vertex(g, idx[i]);
 }
@@ -566,6 +650,18 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
     hit->lightId = shapes[id].lightId;
     hit->attribute = Rgb(0.0f);
 
+    if (g.sdf) {
+        // The hit point is not projected onto the level set (as Mitsuba): its error is the
+        // root finder's 1e-5 along the ray, below the origin offset of the next ray.
+        hit->pos = ray.org + rh.ray.tfar * ray.dir;
+        g.sdf->normals(rh.hit.primID, hit->pos, &hit->geoNormal, &hit->shadingNormal);
+        hit->uv = Vec2(0.0f, 0.0f);  // no parameterisation, as in Mitsuba
+        hit->tangent = Vec3(0.0f);
+        if (needsTangent(hit->materialId)) {
+            hit->tangent = Frame(hit->shadingNormal).s;  // any: the shape has no dp/du
+        }
+        return true;
+    }
     if (g.isSphere) {
         // Re-project the hit onto the sphere (double precision) so that the point
         // lies within an ulp or two of the surface.

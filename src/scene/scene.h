@@ -122,9 +122,12 @@ struct RenderSettings {
     std::string defaultAlgorithm;
 };
 
+struct SdfGrid;
+
 struct ShapeInfo {
     std::string name;
     bool isSphere = false;
+    bool isSdfGrid = false;  ///< Mitsuba's sdfgrid (scene/sdf_grid.h): no triangles, no uvs
     int materialId = -1;
     int lightId = -1;
     size_t triangleCount = 0;  ///< 0 for spheres
@@ -158,6 +161,10 @@ class Scene {
     uint32_t addMesh(TriangleMesh mesh, int materialId, int lightId, const std::string& name);
     uint32_t addSphere(const Vec3& center, float radius, int materialId, int lightId,
                        const std::string& name);
+    /// Adds a Mitsuba `sdfgrid` (scene/sdf_grid.h), one Embree user primitive per voxel the
+    /// surface crosses. It cannot emit nor bound a medium.
+    uint32_t addSdfGrid(std::shared_ptr<const SdfGrid> grid, int materialId,
+                        const std::string& name);
     /// Adds a participating medium; returns its id (index into media).
     int addMedium(const Medium& m, const std::string& name);
     /// Declares shape shapeId a medium boundary (scene/medium_stack.h): interior medium

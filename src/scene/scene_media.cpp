@@ -196,7 +196,9 @@ std::vector<MediumIssue> Scene::mediumIssues() const {
                     "around the shape)");
         if (sh.imaginary && sh.lightId >= 0)
             add(int(s), -1, name + " is an imaginary medium boundary and cannot emit light");
-        if (!sh.isSphere) {
+        if (sh.isSdfGrid) {
+            add(int(s), -1, name + " is an sdfgrid, which cannot bound a medium");
+        } else if (!sh.isSphere) {
             Vec3 a, b;
             size_t bad = countBadEdges(*this, uint32_t(s), sh.triangleCount, &a, &b);
             // Mitsuba's transitions are local to each crossing (the side of the face), so an

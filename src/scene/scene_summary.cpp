@@ -103,15 +103,18 @@ std::string describeScene(const Scene& scene) {
     std::ostringstream os;
     if (!scene.sourceFile.empty()) os << "scene: " << scene.sourceFile << "\n";
 
-    size_t spheres = 0, meshes = 0, triangles = 0;
+    size_t spheres = 0, meshes = 0, triangles = 0, sdfGrids = 0;
     for (const ShapeInfo& s : scene.shapes) {
         if (s.isSphere)
             ++spheres;
+        else if (s.isSdfGrid)
+            ++sdfGrids;
         else
             ++meshes, triangles += s.triangleCount;
     }
     os << "shapes: " << scene.shapes.size() << " (" << meshes << " meshes with " << triangles
-       << " triangles, " << spheres << " spheres)\n";
+       << " triangles, " << spheres << " spheres"
+       << (sdfGrids ? ", " + std::to_string(sdfGrids) + " sdfgrids" : std::string()) << ")\n";
 
     os << "materials: " << countByType(scene.materials, [](const Material& m) {
         return materialTypeName(m.type);

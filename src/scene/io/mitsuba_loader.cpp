@@ -4,14 +4,17 @@
 
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <set>
 
 #include "core/file_status.h"
 #include "core/image.h"
 #include "scene/io/mitsuba_build.h"
 #include "scene/mesh_io.h"
+#include "scene/sdf_grid.h"
 #include "scene/serialized_mesh.h"
 #include "scene/shapes.h"
+#include "scene/vol_grid.h"
 
 namespace ub {
 
@@ -19,8 +22,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kShapes = {"obj",    "ply",  "serialized", "rectangle",  "cube",
-                                          "sphere", "disk", "cylinder",   "shapegroup", "instance"};
+const std::vector<std::string> kShapes = {"obj",     "ply",        "serialized", "rectangle",
+                                          "cube",    "sphere",     "disk",       "cylinder",
+                                          "sdfgrid", "shapegroup", "instance"};
 const std::vector<std::string> kEmitters = {"area",     "point",       "spot",  "projector",
                                             "constant", "directional", "envmap"};
 const std::vector<std::string> kIntegrators = {"path",   "volpath", "volpathmis",
@@ -40,12 +44,18 @@ float similarityScale(const Transform& t) {
     return s;
 }
 
-/// A shape's geometry: a triangle mesh, or a sphere's centre and radius.
+/// A shape's geometry: a triangle mesh, a sphere's centre and radius, or an sdfgrid's samples
+/// with its to_world (an instance composes its own, so the grid is built where it is added).
 struct ShapeGeometry {
     TriangleMesh mesh;
     bool isSphere = false;
     Vec3 center;
     float radius = 1.0f;
+    bool isSdfGrid = false;
+    std::shared_ptr<const VolGrid> sdfSamples;
+    Transform sdfToWorld;
+    bool sdfSmooth = true;
+    std::string sdfLabel;
 };
 
 /// The shapes of a `shapegroup`, built once in the group's space and copied per instance.
@@ -556,6 +566,40 @@ int Builder::blackMaterial() {
 // group's space): its mesh, or the centre and radius of a sphere.
 void Builder::readGeometry(const XmlObject& o, ShapeGeometry* g) {
     Transform toWorld = r_.getTransform(o, "to_world");
+    if (o.type == "sdfgrid") {
+        // Mitsuba's sdfgrid (scene/sdf_grid.h): a one-channel .vol of distances over [0, 1]^3.
+        g->isSdfGrid = true;
+        g->sdfToWorld = toWorld;
+        const std::string normals = r_.getString(o, "normals", "smooth");
+        if (normals != "smooth" && normals != "analytic")
+            r_.error(o.find("normals")->pos,
+                     o.label() + ": normals '" + normals + "' is not one of smooth, analytic");
+        g->sdfSmooth = normals != "analytic";
+        const std::string file = r_.getString(o, "filename", "");
+        if (file.empty()) {
+            r_.error(o.pos, o.label() +
+                                ": needs <string name=\"filename\"> (a .vol grid of "
+                                "distances)");
+            return;
+        }
+        const std::string path = b_.resolveFile(o, "filename", file);
+        if (path.empty()) return;
+        try {
+            auto vol = std::make_shared<VolGrid>(readVolFile(path));
+            if (vol->channels != 1)
+                r_.error(o.find("filename")->pos, o.label() + ": '" + file + "' has " +
+                                                      std::to_string(vol->channels) +
+                                                      " channels (expected 1: signed distances)");
+            g->sdfSamples = vol;
+            g->sdfLabel = path;
+            // Validated now (resolution, values, a surface), built again where it is added.
+            SdfGrid::make(vol->nx, vol->ny, vol->nz, vol->values, toWorld, g->sdfSmooth, path);
+        } catch (const InputError& e) {
+            for (const Diagnostic& d : e.diagnostics())
+                r_.error(o.find("filename")->pos, o.label() + ": " + d.message);
+        }
+        return;
+    }
     bool flipNormals = r_.getBool(o, "flip_normals", false);
     TriangleMesh& mesh = g->mesh;
     const XmlProperty* toWorldProp = o.find("to_world");
@@ -689,6 +733,10 @@ void Builder::readShape(const XmlObject& o) {
     else
         materialId = em ? blackMaterial() : defaultMaterial();
     if (!bindMeshAttribute(o, materialId, &g)) return;
+    if (g.isSdfGrid && em) {
+        r_.error(em->pos, o.label() + " '" + name + "': an sdfgrid cannot emit (nor in Mitsuba)");
+        return;
+    }
 
     int lightId = -1;
     Light light;
@@ -764,6 +812,18 @@ void Builder::readShape(const XmlObject& o) {
                 r_.error(em->pos, em->label() + ": " + d.message);
             return;
         }
+    }
+    if (g.isSdfGrid) {
+        if (boundary) {
+            r_.error(o.pos, o.label() + " '" + name +
+                                "': an sdfgrid cannot bound a medium (not supported)");
+            return;
+        }
+        const VolGrid& v = *g.sdfSamples;
+        b_.scene.addSdfGrid(
+            SdfGrid::make(v.nx, v.ny, v.nz, v.values, g.sdfToWorld, g.sdfSmooth, g.sdfLabel),
+            materialId, name);
+        return;
     }
     const uint32_t shapeId = isSphere
                                  ? b_.scene.addSphere(center, radius, materialId, lightId, name)
@@ -867,7 +927,19 @@ void Builder::readInstance(const XmlObject& o) {
     const float scale = similarityScale(toWorld);
     for (const ShapeGroupShapes::Member& m : shapes.members) {
         const std::string memberName = name + "/" + m.name;
-        if (m.geometry.isSphere) {
+        if (m.geometry.isSdfGrid) {
+            const VolGrid& v = *m.geometry.sdfSamples;
+            try {
+                b_.scene.addSdfGrid(
+                    SdfGrid::make(v.nx, v.ny, v.nz, v.values, toWorld * m.geometry.sdfToWorld,
+                                  m.geometry.sdfSmooth, m.geometry.sdfLabel),
+                    m.materialId, memberName);
+            } catch (const InputError& e) {
+                for (const Diagnostic& d : e.diagnostics())
+                    r_.error(toWorldProp ? toWorldProp->pos : o.pos, o.label() + ": " + d.message);
+                return;
+            }
+        } else if (m.geometry.isSphere) {
             if (!(scale > 0)) {
                 r_.error(toWorldProp ? toWorldProp->pos : o.pos,
                          o.label() +
