@@ -1,6 +1,9 @@
 // Light tracing (lt, and the light-tracing technique of bpt; Veach 1997, Sec. 10.2): each
-// non-specular light vertex y is connected to the pinhole camera and splatted to the pixel
-// it projects to.
+// non-specular light vertex y is connected to the camera and splatted to the pixel it
+// projects to. A thin lens: to a lens point sampled uniformly (the camera's own lens
+// sampling, so its area pdf cancels against the importance's 1 / A_lens and appears in no
+// MIS ratio), splatted where the line through it meets the focus plane; the camera's
+// direction pdf from a lens point is the pinhole's d_img^2 / cos^3 (scene/camera.h).
 //
 // Estimates  Theta_y f(y) T(y, c) / (N_L p_cam,A)   with p_cam,A = p_cam,W |cos_y| / d^2,
 //            the image-to-surface factor of [TR Sec. 5.2] (|cos_y| = 1 in a medium).
@@ -10,18 +13,21 @@
 //            whose R_out is the query beam along the camera ray.
 #include <cmath>
 
+#include "core/rng.h"
 #include "render/medium_walk.h"
 #include "render/vcm.h"
 #include "render/vertex_scatter.h"
 
 namespace ub {
 
-void VertexCM::connectToCamera(const SubPath& state, const PathVertex& v,
+void VertexCM::connectToCamera(Rng& rng, const SubPath& state, const PathVertex& v,
                                const VertexScatter& scatter, SplatBuffer::Chunk& splats) const {
     const Camera& camera = scene_.camera;
+    // The lens point (a pinhole draws no random numbers: its sequences stay as they were).
+    const Vec3 eye = camera.isPinhole() ? camera.position() : camera.lensPoint(rng.uniform2());
     Vec2 raster;
-    if (!camera.worldToRaster(v.pos, &raster)) return;
-    Vec3 dirToCamera = camera.position() - v.pos;
+    if (!camera.worldToRaster(v.pos, eye, &raster)) return;
+    Vec3 dirToCamera = eye - v.pos;
     const float distSqr = lengthSqr(dirToCamera);
     const float distance = std::sqrt(distSqr);
     dirToCamera /= distance;
@@ -45,7 +51,7 @@ void VertexCM::connectToCamera(const SubPath& state, const PathVertex& v,
     float distPdfToVertex = 1.0f, passToVertex = 1.0f;
     if (useMedia_) {
         const MediumShadow sh = scene_.shadowTransmittance(
-            camera.position(), Vec3(0.0f), scene_.cameraMediumStack, v.pos, v.geoNormal());
+            eye, Vec3(0.0f), scene_.cameraMediumStack, v.pos, v.geoNormal());
         if (sh.blocked || isBlack(sh.transmittance)) return;
         transmittance = sh.transmittance;
         distPdfToVertex = v.inMedium ? sh.pdfScatterFwdL : sh.probPass;
@@ -65,7 +71,7 @@ void VertexCM::connectToCamera(const SubPath& state, const PathVertex& v,
     const Rgb contrib =
         state.throughput * f * transmittance * (weight * imageToSurface / lightSubPathCount_);
     if (isBlack(contrib)) return;
-    if (!useMedia_ && scene_.occluded(v.pos, v.geoNormal(), camera.position(), Vec3(0.0f))) return;
+    if (!useMedia_ && scene_.occluded(v.pos, v.geoNormal(), eye, Vec3(0.0f))) return;
     splats.add(raster, contrib);
 }
 

@@ -130,16 +130,11 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
             throw InputError(scene.sourceFile, "beam paths must be >= 0 (0: N_L / 16), got " +
                                                    std::to_string(options.beamPaths));
     }
-    if ((useVC_ || lightTraceOnly_) && !scene.camera.isPinhole())
-        throw InputError(
-            scene.sourceFile,
-            "algorithm '" + options.algorithm +
-                "' uses light tracing, which needs a pinhole camera; this scene's "
-                "camera " +
-                (scene.camera.isOrthographic()
-                     ? std::string("is orthographic: use pt, vpt, ppm or bpm")
-                     : "has a thin lens (lens radius " + std::to_string(scene.camera.lensRadius()) +
-                           "): use pt, vpt, ppm or bpm, or set the lens radius to 0"));
+    if ((useVC_ || lightTraceOnly_) && !scene.camera.supportsLightTracing())
+        throw InputError(scene.sourceFile,
+                         "algorithm '" + options.algorithm +
+                             "' uses light tracing, which needs a pinhole or thin-lens camera; "
+                             "this scene's camera is orthographic: use pt, vpt, ppm or bpm");
     if (useVM_) {
         if (!(options.radius > 0.0f) || !std::isfinite(options.radius))
             throw InputError(scene.sourceFile, "merging radius must be a positive number, got " +

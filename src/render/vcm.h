@@ -188,8 +188,8 @@ class VertexCM : public Integrator {
     void traceLightPaths(int iteration, size_t begin, size_t end, SplatBuffer::Chunk& splats,
                          LightChunk& out) const;
     bool startLightPath(Rng& rng, SubPath& state) const;
-    void connectToCamera(const SubPath& state, const PathVertex& v, const VertexScatter& scatter,
-                         SplatBuffer::Chunk& splats) const;
+    void connectToCamera(Rng& rng, const SubPath& state, const PathVertex& v,
+                         const VertexScatter& scatter, SplatBuffer::Chunk& splats) const;
 
     // Camera pass (vcm_camera.cpp).
     Rgb traceCameraPath(int x, int y, int iteration, CameraRecords* records) const;

@@ -38,7 +38,9 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
     // Camera subpath partials [TR (31)-(33)], completed at the first hit. Thin lenses and
     // orthographic cameras (ppm and bpm only) never use dVCM of the camera vertex: it is
     // multiplied by bptFactor = 0.
-    const float cameraPdfW = camera.isPinhole() ? camera.pdfW(state.ray.dir) : 1.0f;
+    // Pinhole and thin lens (the direction pdf from the lens point, scene/camera.h); the
+    // orthographic camera runs without light tracing, where the value does not matter.
+    const float cameraPdfW = camera.isOrthographic() ? 1.0f : camera.pdfW(state.ray.dir);
     state.mis = ub_mis_init_camera(mis_, cameraPdfW);
 
     state.rayFromMedium = false;

@@ -136,7 +136,7 @@ void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuf
             // Light tracing: connect to the camera (a path of pathLength + 1 segments).
             if (!scatter.isDelta() && (useVC_ || lightTraceOnly_) &&
                 state.pathLength + 1 >= minLength && state.pathLength + 1 <= maxLength)
-                connectToCamera(state, v, scatter, splats);
+                connectToCamera(rng, state, v, scatter, splats);
 
             // Stop if scattering would make the path too long even when connected directly
             // (unless the vertex may pass the ray on through a null lobe, not counted).

@@ -86,11 +86,25 @@ Ray Camera::generateRay(const Vec2& raster, const Vec2& lensU) const {
         // Thin lens: all rays through the pinhole direction meet at the focus plane.
         float ft = focusDistance_ / dot(d, forward_);
         Vec3 focus = position_ + d * ft;
-        Vec2 l = sampleConcentricDisk(lensU);
-        ray.org = position_ + right_ * (l.x * lensRadius_) + up_ * (l.y * lensRadius_);
+        ray.org = lensPoint(lensU);
         ray.dir = normalize(focus - ray.org);
     }
     return ray;
+}
+
+Vec3 Camera::lensPoint(const Vec2& lensU) const {
+    if (!(lensRadius_ > 0.0f)) return position_;
+    const Vec2 l = sampleConcentricDisk(lensU);
+    return position_ + right_ * (l.x * lensRadius_) + up_ * (l.y * lensRadius_);
+}
+
+bool Camera::worldToRaster(const Vec3& p, const Vec3& lens, Vec2* raster) const {
+    if (!(lensRadius_ > 0.0f) || orthographic_) return worldToRaster(p, raster);
+    const Vec3 w = p - lens;
+    const float z = dot(w, forward_);
+    if (z <= 0.0f) return false;
+    // Where the line from the lens point to p meets the focus plane, seen through the eye.
+    return worldToRaster(lens + w * (focusDistance_ / z), raster);
 }
 
 bool Camera::worldToRaster(const Vec3& p, Vec2* raster) const {

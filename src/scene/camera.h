@@ -43,10 +43,20 @@ class Camera {
     /// picks the lens point (ignored for a pinhole).
     Ray generateRay(const Vec2& raster, const Vec2& lensU = Vec2(0.5f, 0.5f)) const;
     /// Projects world point p to raster coordinates; false if behind the camera or
-    /// outside the image. Pinhole only (light tracing requires isPinhole()).
-    /// For an orthographic camera position() is the centre of the near plane.
+    /// outside the image. Pinhole (for an orthographic camera position() is the centre of the
+    /// near plane).
     bool worldToRaster(const Vec3& p, Vec2* raster) const;
-    /// Solid-angle pdf of sampling direction `dir` (unit, world) from the eye (pinhole).
+    /// Thin lens: the raster position whose rays through lens point `lens` reach p (the line
+    /// from lens to p crosses the focus plane where the pinhole ray of that raster position
+    /// does, as generateRay builds them); a pinhole ignores `lens`.
+    bool worldToRaster(const Vec3& p, const Vec3& lens, Vec2* raster) const;
+    /// The lens point generateRay uses for lensU (the eye for a pinhole).
+    Vec3 lensPoint(const Vec2& lensU) const;
+    /// Light tracing works with a pinhole and a thin lens (not orthographic).
+    bool supportsLightTracing() const { return !orthographic_; }
+    /// Solid-angle pdf of sampling direction `dir` (unit, world) from the eye, or for a thin
+    /// lens from the lens point the ray starts at: the same d_img^2 / cos^3 (the raster maps to
+    /// the focus plane, dA_focus = (f / d_img)^2 dA_raster, and d omega = dA_focus cos^3 / f^2).
     float pdfW(const Vec3& dir) const;
 
     bool isPinhole() const { return lensRadius_ <= 0.0f && !orthographic_; }
