@@ -12,6 +12,7 @@
 #include <fstream>
 
 #include "core/image.h"
+#include "render/aov.h"
 #include "scene/bsdf.h"
 #include "scene/camera.h"
 #include "scene/io/mitsuba_spectra.h"
@@ -957,4 +958,43 @@ TEST(MitsubaXml, PrincipledParametersDefaultsAndErrors) {
                        "  <float name=\"sheen\" value=\"1.5\"/></bsdf></shape>\n"));
     EXPECT_TRUE(contains(e, "scene.xml:10:3: error")) << e;
     EXPECT_TRUE(contains(e, "'sheen'")) << e;
+}
+
+// Mitsuba's aov integrator: its "name:type" list and nested integrator are read, the
+// variables are rendered as layers (render/aov.h): on a plane z = -1 seen head-on, position.z
+// is -1 and sh_normal (0, 0, 1) everywhere the plane covers, depth between the plane's
+// nearest and farthest distance; unsupported types and a missing nested integrator are errors.
+TEST(MitsubaXml, AovIntegratorListsVariablesAndRendersThem) {
+    const std::string body = std::string(kLight) +
+                             "<shape type=\"rectangle\"><transform name=\"to_world\">"
+                             "<scale value=\"10\"/><translate z=\"-1\"/></transform></shape>\n";
+    auto s = load(std::string("<scene version=\"3.0.0\">\n") +
+                  "<integrator type=\"aov\"><string name=\"aovs\" value=\"dd:depth, nn:sh_normal,"
+                  " pp:position\"/><integrator type=\"path\"/></integrator>\n" +
+                  kSensor + body + "</scene>\n");
+    ASSERT_EQ(s->settings.aovs.size(), 3u);
+    EXPECT_EQ(s->settings.aovs[0].name, "dd");
+    EXPECT_EQ(s->settings.aovs[1].type, "sh_normal");
+    const auto layers = renderAovs(*s, 4, 1);
+    ASSERT_EQ(layers.size(), 3u);
+    EXPECT_EQ(layers[2].first, "pp");
+    const float maxDist = 5.0f / std::cos(20.0f * 3.14159265f / 180.0f) * 1.5f;
+    for (int y = 0; y < 24; ++y)
+        for (int x = 0; x < 32; ++x) {
+            ASSERT_NEAR(layers[2].second.at(x, y).z, -1.0f, 1e-5f);
+            ASSERT_NEAR(layers[1].second.at(x, y).z, 1.0f, 1e-5f);
+            const float d = layers[0].second.at(x, y).x;
+            ASSERT_GE(d, 6.0f - 1e-4f);  // the camera is at z = 5
+            ASSERT_LE(d, maxDist);
+        }
+    std::string e = errorsOf(std::string("<scene version=\"3.0.0\">\n") +
+                             "<integrator type=\"aov\"><string name=\"aovs\" value=\"a:albedo\"/>"
+                             "<integrator type=\"path\"/></integrator>\n" +
+                             kSensor + body + "</scene>\n");
+    EXPECT_TRUE(contains(e, "aov 'a:albedo': expected NAME:TYPE with TYPE one of depth")) << e;
+    e = errorsOf(std::string("<scene version=\"3.0.0\">\n") +
+                 "<integrator type=\"aov\"><string name=\"aovs\" value=\"d:depth\"/>"
+                 "</integrator>\n" +
+                 kSensor + body + "</scene>\n");
+    EXPECT_TRUE(contains(e, "expected exactly one nested <integrator>")) << e;
 }

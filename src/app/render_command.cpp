@@ -17,6 +17,7 @@
 #include "core/file_status.h"
 #include "core/image.h"
 #include "core/memory_budget.h"
+#include "render/aov.h"
 #include "render/checkpoint.h"
 #include "render/integrator.h"
 #include "render/progressive.h"
@@ -266,8 +267,21 @@ int runRender(const RenderArgs& args) {
         meta["layers"] = names;
     }
     for (const auto& [key, value] : rejectionAttributes(result.rejected)) meta[key] = value;
+    // Mitsuba's aov integrator: its variables as extra layers (render/aov.h), from as many
+    // camera samples per pixel as the image had iterations, at most 64.
+    std::vector<std::pair<std::string, Image>> exrLayers = result.layers;
+    if (!scene->settings.aovs.empty()) {
+        const int samples = std::clamp(result.iterations, 1, 64);
+        for (auto& l : renderAovs(*scene, samples, options.seed)) exrLayers.push_back(std::move(l));
+        std::string names;
+        for (const auto& a : scene->settings.aovs)
+            names += (names.empty() ? "" : ",") + a.name + ":" + a.type;
+        meta["aovs"] = names;
+        std::fprintf(stderr, "unibeam: AOV layers %s (%d camera samples per pixel)\n",
+                     names.c_str(), samples);
+    }
     if (!exrPath.empty()) {
-        writeExr(exrPath, result.image, meta, result.layers);
+        writeExr(exrPath, result.image, meta, exrLayers);
         std::fprintf(stderr, "unibeam: wrote %s\n", exrPath.c_str());
     }
     if (!args.variancePath.empty()) {

@@ -120,6 +120,13 @@ struct RenderSettings {
     /// Algorithm `unibeam render` uses when -a is not given (empty: pt). Mitsuba's `ptracer`
     /// integrator sets lt.
     std::string defaultAlgorithm;
+    /// Mitsuba's `aov` integrator: arbitrary output variables written as extra EXR layers
+    /// beside the image (render/aov.h); name and type (depth, position, uv, geo_normal,
+    /// sh_normal, prim_index, shape_index).
+    struct Aov {
+        std::string name, type;
+    };
+    std::vector<Aov> aovs;
 };
 
 struct SdfGrid;

@@ -9,6 +9,7 @@
 
 #include "core/file_status.h"
 #include "core/image.h"
+#include "render/aov.h"
 #include "scene/io/mitsuba_build.h"
 #include "scene/mesh_io.h"
 #include "scene/sdf_grid.h"
@@ -27,8 +28,8 @@ const std::vector<std::string> kShapes = {"obj",     "ply",        "serialized",
                                           "sdfgrid", "shapegroup", "instance"};
 const std::vector<std::string> kEmitters = {"area",     "point",       "spot",  "projector",
                                             "constant", "directional", "envmap"};
-const std::vector<std::string> kIntegrators = {"path",   "volpath", "volpathmis",
-                                               "direct", "ptracer", "moment"};
+const std::vector<std::string> kIntegrators = {"path",    "volpath", "volpathmis", "direct",
+                                               "ptracer", "moment",  "aov"};
 const std::vector<std::string> kRfilters = {"box", "tent", "gaussian"};
 const std::vector<std::string> kSamplers = {"independent", "stratified", "multijitter",
                                             "orthogonal", "ldsampler"};
@@ -276,6 +277,48 @@ bool Builder::bindMeshAttribute(const XmlObject& o, int materialId, ShapeGeometr
 
 void Builder::readIntegrator(const XmlObject& top) {
     const XmlObject* o = &top;
+    if (o->type == "aov") {
+        const size_t before = r_.errorCount();
+        // Mitsuba's aov: "name:type" pairs, written as extra EXR layers (render/aov.h), beside
+        // the image of its nested integrator.
+        const std::string list = r_.getString(*o, "aovs", "");
+        const XmlPos& at = o->find("aovs") ? o->find("aovs")->pos : o->pos;
+        size_t start = 0;
+        while (start <= list.size()) {
+            size_t end = list.find(',', start);
+            if (end == std::string::npos) end = list.size();
+            std::string item = list.substr(start, end - start);
+            item.erase(0, item.find_first_not_of(" \t"));
+            item.erase(item.find_last_not_of(" \t") + 1);
+            start = end + 1;
+            if (item.empty()) continue;
+            const size_t colon = item.find(':');
+            const std::string name = colon == std::string::npos ? "" : item.substr(0, colon);
+            const std::string type = colon == std::string::npos ? "" : item.substr(colon + 1);
+            bool knownType = false;
+            for (const std::string& t : aovTypes()) knownType = knownType || t == type;
+            if (name.empty() || !knownType) {
+                std::string types;
+                for (const std::string& t : aovTypes()) types += (types.empty() ? "" : ", ") + t;
+                r_.error(at, o->label() + ": aov '" + item +
+                                 "': expected NAME:TYPE with TYPE one of " + types +
+                                 " (the others, e.g. albedo or dp_du, are not supported)");
+                continue;
+            }
+            b_.scene.settings.aovs.push_back({name, type});
+        }
+        if (b_.scene.settings.aovs.empty() && r_.errorCount() == before)
+            r_.error(at, o->label() + ": needs <string name=\"aovs\"> with NAME:TYPE entries");
+        std::vector<const XmlObject*> inner = r_.children(*o, "integrator");
+        r_.checkUnused(*o);
+        if (inner.size() != 1) {
+            r_.error(o->pos, o->label() +
+                                 ": expected exactly one nested <integrator> (the image; "
+                                 "unibeam always renders one)");
+            return;
+        }
+        o = inner[0];
+    }
     if (o->type == "moment") {
         // `moment` only adds a second-moment output; it renders its nested integrator.
         std::vector<const XmlObject*> inner = r_.children(*o, "integrator");
