@@ -171,6 +171,15 @@ const std::vector<Case> kCases = {
      2,
      {"scene.json:3:", "cannot read bitmap 'image.exr': corrupt OpenEXR image: header attribute",
       "announces 1634231040 bytes, more than the 496 bytes left in the file"}},
+    // OpenEXR read a channel name running past the end of the channel list attribute (4.5 KB
+    // file, a mutation of a reference image; CI's fuzz run, 2026-12-04) on into the following
+    // attributes and sized its buffers from the garbage: 2 GB. The channel list is walked first.
+    {"fuzz_exr_image",
+     "chlist-name-past-attribute.exr",
+     2,
+     {"scene.json:3:",
+      "cannot read bitmap 'image.exr': corrupt OpenEXR image: the channel list attribute ends "
+      "inside a channel entry"}},
     // readExr allocated the pixels of the data window (12033 x 12033, 1.7 GB) before reading
     // any from a 20 KB file.
     {"fuzz_exr_image",

@@ -874,6 +874,42 @@ TEST(JsonLoaderErrors, ImageHeaderWithAbsurdSizeIsAnError) {
     }
 }
 
+// OpenEXR sizes its buffers from the channel list when it opens a file: readExr checks the
+// list first (docs/fuzzing.md). A valid 2 x 2 file with one channel's pixel type, then its
+// sampling, patched is an error naming the channel; the regression input with a name running
+// past the attribute is in tests/data/fuzz-regressions.
+TEST(JsonLoaderErrors, OpenExrChannelListIsCheckedBeforeOpening) {
+    TempDir tmp;
+    const std::string exr = (tmp.path / "bad.exr").string();
+    writeExr(exr, Image(2, 2));
+    std::string good;
+    {
+        std::ifstream in(exr, std::ios::binary);
+        good.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    const std::string tag("channels\0chlist\0", 16);
+    const size_t at = good.find(tag);
+    ASSERT_NE(at, std::string::npos);
+    const size_t entry = at + tag.size() + 4;  // the first channel: "B\0", then int32 type
+    ASSERT_EQ(good.substr(entry, 2), std::string("B\0", 2));
+    for (int field : {0, 8}) {  // pixel type, xSampling
+        std::string bytes = good;
+        const int32_t bad = field == 0 ? 7 : 2;
+        std::memcpy(&bytes[entry + 2 + size_t(field)], &bad, 4);
+        std::ofstream(exr, std::ios::binary | std::ios::trunc) << bytes;
+        try {
+            readExr(exr);
+            ADD_FAILURE() << "readExr accepted a patched channel list";
+        } catch (const InputError& err) {
+            const std::string m = err.what();
+            EXPECT_TRUE(contains(m, field == 0 ? "OpenEXR channel 'B' has pixel type 7"
+                                               : "OpenEXR channel 'B' has pixel type 2 and "
+                                                 "sampling 2 x 1"))
+                << m;
+        }
+    }
+}
+
 // Messages quote what the file holds; control characters, bytes that are not UTF-8 and
 // megabytes of text are printed escaped and cut, never raw (a NUL cut the message short).
 TEST(JsonLoaderErrors, QuotedTextIsPrintedEscapedAndCut) {

@@ -57,6 +57,41 @@ namespace {
 /// the headers of a multi-part file): each attribute's announced size must fit in the rest of
 /// the file. OpenEXR allocates what an attribute announces before reading it (found by
 /// fuzz_exr_image: a 647-byte file announcing a 1.6 GB attribute). Throws InputError.
+/// An OpenEXR chlist attribute: per channel a name (NUL-terminated), int32 pixel type, uint8
+/// pLinear, 3 reserved bytes, int32 xSampling and ySampling; an empty name ends it. Throws
+/// InputError for a type other than uint, half, float, or a sampling other than 1 x 1.
+void checkExrChannels(const std::string& path, const std::string& list) {
+    size_t at = 0;
+    auto int32At = [&](size_t i) {
+        return int32_t(uint32_t(uint8_t(list[i])) | (uint32_t(uint8_t(list[i + 1])) << 8) |
+                       (uint32_t(uint8_t(list[i + 2])) << 16) |
+                       (uint32_t(uint8_t(list[i + 3])) << 24));
+    };
+    while (at < list.size()) {
+        const size_t end = list.find('\0', at);
+        if (end == at) return;  // the empty name that ends the list
+        // A name or entry running past the attribute: OpenEXR would read on into the next
+        // attributes as channel data.
+        if (end == std::string::npos || end + 1 + 16 > list.size())
+            throw InputError(path, "corrupt OpenEXR image: the channel list attribute ends "
+                                   "inside a channel entry (truncated or corrupt file?)");
+        const std::string name = list.substr(at, end - at);
+        const int32_t type = int32At(end + 1);
+        const int32_t xs = int32At(end + 9), ys = int32At(end + 13);
+        if (type < 0 || type > 2 || xs != 1 || ys != 1) {
+            std::string shown;
+            for (char c : name.substr(0, 32))
+                shown += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
+            if (name.size() > 32) shown += "...";
+            throw InputError(path, "OpenEXR channel '" + shown + "' has pixel type " +
+                                       std::to_string(type) + " and sampling " +
+                                       std::to_string(xs) + " x " + std::to_string(ys) +
+                                       " (expected uint, half or float, sampled 1 x 1)");
+        }
+        at = end + 1 + 16;
+    }
+}
+
 void checkExrHeader(const std::string& path) {
     std::error_code ec;
     const uint64_t fileBytes = std::filesystem::file_size(path, ec);
@@ -96,6 +131,15 @@ void checkExrHeader(const std::string& path) {
                                            " bytes, more than the " +
                                            std::to_string(fileBytes - at) +
                                            " bytes left in the file (truncated or corrupt file?)");
+            }
+            if (name == "channels" && type == "chlist") {
+                // The channel list: OpenEXR sizes its line buffers from each channel's pixel
+                // type and sampling when the file is opened, so they are checked here (found
+                // by fuzz_exr_image: a 4.5 KB file with a corrupt channel took 2 GB).
+                std::string list(size_t(size), '\0');
+                if (!in.read(list.data(), size)) return;
+                checkExrChannels(path, list);
+                continue;
             }
             in.seekg(std::streamoff(size), std::ios::cur);
         }
