@@ -73,8 +73,9 @@ void checkExrChannels(const std::string& path, const std::string& list) {
         // A name or entry running past the attribute: OpenEXR would read on into the next
         // attributes as channel data.
         if (end == std::string::npos || end + 1 + 16 > list.size())
-            throw InputError(path, "corrupt OpenEXR image: the channel list attribute ends "
-                                   "inside a channel entry (truncated or corrupt file?)");
+            throw InputError(path,
+                             "corrupt OpenEXR image: the channel list attribute ends "
+                             "inside a channel entry (truncated or corrupt file?)");
         const std::string name = list.substr(at, end - at);
         const int32_t type = int32At(end + 1);
         const int32_t xs = int32At(end + 9), ys = int32At(end + 13);

@@ -8,12 +8,6 @@
 
 namespace ub {
 
-const std::vector<std::string>& aovTypes() {
-    static const std::vector<std::string> types = {
-        "depth", "position", "uv", "geo_normal", "sh_normal", "prim_index", "shape_index"};
-    return types;
-}
-
 std::vector<std::pair<std::string, Image>> renderAovs(const Scene& scene, int samples,
                                                       uint64_t seed) {
     const Camera& camera = scene.camera;

@@ -12,12 +12,10 @@
 #include <vector>
 
 #include "core/image.h"
+#include "scene/aov_types.h"
 #include "scene/scene.h"
 
 namespace ub {
-
-/// The AOV types renderAovs knows (Mitsuba's names).
-const std::vector<std::string>& aovTypes();
 
 /// One layer per scene.settings.aovs entry, named by it, `samples` camera samples per pixel
 /// (seeded by `seed`).

@@ -9,7 +9,7 @@
 
 #include "core/file_status.h"
 #include "core/image.h"
-#include "render/aov.h"
+#include "scene/aov_types.h"
 #include "scene/io/mitsuba_build.h"
 #include "scene/mesh_io.h"
 #include "scene/sdf_grid.h"
