@@ -910,6 +910,75 @@ TEST(JsonLoaderErrors, OpenExrChannelListIsCheckedBeforeOpening) {
     }
 }
 
+// Preview and string-vector attributes must hold what they announce (OpenEXR allocates it on
+// opening): a valid file with one such attribute added to its header is read, and with the
+// announced size too large it is an error naming the attribute.
+TEST(JsonLoaderErrors, OpenExrPreviewAndStringVectorMustFitTheirAttribute) {
+    TempDir tmp;
+    const std::string exr = (tmp.path / "attr.exr").string();
+    writeExr(exr, Image(2, 2));
+    std::string good;
+    {
+        std::ifstream in(exr, std::ios::binary);
+        good.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    // The end of the header: walk name, type, int32 size, value from byte 8.
+    size_t at = 8;
+    while (good[at] != '\0') {
+        at = good.find('\0', at) + 1;  // name
+        at = good.find('\0', at) + 1;  // type
+        int32_t size;
+        std::memcpy(&size, &good[at], 4);
+        at += 4 + size_t(size);
+    }
+    auto le32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+    auto withAttribute = [&](const std::string& name, const std::string& type,
+                             const std::string& value) {
+        std::string bytes = good;
+        bytes.insert(at, name + std::string(1, '\0') + type + std::string(1, '\0') +
+                             le32(uint32_t(value.size())) + value);
+        // The chunk offsets after the header are absolute: shift them by the insertion. The
+        // first chunk starts right after the table, which gives the table's length.
+        const size_t added = bytes.size() - good.size();
+        uint64_t first;
+        std::memcpy(&first, &good[at + 1], 8);
+        const size_t chunks = size_t(first - (at + 1)) / 8;
+        for (size_t o = at + added + 1; o < at + added + 1 + 8 * chunks; o += 8) {
+            uint64_t off;
+            std::memcpy(&off, &bytes[o], 8);
+            off += added;
+            std::memcpy(&bytes[o], &off, 8);
+        }
+        std::ofstream(exr, std::ios::binary | std::ios::trunc) << bytes;
+    };
+    // A 1 x 1 preview (4 bytes of RGBA) and two strings: read.
+    withAttribute("preview", "preview", le32(1) + le32(1) + std::string(4, 'p'));
+    EXPECT_NO_THROW(readExr(exr));
+    withAttribute("notes", "stringvector", le32(2) + "ab" + le32(1) + "c");
+    EXPECT_NO_THROW(readExr(exr));
+    // Announcing more than the attribute holds: errors naming it.
+    withAttribute("preview", "preview", le32(60000) + le32(60000) + std::string(4, 'p'));
+    try {
+        readExr(exr);
+        ADD_FAILURE() << "a 60000 x 60000 preview in 12 bytes was accepted";
+    } catch (const InputError& e) {
+        EXPECT_TRUE(contains(e.what(),
+                             "header attribute 'preview' (preview) announces a 60000 x "
+                             "60000 preview, more than its 12 bytes"))
+            << e.what();
+    }
+    withAttribute("notes", "stringvector", le32(2) + "ab" + le32(1000000) + "c");
+    try {
+        readExr(exr);
+        ADD_FAILURE() << "a string vector announcing 1 MB in 11 bytes was accepted";
+    } catch (const InputError& e) {
+        EXPECT_TRUE(contains(e.what(),
+                             "header attribute 'notes' (stringvector) announces a "
+                             "string of 1000000 bytes"))
+            << e.what();
+    }
+}
+
 // Messages quote what the file holds; control characters, bytes that are not UTF-8 and
 // megabytes of text are printed escaped and cut, never raw (a NUL cut the message short).
 TEST(JsonLoaderErrors, QuotedTextIsPrintedEscapedAndCut) {

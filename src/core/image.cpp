@@ -93,6 +93,42 @@ void checkExrChannels(const std::string& path, const std::string& list) {
     }
 }
 
+/// A preview or string vector attribute must hold what it announces (see checkExrHeader).
+void checkExrAttribute(const std::string& path, const std::string& name, const std::string& type,
+                       const std::string& value) {
+    if (type == "chlist") return checkExrChannels(path, value);
+    auto u32At = [&](size_t i) {
+        return uint32_t(uint8_t(value[i])) | (uint32_t(uint8_t(value[i + 1])) << 8) |
+               (uint32_t(uint8_t(value[i + 2])) << 16) | (uint32_t(uint8_t(value[i + 3])) << 24);
+    };
+    std::string shown;
+    for (char c : name.substr(0, 32))
+        shown += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
+    auto corrupt = [&](const std::string& what) {
+        throw InputError(path, "corrupt OpenEXR image: header attribute '" + shown + "' (" + type +
+                                   ") " + what + " (truncated or corrupt file?)");
+    };
+    if (type == "preview") {
+        if (value.size() < 8) corrupt("is shorter than its size fields");
+        const uint64_t need = 8u + uint64_t(u32At(0)) * uint64_t(u32At(4)) * 4u;
+        if (need > value.size())
+            corrupt("announces a " + std::to_string(u32At(0)) + " x " + std::to_string(u32At(4)) +
+                    " preview, more than its " + std::to_string(value.size()) + " bytes");
+        return;
+    }
+    // stringvector: (int32 length, characters) until the attribute ends
+    size_t at = 0;
+    while (at < value.size()) {
+        if (at + 4 > value.size()) corrupt("ends inside a string's length");
+        const uint64_t len = u32At(at);
+        at += 4;
+        if (len > value.size() - at)
+            corrupt("announces a string of " + std::to_string(len) + " bytes, more than the " +
+                    std::to_string(value.size() - at) + " left in it");
+        at += size_t(len);
+    }
+}
+
 void checkExrHeader(const std::string& path) {
     std::error_code ec;
     const uint64_t fileBytes = std::filesystem::file_size(path, ec);
@@ -133,13 +169,15 @@ void checkExrHeader(const std::string& path) {
                                            std::to_string(fileBytes - at) +
                                            " bytes left in the file (truncated or corrupt file?)");
             }
-            if (name == "channels" && type == "chlist") {
-                // The channel list: OpenEXR sizes its line buffers from each channel's pixel
-                // type and sampling when the file is opened, so they are checked here (found
-                // by fuzz_exr_image: a 4.5 KB file with a corrupt channel took 2 GB).
-                std::string list(size_t(size), '\0');
-                if (!in.read(list.data(), size)) return;
-                checkExrChannels(path, list);
+            if (type == "chlist" || type == "preview" || type == "stringvector") {
+                // Attributes whose contents OpenEXR sizes allocations from when the file is
+                // opened: a channel list (line buffers from each channel's type and sampling;
+                // by type, whatever the attribute's name), a preview image (width x height x 4
+                // bytes) and a string vector (each string's length) must fit in the attribute
+                // (found by fuzz_exr_image: 2 GB from 4.5 KB and 2.6 KB files).
+                std::string value(size_t(size), '\0');
+                if (!in.read(value.data(), size)) return;
+                checkExrAttribute(path, name, type, value);
                 continue;
             }
             in.seekg(std::streamoff(size), std::ios::cur);
