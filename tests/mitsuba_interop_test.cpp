@@ -133,10 +133,10 @@ TEST(MitsubaInterop, DirectAndPtracerIntegrators) {
                                kLight));
     EXPECT_TRUE(contains(e, "<integrator type=\"direct\">: unsupported parameter 'max_depth'"))
         << e;
-    e = errorsOf(scene("", std::string("<integrator type=\"aov\"/>\n") + kLight));
+    e = errorsOf(scene("", std::string("<integrator type=\"stokes\"/>\n") + kLight));
     EXPECT_TRUE(contains(e,
-                         "unsupported integrator plugin 'aov' (supported: path, volpath, "
-                         "volpathmis, direct, ptracer, moment)"))
+                         "unsupported integrator plugin 'stokes' (supported: path, volpath, "
+                         "volpathmis, direct, ptracer, moment, aov)"))
         << e;
 }
 
