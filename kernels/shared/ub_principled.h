@@ -130,6 +130,33 @@ UB_INLINE ub_float3 ub_principled_half(ub_float3 wi, ub_float3 wo, float etaPath
     return h.z < 0.0f ? ub_f3_neg(h) : h;
 }
 
+/* Burley's diffuse and retro-reflection (|cos i| = ci, |cos o| = co, cd = h.o), blended with
+ * the Hanrahan-Krueger fake subsurface term by flatness (Burley 2015, eq. 4); times base / pi
+ * and |cos o| by the caller. Shared by principled and principledthin. */
+UB_INLINE float ub_principled_diffuse_lobe(float ci, float co, float cd, float roughness,
+                                           float flatness) {
+    float fo = ub_principled_schlick_weight(co), fi = ub_principled_schlick_weight(ci);
+    float diff = (1.0f - 0.5f * fi) * (1.0f - 0.5f * fo);
+    float rr = 2.0f * roughness * cd * cd;
+    float lobe = diff + rr * (fo + fi + fo * fi * (rr - 1.0f));
+    if (flatness > 0.0f) {
+        float fss90 = 0.5f * rr;
+        float fss = (1.0f + (fss90 - 1.0f) * fo) * (1.0f + (fss90 - 1.0f) * fi);
+        float ss = 1.25f * (fss * (1.0f / (co + ci) - 0.5f) + 0.5f);
+        lobe = lobe + (ss - lobe) * flatness;
+    }
+    return lobe;
+}
+
+/* The sheen's colour: 1 blended towards base / luminance by sheenTint (Burley 2012, B.2). */
+UB_INLINE void ub_principled_sheen_colour(const float base[3], float lum, float sheenTint,
+                                          UB_PRIVATE float tint[3]) {
+    for (int c = 0; c < 3; ++c) {
+        float ct = lum > 0.0f ? base[c] / lum : 1.0f;
+        tint[c] = 1.0f + (ct - 1.0f) * sheenTint;
+    }
+}
+
 /* Lobe probabilities for wi (before the main lobe's reflection/refraction split); return
  * their sum (0: nothing to sample). */
 UB_INLINE float ub_principled_lobe_weights(UB_PRIVATE const ub_principled* p, int front,
@@ -244,28 +271,15 @@ UB_INLINE ub_float3 ub_principled_value(UB_PRIVATE const ub_principled* p, ub_fl
         v = ub_f3_add(v, ub_make_float3(cc, cc, cc));
     }
     if (brdf > 0.0f && reflect && front) {
-        float fo = ub_principled_schlick_weight(co), fi = ub_principled_schlick_weight(ci);
-        float diff = (1.0f - 0.5f * fi) * (1.0f - 0.5f * fo);
         float cd = ub_f3_dot(h, wo);
-        float rr = 2.0f * p->roughness * cd * cd;
-        float retro = rr * (fo + fi + fo * fi * (rr - 1.0f));
-        float lobe = diff + retro;
-        if (p->flatness > 0.0f) {
-            float fss90 = 0.5f * rr;
-            float fss = (1.0f + (fss90 - 1.0f) * fo) * (1.0f + (fss90 - 1.0f) * fi);
-            float ss = 1.25f * (fss * (1.0f / (co + ci) - 0.5f) + 0.5f);
-            lobe = lobe + (ss - lobe) * p->flatness;
-        }
-        float k = brdf * co * UB_INV_PI * lobe;
+        float k = brdf * co * UB_INV_PI *
+                  ub_principled_diffuse_lobe(ci, co, cd, p->roughness, p->flatness);
         v = ub_f3_add(v, ub_make_float3(k * p->base[0], k * p->base[1], k * p->base[2]));
         if (p->sheen > 0.0f && 1.0f - p->metallic > 0.0f) {
-            float fd = ub_principled_schlick_weight(ub_fabs(cd));
-            float s = p->sheen * (1.0f - p->metallic) * fd * co;
+            float s =
+                p->sheen * (1.0f - p->metallic) * ub_principled_schlick_weight(ub_fabs(cd)) * co;
             float tint[3];
-            for (int c = 0; c < 3; ++c) {
-                float ct = lum > 0.0f ? p->base[c] / lum : 1.0f;
-                tint[c] = 1.0f + (ct - 1.0f) * p->sheenTint;
-            }
+            ub_principled_sheen_colour(p->base, lum, p->sheenTint, tint);
             v = ub_f3_add(v, ub_make_float3(s * tint[0], s * tint[1], s * tint[2]));
         }
     }

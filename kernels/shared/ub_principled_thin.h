@@ -123,27 +123,15 @@ UB_INLINE ub_float3 ub_principled_thin_value(UB_PRIVATE const ub_principled_thin
         }
     }
     if (reflect && st < 1.0f && dt < 1.0f) {
-        float fo = ub_principled_schlick_weight(co), fi = ub_principled_schlick_weight(ci);
-        float diff = (1.0f - 0.5f * fi) * (1.0f - 0.5f * fo);
         float cd = ub_f3_dot(h, wo);
-        float rr = 2.0f * p->roughness * cd * cd;
-        float lobe = diff + rr * (fo + fi + fo * fi * (rr - 1.0f));
-        if (p->flatness > 0.0f) {
-            float fss90 = 0.5f * rr;
-            float fss = (1.0f + (fss90 - 1.0f) * fo) * (1.0f + (fss90 - 1.0f) * fi);
-            float ss = 1.25f * (fss * (1.0f / (co + ci) - 0.5f) + 0.5f);
-            lobe = lobe + (ss - lobe) * p->flatness;
-        }
-        float k = (1.0f - st) * co * UB_INV_PI * (1.0f - dt) * lobe;
+        float k = (1.0f - st) * co * UB_INV_PI * (1.0f - dt) *
+                  ub_principled_diffuse_lobe(ci, co, cd, p->roughness, p->flatness);
         v = ub_f3_add(v, ub_make_float3(k * p->base[0], k * p->base[1], k * p->base[2]));
         if (p->sheen > 0.0f) {
-            float fd = ub_principled_schlick_weight(ub_fabs(cd));
-            float s = p->sheen * (1.0f - st) * fd * (1.0f - dt) * co;
+            float s = p->sheen * (1.0f - st) * ub_principled_schlick_weight(ub_fabs(cd)) *
+                      (1.0f - dt) * co;
             float tint[3];
-            for (int c = 0; c < 3; ++c) {
-                float ct = lum > 0.0f ? p->base[c] / lum : 1.0f;
-                tint[c] = 1.0f + (ct - 1.0f) * p->sheenTint;
-            }
+            ub_principled_sheen_colour(p->base, lum, p->sheenTint, tint);
             v = ub_f3_add(v, ub_make_float3(s * tint[0], s * tint[1], s * tint[2]));
         }
     }

@@ -94,65 +94,49 @@ std::shared_ptr<const AlbedoGrid> AlbedoGrid::make(
 
 Rgb albedoGridAt(const AlbedoGrid& a, const Vec3& p) {
     const Vec3 q = a.worldToCell.point(p);
-    float v[3] = {0.0f, 0.0f, 0.0f};
-    if (a.wrap != GridWrap::kClamp) {
-        // Indices first, then wrapped (Mitsuba's texture address modes).
-        int k0[3], k1[3];
-        float w[3];
-        for (int i = 0; i < 3; ++i) {
-            const float d = a.filter == GridFilter::kNearest ? q[i] : q[i] - 0.5f;
+    // Per axis the two voxels to blend and the weight of the second (nearest: one voxel,
+    // weight 0). Trilinear works in dual space, voxel k's centre at the integer point k.
+    int k0[3], k1[3];
+    float w[3];
+    const bool trilinear = a.filter == GridFilter::kTrilinear;
+    for (int i = 0; i < 3; ++i) {
+        const int lo = a.domainLo[i], hi = a.domainHi[i];
+        if (a.wrap != GridWrap::kClamp) {
+            // Indices first, then wrapped (Mitsuba's texture address modes).
+            const float d = trilinear ? q[i] - 0.5f : q[i];
             const long long f = floorIndex(d);
-            w[i] = std::isfinite(d) ? d - float(f) : 0.0f;
-            k0[i] = wrapIndex(f, a.domainLo[i], a.domainHi[i], a.wrap);
-            k1[i] = wrapIndex(f + 1, a.domainLo[i], a.domainHi[i], a.wrap);
-        }
-        for (int c = 0; c < a.channelCount; ++c) {
-            auto acc = a.channels[c]->grid().getAccessor();
-            if (a.filter == GridFilter::kNearest) {
-                v[c] = acc.getValue(nanovdb::Coord(k0[0], k0[1], k0[2]));
-                continue;
-            }
-            auto at = [&](int x, int y, int z) {
-                return acc.getValue(
-                    nanovdb::Coord(x ? k1[0] : k0[0], y ? k1[1] : k0[1], z ? k1[2] : k0[2]));
-            };
-            const float x00 = lerp(at(0, 0, 0), at(1, 0, 0), w[0]);
-            const float x10 = lerp(at(0, 1, 0), at(1, 1, 0), w[0]);
-            const float x01 = lerp(at(0, 0, 1), at(1, 0, 1), w[0]);
-            const float x11 = lerp(at(0, 1, 1), at(1, 1, 1), w[0]);
-            v[c] = lerp(lerp(x00, x10, w[1]), lerp(x01, x11, w[1]), w[2]);
-        }
-    } else if (a.filter == GridFilter::kNearest) {
-        const nanovdb::Coord ijk(nearestIndex(q.x, a.domainLo[0], a.domainHi[0]),
-                                 nearestIndex(q.y, a.domainLo[1], a.domainHi[1]),
-                                 nearestIndex(q.z, a.domainLo[2], a.domainHi[2]));
-        for (int c = 0; c < a.channelCount; ++c)
-            v[c] = a.channels[c]->grid().getAccessor().getValue(ijk);
-    } else {
-        // Dual space: voxel k's centre at the integer point k; clamp-to-edge interpolation.
-        int k0[3], k1[3];
-        float w[3];
-        for (int i = 0; i < 3; ++i) {
+            w[i] = trilinear && std::isfinite(d) ? d - float(f) : 0.0f;
+            k0[i] = wrapIndex(f, lo, hi, a.wrap);
+            k1[i] = wrapIndex(f + 1, lo, hi, a.wrap);
+        } else if (!trilinear) {
+            k0[i] = k1[i] = nearestIndex(q[i], lo, hi);
+            w[i] = 0.0f;
+        } else {
+            // Clamp-to-edge interpolation.
             float d = q[i] - 0.5f;
-            const float lo = float(a.domainLo[i]), hi = float(a.domainHi[i]);
-            if (!(d >= lo)) d = lo;
-            if (d > hi) d = hi;
-            k0[i] = std::min(int(std::floor(d)), a.domainHi[i]);
-            k1[i] = std::min(k0[i] + 1, a.domainHi[i]);
+            if (!(d >= float(lo))) d = float(lo);
+            if (d > float(hi)) d = float(hi);
+            k0[i] = std::min(int(std::floor(d)), hi);
+            k1[i] = std::min(k0[i] + 1, hi);
             w[i] = d - float(k0[i]);
         }
-        for (int c = 0; c < a.channelCount; ++c) {
-            auto acc = a.channels[c]->grid().getAccessor();
-            auto at = [&](int x, int y, int z) {
-                return acc.getValue(
-                    nanovdb::Coord(x ? k1[0] : k0[0], y ? k1[1] : k0[1], z ? k1[2] : k0[2]));
-            };
-            const float x00 = lerp(at(0, 0, 0), at(1, 0, 0), w[0]);
-            const float x10 = lerp(at(0, 1, 0), at(1, 1, 0), w[0]);
-            const float x01 = lerp(at(0, 0, 1), at(1, 0, 1), w[0]);
-            const float x11 = lerp(at(0, 1, 1), at(1, 1, 1), w[0]);
-            v[c] = lerp(lerp(x00, x10, w[1]), lerp(x01, x11, w[1]), w[2]);
+    }
+    float v[3] = {0.0f, 0.0f, 0.0f};
+    for (int c = 0; c < a.channelCount; ++c) {
+        auto acc = a.channels[c]->grid().getAccessor();
+        if (!trilinear) {
+            v[c] = acc.getValue(nanovdb::Coord(k0[0], k0[1], k0[2]));
+            continue;
         }
+        auto at = [&](int x, int y, int z) {
+            return acc.getValue(
+                nanovdb::Coord(x ? k1[0] : k0[0], y ? k1[1] : k0[1], z ? k1[2] : k0[2]));
+        };
+        const float x00 = lerp(at(0, 0, 0), at(1, 0, 0), w[0]);
+        const float x10 = lerp(at(0, 1, 0), at(1, 1, 0), w[0]);
+        const float x01 = lerp(at(0, 0, 1), at(1, 0, 1), w[0]);
+        const float x11 = lerp(at(0, 1, 1), at(1, 1, 1), w[0]);
+        v[c] = lerp(lerp(x00, x10, w[1]), lerp(x01, x11, w[1]), w[2]);
     }
     if (a.channelCount == 1) return Rgb(v[0]);
     return Rgb(v[0], v[1], v[2]);
