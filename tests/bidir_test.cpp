@@ -204,8 +204,8 @@ TEST(BidirEngine, SameImageForAnyThreadCount) {
 
 // Light tracing connects to a sampled lens point (estimators/light_tracing.cpp): every
 // algorithm takes a thin-lens camera (images against Mitsuba's thinlens sensor:
-// mitsuba_handwritten_test, interop_lens.xml); the orthographic camera stays refused
-// (mitsuba_handwritten_test).
+// mitsuba_handwritten_test, interop_lens.xml); the orthographic camera's film too
+// (mitsuba_handwritten_test, orthographic_media.xml).
 TEST(BidirEngine, ThinLensCameraAcceptedByEveryAlgorithm) {
     auto scene = furnaceScene(Rgb(0.5f), Rgb(1.0f), 8);
     scene->camera.setup(Vec3(0, 0, 0), Vec3(0, 0, 1), Vec3(0, 1, 0), 60.0f, 8, 8, 0.05f, 1.0f);

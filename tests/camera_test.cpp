@@ -46,6 +46,36 @@ TEST(Camera, PixelCentresRoundTripThroughWorldToRaster) {
     }
 }
 
+// Orthographic: worldToRaster inverts generateRay along the whole ray, orthoFilmPoint is the
+// ray's origin, points behind the near plane are not seen, and a pixel's near-plane area is
+// the region's area over the pixel count (the light-tracing factor's A_pixel).
+TEST(Camera, OrthographicRoundTripsThroughWorldToRaster) {
+    Camera cam;
+    const Vec3 f = normalize(Vec3(0.3f, -0.4f, -1.0f));
+    const Vec3 r = normalize(cross(f, Vec3(0, 1, 0)));
+    const Vec3 u = cross(r, f);
+    cam.setupOrthographic(Vec3(1, 2, 3), f, r, u, 1.5f, 0.75f, 40, 20);
+    EXPECT_NEAR(cam.orthoPixelArea(), 3.0f * 1.5f / 800.0f, 1e-7f);
+    for (int j = 0; j < cam.height(); ++j)
+        for (int i = 0; i < cam.width(); ++i) {
+            const Vec2 px(i + 0.25f, j + 0.75f);
+            const Ray ray = cam.generateRay(px);
+            for (float t : {0.01f, 2.0f, 50.0f}) {
+                const Vec3 p = ray.org + t * ray.dir;
+                EXPECT_LT(length(cam.orthoFilmPoint(p) - ray.org), 1e-4f);
+                Vec2 back;
+                ASSERT_TRUE(cam.worldToRaster(p, &back));
+                EXPECT_NEAR(back.x, px.x, 1e-3f) << i << "," << j;
+                EXPECT_NEAR(back.y, px.y, 1e-3f) << i << "," << j;
+            }
+            Vec2 back;
+            EXPECT_FALSE(cam.worldToRaster(ray.org - 0.1f * ray.dir, &back));
+        }
+    Vec2 back;
+    EXPECT_FALSE(cam.worldToRaster(Vec3(1, 2, 3) + 2.0f * f + 1.6f * r, &back));
+    EXPECT_FALSE(cam.worldToRaster(Vec3(1, 2, 3) + 2.0f * f - 0.8f * u, &back));
+}
+
 TEST(Camera, OrientationMatchesRasterConvention) {
     Camera cam = makeCamera(64, 48, 50);
     Vec3 fwd = normalize(Vec3(-2, 0.5f, -1) - Vec3(1, 2, 3));

@@ -3,7 +3,10 @@
 // projects to. A thin lens: to a lens point sampled uniformly (the camera's own lens
 // sampling, so its area pdf cancels against the importance's 1 / A_lens and appears in no
 // MIS ratio), splatted where the line through it meets the focus plane; the camera's
-// direction pdf from a lens point is the pinhole's d_img^2 / cos^3 (scene/camera.h).
+// direction pdf from a lens point is the pinhole's d_img^2 / cos^3 (scene/camera.h). An
+// orthographic camera: to the point of its near plane in front of y, along -forward; its
+// importance is a delta in direction, so the image-to-surface factor is |cos_y| / A_pixel with
+// no 1/d^2, the conversion of a directional light's emission [TR Sec. 5.1] mirrored.
 //
 // Estimates  Theta_y f(y) T(y, c) / (N_L p_cam,A)   with p_cam,A = p_cam,W |cos_y| / d^2,
 //            the image-to-surface factor of [TR Sec. 5.2] (|cos_y| = 1 in a medium).
@@ -23,8 +26,12 @@ namespace ub {
 void VertexCM::connectToCamera(Rng& rng, const SubPath& state, const PathVertex& v,
                                const VertexScatter& scatter, SplatBuffer::Chunk& splats) const {
     const Camera& camera = scene_.camera;
-    // The lens point (a pinhole draws no random numbers: its sequences stay as they were).
-    const Vec3 eye = camera.isPinhole() ? camera.position() : camera.lensPoint(rng.uniform2());
+    // The lens point (a pinhole draws no random numbers: its sequences stay as they were), or
+    // the orthographic camera's film point.
+    const bool ortho = camera.isOrthographic();
+    const Vec3 eye = ortho                ? camera.orthoFilmPoint(v.pos)
+                     : camera.isPinhole() ? camera.position()
+                                          : camera.lensPoint(rng.uniform2());
     Vec2 raster;
     if (!camera.worldToRaster(v.pos, eye, &raster)) return;
     Vec3 dirToCamera = eye - v.pos;
@@ -41,9 +48,16 @@ void VertexCM::connectToCamera(Rng& rng, const SubPath& state, const PathVertex&
     if (cosAtCamera <= 0.0f) return;
     // Image-plane area (unit pixel area) to surface area at v.pos [TR Sec. 5.2]:
     // p_cam,W = d_img^2 / cos^3, and p_cam,A = p_cam,W cos_y / d^2 (cos_y = 1 in a medium).
-    const float imagePointToCameraDist = camera.imagePlaneDist() / cosAtCamera;
-    const float imageToSolidAngle = imagePointToCameraDist * imagePointToCameraDist / cosAtCamera;
-    const float imageToSurface = imageToSolidAngle * cosToCamera / distSqr;
+    // Orthographic: p_cam,A = cos_y / A_pixel (scene/camera.h, orthoPixelArea).
+    float imageToSurface;
+    if (ortho) {
+        imageToSurface = cosToCamera / camera.orthoPixelArea();
+    } else {
+        const float imagePointToCameraDist = camera.imagePlaneDist() / cosAtCamera;
+        const float imageToSolidAngle =
+            imagePointToCameraDist * imagePointToCameraDist / cosAtCamera;
+        imageToSurface = imageToSolidAngle * cosToCamera / distSqr;
+    }
 
     // Visibility, and with media the transmittance of the chain from the camera (walked from
     // the camera's media) with the pdf of the camera ray stopping at v (ub_mis.h, MEDIA).

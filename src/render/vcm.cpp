@@ -130,11 +130,6 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
             throw InputError(scene.sourceFile, "beam paths must be >= 0 (0: N_L / 16), got " +
                                                    std::to_string(options.beamPaths));
     }
-    if ((useVC_ || lightTraceOnly_) && !scene.camera.supportsLightTracing())
-        throw InputError(scene.sourceFile,
-                         "algorithm '" + options.algorithm +
-                             "' uses light tracing, which needs a pinhole or thin-lens camera; "
-                             "this scene's camera is orthographic: use pt, vpt, ppm or bpm");
     if (useVM_) {
         if (!(options.radius > 0.0f) || !std::isfinite(options.radius))
             throw InputError(scene.sourceFile, "merging radius must be a positive number, got " +
@@ -460,7 +455,7 @@ bool VertexCM::traceToVertex(Rng& rng, SubPath& state, PathVertex* v, bool* esca
         src.mis = state.mis;
         src.pathLength = uint32_t(state.pathLength);
         src.fromMedium = state.rayFromMedium;
-        src.applyDistSqr = state.pathLength > 1 || state.isFiniteLight;
+        src.applyDistSqr = state.applyDistSqr();
         src.shortBeams = state.fromLight ? options_.shortPhotonBeams : options_.shortQueryBeams;
         src.tag = tag;
         src.budgetName = state.fromLight ? "photon beams" : "query beams";

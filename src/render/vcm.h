@@ -49,7 +49,8 @@
 // count the other vertices only; such a vertex stays a delta vertex for MIS, never
 // connected to); surfaces that emit and have a material keep
 // scattering; Russian roulette with Bsdf::continuationProb(). Light tracing
-// needs a pinhole camera: lt, bpt, vcm, vlt and vbpt reject thin-lens cameras.
+// connects to every camera: a pinhole, a thin lens (a sampled lens point) and the
+// orthographic film (estimators/light_tracing.cpp).
 #pragma once
 
 #include <memory>
@@ -123,7 +124,11 @@ class VertexCM : public Integrator {
         Ray ray;  ///< next segment
         Rgb throughput{1, 1, 1};
         int pathLength = 1;  ///< segments, including the one being traced
+        /// false: the subpath starts with a planar measure (a light at infinity, or the
+        /// orthographic camera's film), so its first segment adds no 1/d^2 [TR Sec. 5.1]
         bool isFiniteLight = true;
+        /// Whether ub_mis_at_hit_volume converts the segment being traced with its d^2.
+        int applyDistSqr() const { return pathLength > 1 || isFiniteLight; }
         bool specularPath = true;    ///< every scattering so far was specular (camera side)
         bool rayFromMedium = false;  ///< the ray starts at a medium vertex
         bool fromLight = false;      ///< a light subpath (else camera)

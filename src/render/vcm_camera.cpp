@@ -35,13 +35,14 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
     state.ray = camera.generateRay(raster, lensU);
     if (pixelWeight <= 0.0f) return Rgb(0.0f);  // outside the image (ptracer convention)
     state.throughput = Rgb(pixelWeight);
-    // Camera subpath partials [TR (31)-(33)], completed at the first hit. Thin lenses and
-    // orthographic cameras (ppm and bpm only) never use dVCM of the camera vertex: it is
-    // multiplied by bptFactor = 0.
-    // Pinhole and thin lens (the direction pdf from the lens point, scene/camera.h); the
-    // orthographic camera runs without light tracing, where the value does not matter.
-    const float cameraPdfW = camera.isOrthographic() ? 1.0f : camera.pdfW(state.ray.dir);
+    // Camera subpath partials [TR (31)-(33)], completed at the first hit. Pinhole and thin
+    // lens: the direction pdf (from the lens point, scene/camera.h). Orthographic: the area pdf
+    // 1 / A_pixel of the ray's origin, the direction a delta, and the first hit converts it
+    // without 1/d^2 (as a directional light's first segment [TR Sec. 5.1]).
+    const bool ortho = camera.isOrthographic();
+    const float cameraPdfW = ortho ? 1.0f / camera.orthoPixelArea() : camera.pdfW(state.ray.dir);
     state.mis = ub_mis_init_camera(mis_, cameraPdfW);
+    state.isFiniteLight = !ortho;
 
     state.rayFromMedium = false;
     if (useMedia_) state.stack = scene_.cameraMediumStack;
@@ -74,7 +75,8 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
         // Emitter hit: the light endpoint's cosine is the geometric one, as in emission.
         if (!v.inMedium && v.hit.lightId >= 0 && state.pathLength >= minLength) {
             SubPath atLight = state;
-            atLight.mis = misAtHit(state, v, std::fabs(dot(v.hit.geoNormal, state.ray.dir)), 1);
+            atLight.mis = misAtHit(state, v, std::fabs(dot(v.hit.geoNormal, state.ray.dir)),
+                                   state.applyDistSqr());
             color += state.throughput * lightHitRadiance(scene_.lights[size_t(v.hit.lightId)],
                                                          atLight, state.ray.dir, v.hit.pos,
                                                          v.hit.geoNormal, v.hit.uv);
@@ -89,7 +91,7 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
         if (!setupScatter(v, state, /*fromLight=*/false, &scatter)) break;
         if (atLimit && !scatter.hasNullLobe()) break;
         // Complete the partials at this vertex [TR (31)-(36)] (ub_mis.h, MEDIA).
-        state.mis = misAtHit(state, v, scatter.cosThetaFix(), 1);
+        state.mis = misAtHit(state, v, scatter.cosThetaFix(), state.applyDistSqr());
 
         // UPBP query point: merged with photon points (pp3d) and photon beams (bp2d).
         if (v.inMedium && upbp_.queryPoints() && !atLimit) {

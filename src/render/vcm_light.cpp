@@ -83,8 +83,7 @@ void VertexCM::traceLightPaths(int iteration, size_t begin, size_t end, SplatBuf
             // Complete the MIS partials at this vertex [TR (31)-(36)], with the free-flight
             // pdfs of the segment (ub_mis.h, MEDIA); the first segment of a light at infinity
             // is in planar measure already [TR Sec. 5.1].
-            state.mis = misAtHit(state, v, scatter.cosThetaFix(),
-                                 state.pathLength > 1 || state.isFiniteLight);
+            state.mis = misAtHit(state, v, scatter.cosThetaFix(), state.applyDistSqr());
             const float rIn = ratioIn(state, v);
 
             // Store the vertex unless the BSDF is purely specular (no connection or merging).

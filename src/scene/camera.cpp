@@ -37,7 +37,7 @@ void Camera::setupOrthographic(const Vec3& nearCentre, const Vec3& forward, cons
     orthographic_ = true;
     orthoHalfWidth_ = halfWidth;
     orthoHalfHeight_ = halfHeight;
-    // Not used by an orthographic camera (no light tracing); kept finite.
+    // Not used by an orthographic camera (orthoPixelArea() instead); kept finite.
     fovYDeg_ = 0.0f;
     imagePlaneDist_ = 1.0f;
 }
@@ -107,13 +107,28 @@ bool Camera::worldToRaster(const Vec3& p, const Vec3& lens, Vec2* raster) const 
     return worldToRaster(lens + w * (focusDistance_ / z), raster);
 }
 
+Vec3 Camera::orthoFilmPoint(const Vec3& p) const {
+    return p - forward_ * dot(p - position_, forward_);
+}
+
+float Camera::orthoPixelArea() const {
+    return (2.0f * orthoHalfWidth_ / float(width_)) * (2.0f * orthoHalfHeight_ / float(height_));
+}
+
 bool Camera::worldToRaster(const Vec3& p, Vec2* raster) const {
     Vec3 v = p - position_;
     float z = dot(v, forward_);
     if (z <= 0.0f) return false;
-    float s = imagePlaneDist_ / z;
-    float x = dot(v, right_) * s + 0.5f * float(width_);
-    float y = 0.5f * float(height_) - dot(v, up_) * s;
+    float x, y;
+    if (orthographic_) {
+        // generateRay's map inverted: x_world = (2 x / W - 1) hw, y_world = (1 - 2 y / H) hh.
+        x = (dot(v, right_) / orthoHalfWidth_ + 1.0f) * 0.5f * float(width_);
+        y = (1.0f - dot(v, up_) / orthoHalfHeight_) * 0.5f * float(height_);
+    } else {
+        float s = imagePlaneDist_ / z;
+        x = dot(v, right_) * s + 0.5f * float(width_);
+        y = 0.5f * float(height_) - dot(v, up_) * s;
+    }
     if (!(x >= 0.0f && x < float(width_) && y >= 0.0f && y < float(height_))) return false;
     *raster = Vec2(x, y);
     return true;

@@ -42,9 +42,8 @@ class Camera {
     /// Primary ray through raster position `raster` (e.g. pixel + jitter); lensU in [0,1)^2
     /// picks the lens point (ignored for a pinhole).
     Ray generateRay(const Vec2& raster, const Vec2& lensU = Vec2(0.5f, 0.5f)) const;
-    /// Projects world point p to raster coordinates; false if behind the camera or
-    /// outside the image. Pinhole (for an orthographic camera position() is the centre of the
-    /// near plane).
+    /// Projects world point p to raster coordinates; false if behind the camera (for an
+    /// orthographic camera: behind its near plane) or outside the image.
     bool worldToRaster(const Vec3& p, Vec2* raster) const;
     /// Thin lens: the raster position whose rays through lens point `lens` reach p (the line
     /// from lens to p crosses the focus plane where the pinhole ray of that raster position
@@ -52,12 +51,19 @@ class Camera {
     bool worldToRaster(const Vec3& p, const Vec3& lens, Vec2* raster) const;
     /// The lens point generateRay uses for lensU (the eye for a pinhole).
     Vec3 lensPoint(const Vec2& lensU) const;
-    /// Light tracing works with a pinhole and a thin lens (not orthographic).
-    bool supportsLightTracing() const { return !orthographic_; }
+    /// Orthographic: the point of the near plane whose ray (along forward) reaches p.
+    Vec3 orthoFilmPoint(const Vec3& p) const;
     /// Solid-angle pdf of sampling direction `dir` (unit, world) from the eye, or for a thin
     /// lens from the lens point the ray starts at: the same d_img^2 / cos^3 (the raster maps to
     /// the focus plane, dA_focus = (f / d_img)^2 dA_raster, and d omega = dA_focus cos^3 / f^2).
+    /// Not for an orthographic camera (its direction is a delta: orthoPixelArea()).
     float pdfW(const Vec3& dir) const;
+    /// Orthographic: the near-plane area of one pixel (world units^2). The camera samples the
+    /// ray's origin with the area pdf 1 / orthoPixelArea() per pixel and its direction as a
+    /// delta, so the first vertex x_1 has the area pdf |cos x_1| / orthoPixelArea() with no
+    /// 1/d^2 (the delta counted as 1 on both sides of every MIS ratio, as for a directional
+    /// light [TR Sec. 5.1]).
+    float orthoPixelArea() const;
 
     bool isPinhole() const { return lensRadius_ <= 0.0f && !orthographic_; }
     bool isOrthographic() const { return orthographic_; }
