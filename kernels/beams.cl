@@ -16,6 +16,7 @@
 #include "ub_medium_homogeneous.h"
 #include "ub_pb2d.h"
 
+/* = Bvh::kStackSize (src/estimators/bvh.h), whose build checks that no walk needs more */
 #define UB_BVH_STACK 64
 /* Pieces of a query beam's private table: long query beams through the bundled VDB smoke
  * cross up to ~100 non-empty pieces (docs/performance.md). A build option may change it. */

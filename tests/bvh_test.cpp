@@ -11,7 +11,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <sstream>
+#include <string>
 
 #include "core/rng.h"
 
@@ -131,6 +134,52 @@ TEST(Bvh, WalksReportExactlyTheBoxesOfSmallCubesAndDegenerateSets) {
     int visits = 0;
     empty.querySegment(Vec3(0.0f), Vec3(1.0f, 0.0f, 0.0f), 1.0f, [&](uint32_t) { ++visits; });
     EXPECT_EQ(visits, 0);
+}
+
+// The walks hold Bvh::kStackSize entries (and UB_BVH_STACK in kernels/beams.cl), with no
+// check as they push. Boxes whose sizes fall geometrically along a line make the largest-box
+// collapse leave inner children one binary level down at every four-wide level of the small
+// boxes' path; the build must measure the stack the tree needs and keep it within the bound
+// (it then opens the shallowest child first). Measured: 25 entries for the geometric set with
+// leaves of 1, 16-20 for beam parts.
+TEST(Bvh, StackNeedStaysWithinTheWalksStack) {
+    std::vector<Bounds3> geometric;
+    for (int i = 0; i < 4000; ++i) {
+        const float x = std::pow(2.0f, -float(i) / 40.0f), h = 0.25f * x;
+        Bounds3 b;
+        b.extend(Vec3(x - h, -h, -h));
+        b.extend(Vec3(x + h, h, h));
+        geometric.push_back(b);
+    }
+    Rng rng(14, 1);
+    const std::vector<Bounds3> beams = beamBoxes(rng, 20000);
+    for (const std::vector<Bounds3>* set :
+         std::vector<const std::vector<Bounds3>*>{&geometric, &beams})
+        for (uint32_t leaf : {1u, 4u, 8u}) {
+            Bvh bvh;
+            bvh.build(*set, leaf);
+            EXPECT_LE(bvh.stackNeed(), Bvh::kStackSize) << "leaf " << leaf;
+            EXPECT_GE(bvh.stackNeed(), 4);
+        }
+    checkWalks(geometric, 1, 15);
+    // The fallback collapse: 25 entries with the largest box opened first (above), at most
+    // 3 ceil(12 / 2) + 1 = 19 with the shallowest first (12 binary levels over 4000 boxes).
+    Bvh shallow;
+    shallow.build(geometric, 1, 20);
+    EXPECT_LE(shallow.stackNeed(), 19);
+    size_t reported = 0;
+    shallow.queryPoint(Vec3(0.5f, 0.0f, 0.0f), [&](uint32_t) { ++reported; });
+    size_t expected = 0;
+    for (const Bounds3& b : geometric) expected += (b.lo.x <= 0.5f && b.hi.x >= 0.5f) ? 1 : 0;
+    EXPECT_EQ(reported, expected);
+    EXPECT_GT(expected, 0u);
+    EXPECT_THROW(shallow.build(geometric, 1, 10), std::logic_error);
+    // The kernels' stack is the host's.
+    std::ifstream cl(std::string(UNIBEAM_SOURCE_DIR) + "/kernels/beams.cl");
+    std::stringstream text;
+    text << cl.rdbuf();
+    EXPECT_NE(text.str().find("#define UB_BVH_STACK " + std::to_string(Bvh::kStackSize) + "\n"),
+              std::string::npos);
 }
 
 TEST(Bvh, SseNodeTestEqualsTheSharedOne) {

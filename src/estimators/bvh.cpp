@@ -2,10 +2,12 @@
 #include "estimators/bvh.h"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 namespace ub {
 
-void Bvh::build(const std::vector<Bounds3>& boxes, uint32_t leafSize) {
+void Bvh::build(const std::vector<Bounds3>& boxes, uint32_t leafSize, int stackLimit) {
     leafSize_ = std::max(1u, leafSize);
     nodes_.clear();
     prims_.resize(boxes.size());
@@ -19,7 +21,33 @@ void Bvh::build(const std::vector<Bounds3>& boxes, uint32_t leafSize) {
     tree.reserve(2 * boxes.size() / leafSize_ + 1);
     buildNode(boxes, centres, tree, 0, uint32_t(boxes.size()));
     nodes_.reserve(tree.size() / 3 + 1);
-    collapse(tree, 0);
+    collapse(tree, 0, false);
+    stackNeed_ = stackNeed(0, 0);
+    if (stackNeed_ > std::min(stackLimit, kStackSize)) {
+        // Opening the largest box first can leave a child one binary level down on a path of
+        // small boxes; opening the shallowest first consumes two binary levels per four-wide
+        // level (a leaf needs no entry), so with median splits (binary depth <= 33) the walk
+        // holds at most 3 * 17 + 1 = 52 entries.
+        nodes_.clear();
+        collapse(tree, 0, true);
+        stackNeed_ = stackNeed(0, 0);
+        if (stackNeed_ > std::min(stackLimit, kStackSize))
+            throw std::logic_error("Bvh::build: a walk would need " + std::to_string(stackNeed_) +
+                                   " stack entries, more than " + std::to_string(stackLimit));
+    }
+}
+
+int Bvh::stackNeed(uint32_t node, int base) const {
+    // The walk (walk() here, UB_BVH_WALK_* in kernels/beams.cl) pops this node with `base`
+    // entries left, pushes its k inner children (child 0 on top), and pops the i-th of them
+    // with k - 1 - i of its siblings still below it. The largest stack along any path.
+    const BvhNode& n = nodes_[node];
+    int k = 0;
+    for (int c = 0; c < 4; ++c) k += n.count[c] == 0 ? 1 : 0;
+    int need = base + k, i = 0;
+    for (int c = 0; c < 4; ++c)
+        if (n.count[c] == 0) need = std::max(need, stackNeed(n.child[c], base + k - 1 - i++));
+    return std::max(need, 1);
 }
 
 uint32_t Bvh::buildNode(const std::vector<Bounds3>& boxes, std::vector<Vec3>& centres,
@@ -52,10 +80,12 @@ uint32_t Bvh::buildNode(const std::vector<Bounds3>& boxes, std::vector<Vec3>& ce
     return self;
 }
 
-uint32_t Bvh::collapse(const std::vector<Node2>& tree, uint32_t self) {
+uint32_t Bvh::collapse(const std::vector<Node2>& tree, uint32_t self, bool shallowFirst) {
     // The children: a binary inner node's two, then the inner child with the largest box
-    // surface opened until there are four (a leaf root is the only child of the root).
+    // surface (shallowFirst: the one opened fewest times) opened until there are four (a
+    // leaf root is the only child of the root).
     uint32_t kids[4] = {self, 0, 0, 0};
+    int level[4] = {0, 0, 0, 0};
     int n = 1;
     while (n < 4) {
         int open = -1;
@@ -64,16 +94,21 @@ uint32_t Bvh::collapse(const std::vector<Node2>& tree, uint32_t self) {
             const Node2& t = tree[kids[k]];
             const Vec3 e = t.box.hi - t.box.lo;
             const float area = e.x * e.y + e.y * e.z + e.z * e.x;
-            if (t.count == 0 && area > best) {
-                best = area;
+            const float score = shallowFirst ? -float(level[k]) : area;
+            if (t.count == 0 && score > best) {
+                best = score;
                 open = k;
             }
         }
         if (open < 0) break;
         const uint32_t parent = kids[open];
-        for (int k = n; k > open + 1; --k) kids[k] = kids[k - 1];  // keep the tree's order
+        for (int k = n; k > open + 1; --k) {  // keep the tree's order
+            kids[k] = kids[k - 1];
+            level[k] = level[k - 1];
+        }
         kids[open] = parent + 1;
         kids[open + 1] = tree[parent].first;
+        level[open] = level[open + 1] = level[open] + 1;
         ++n;
     }
     const uint32_t index = uint32_t(nodes_.size());
@@ -92,7 +127,7 @@ uint32_t Bvh::collapse(const std::vector<Node2>& tree, uint32_t self) {
         node.hiY[c] = t.box.hi.y;
         node.hiZ[c] = t.box.hi.z;
         node.count[c] = t.count;
-        node.child[c] = t.count > 0 ? t.first : collapse(tree, kids[c]);
+        node.child[c] = t.count > 0 ? t.first : collapse(tree, kids[c], shallowFirst);
     }
     nodes_[index] = node;
     return index;

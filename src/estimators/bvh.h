@@ -68,14 +68,21 @@ inline uint32_t bvhMeets4(const BvhNode& n, const ub_float3& o, const ub_float3&
 
 class Bvh {
   public:
+    /// Entries of a walk's stack: the walks here and in kernels/beams.cl (UB_BVH_STACK) hold
+    /// kStackSize; build checks that the tree needs no more (stackNeed).
+    static constexpr int kStackSize = 64;
     /// Node memory a build needs per box, at most: two binary nodes (32 bytes each; leaves
     /// hold at least one box) and one four-wide node.
     static constexpr size_t kNodeBytesPerBox = 2 * 32 + sizeof(BvhNode);
-    /// Builds over boxes[i], i = 0..n-1, leaves of at most leafSize; visits report i.
-    void build(const std::vector<Bounds3>& boxes, uint32_t leafSize = 4);
+    /// Builds over boxes[i], i = 0..n-1, leaves of at most leafSize; visits report i. The
+    /// walks' stack holds stackLimit entries (tests pass less to reach the fallback collapse).
+    void build(const std::vector<Bounds3>& boxes, uint32_t leafSize = 4,
+               int stackLimit = kStackSize);
     bool empty() const { return nodes_.empty(); }
     size_t nodeCount() const { return nodes_.size(); }
     size_t bytes() const { return nodes_.size() * sizeof(BvhNode) + prims_.size() * 4; }
+    /// The most stack entries a walk of the last build needs, computed over the whole tree.
+    int stackNeed() const { return stackNeed_; }
     const std::vector<BvhNode>& nodes() const { return nodes_; }
 
     /// Reorders items (one per box given to build) into leaf order, so that a walk reads the
@@ -111,8 +118,10 @@ class Bvh {
     };
     uint32_t buildNode(const std::vector<Bounds3>& boxes, std::vector<Vec3>& centres,
                        std::vector<Node2>& tree, uint32_t begin, uint32_t end);
-    uint32_t collapse(const std::vector<Node2>& tree, uint32_t self);
+    uint32_t collapse(const std::vector<Node2>& tree, uint32_t self, bool shallowFirst);
+    int stackNeed(uint32_t node, int base) const;
     uint32_t leafSize_ = 4;
+    int stackNeed_ = 0;
 
     std::vector<BvhNode> nodes_;
     std::vector<uint32_t> prims_;  ///< leaf entry -> box index; empty once leaf-ordered
@@ -130,7 +139,7 @@ void Bvh::traverse(ChildMask&& childMask, Visit&& visit) const {
 template <class ChildMask, class Visit>
 void Bvh::walk(ChildMask&& childMask, Visit&& visit) const {
     if (nodes_.empty()) return;
-    uint32_t stack[64];  // depth <= 33 / 2 + 1 (median splits, bvh.cpp), 3 pushes a level
+    uint32_t stack[kStackSize];  // stackNeed() <= kStackSize entries (checked by build)
     int top = 0;
     stack[top++] = 0;
     while (top > 0) {
