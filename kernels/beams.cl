@@ -74,12 +74,9 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     ub_uint tableState = UB_TABLE_UNBUILT;
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     UB_BVH_WALK_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qb.length)) {
-        __global const ub_photon_point* pp = photons + k;
+        ub_photon_point ph = photons[k];
         float t = 0.0f;
-        if (!ub_pb2d_pair_at(ub_make_float3(pp->pos[0], pp->pos[1], pp->pos[2]), pp->mediumId,
-                             pp->pathLength, qb, radius * radius, minLength, maxLength, &t))
-            continue;
-        ub_photon_point ph = *pp;
+        if (!ub_pb2d_pair(ph, qb, radius * radius, minLength, maxLength, &t)) continue;
         ub_segment_eval s =
             ub_query_beam_segment(m, gi, &acc, qb, t, table, UB_QUERY_PIECES, &tableState);
         ub_float3 c = ub_pb2d_contribution(mis, ph, qb, s, t, m.g, normalization);

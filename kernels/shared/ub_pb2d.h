@@ -28,22 +28,14 @@ UB_INLINE float ub_pb2d_normalization(float lightPaths, float radius) {
 
 /* Whether photon ph and query beam qb make a pb2d pair: same medium, path length in
  * [minLength, maxLength], the photon within radius of the beam; writes its beam parameter. */
-UB_INLINE int ub_pb2d_pair_at(ub_float3 pos, ub_uint mediumId, ub_uint pathLength, ub_beam qb,
-                              float radiusSqr, ub_uint minLength, ub_uint maxLength,
-                              UB_PRIVATE float* t) {
-    if (mediumId != qb.mediumId) return 0;
-    ub_uint length = pathLength + qb.pathLength;
-    if (length > maxLength || length < minLength) return 0;
-    float d2 = ub_point_beam_dist2(pos, ub_f3_from(qb.origin), ub_f3_from(qb.dir), qb.length, t);
-    return d2 >= 0.0f && d2 <= radiusSqr;
-}
-
-/* ub_pb2d_pair_at with the photon's fields (the kernel passes them read from global memory,
- * so that a candidate that fails loads only them). */
 UB_INLINE int ub_pb2d_pair(ub_photon_point ph, ub_beam qb, float radiusSqr, ub_uint minLength,
                            ub_uint maxLength, UB_PRIVATE float* t) {
-    return ub_pb2d_pair_at(ub_f3_from(ph.pos), ph.mediumId, ph.pathLength, qb, radiusSqr,
-                           minLength, maxLength, t);
+    if (ph.mediumId != qb.mediumId) return 0;
+    ub_uint length = ph.pathLength + qb.pathLength;
+    if (length > maxLength || length < minLength) return 0;
+    float d2 = ub_point_beam_dist2(ub_f3_from(ph.pos), ub_f3_from(qb.origin), ub_f3_from(qb.dir),
+                                   qb.length, t);
+    return d2 >= 0.0f && d2 <= radiusSqr;
 }
 
 /* Contribution of photon ph to query beam qb at parameter t (from
