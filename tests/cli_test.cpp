@@ -196,6 +196,47 @@ TEST(Cli, PtracerSceneRendersWithLightTracingUnlessAIsGiven) {
     fs::remove_all(dir);
 }
 
+// Without -a a scene with media renders with vpt (Mitsuba's volpath scenes, and JSON scenes),
+// a ptracer scene with media with vlt; -a pt on it stays an error naming the volumetric ones.
+TEST(Cli, MediaSceneRendersWithVptUnlessAIsGiven) {
+    const std::string scene = std::string(UNIBEAM_SOURCE_DIR) + "/tests/data/mitsuba/media.xml";
+    fs::path dir = tempDir();
+    RunResult r = runUnibeam(
+        {"render", scene, "--resolution", "16x16", "-i", "1", "-o", (dir / "a.exr").string()}, dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("the scene has participating media: renders with vpt"), std::string::npos)
+        << r.err;
+    ImageMetadata meta;
+    readExr((dir / "a.exr").string(), &meta);
+    EXPECT_EQ(meta["technique"], "vpt");
+    r = runUnibeam({"render", scene, "-a", "pt", "-i", "1", "-o", (dir / "b.exr").string()}, dir);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("use a volumetric algorithm"), std::string::npos) << r.err;
+    // A ptracer integrator on the same scene: vlt.
+    std::ifstream in(scene);
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string xml = text.str();
+    const size_t at = xml.find("<integrator type=\"volpath\">");
+    ASSERT_NE(at, std::string::npos);
+    xml.replace(at, std::string("<integrator type=\"volpath\">").size(),
+                "<integrator type=\"ptracer\">");
+    // The copy lives in the test's folder: its relative file names made absolute.
+    const std::string base = fs::path(scene).parent_path().string() + "/";
+    for (const std::string key : {"filename=\"", "value=\"volumes/"})
+        for (size_t p = xml.find(key); p != std::string::npos; p = xml.find(key, p + 1))
+            xml.insert(p + key.size() - (key[0] == 'v' ? 8 : 0), base);
+    const fs::path copy = dir / "media_ptracer.xml";
+    std::ofstream(copy) << xml;
+    r = runUnibeam({"render", copy.string(), "--resolution", "16x16", "-i", "1", "-o",
+                    (dir / "c.exr").string()},
+                   dir);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    readExr((dir / "c.exr").string(), &meta);
+    EXPECT_EQ(meta["technique"], "vlt");
+    fs::remove_all(dir);
+}
+
 TEST(Cli, BadFlagsExitTwoWithMessage) {
     ASSERT_TRUE(fs::exists(kScene)) << kScene;
     fs::path dir = tempDir();

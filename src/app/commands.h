@@ -25,7 +25,8 @@ struct RenderArgs {
     std::string scene;
     std::string algorithm = "pt";
     /// -a was given; otherwise a scene's default algorithm (RenderSettings::defaultAlgorithm,
-    /// e.g. lt for Mitsuba's ptracer) replaces pt.
+    /// e.g. lt for Mitsuba's ptracer) replaces pt, and on a scene with media pt and lt become
+    /// vpt and vlt.
     bool algorithmGiven = false;
     double timeLimit = 0;    ///< -t, 0 if not given
     int iterations = 0;      ///< -i, 0 if not given

@@ -122,7 +122,8 @@ int run(int argc, char** argv) {
             ->add_option("-a,--algorithm", ra.algorithm,
                          "Rendering algorithm: one of " + algorithmList() +
                              " (default pt, or lt for a Mitsuba scene whose integrator is "
-                             "ptracer). UPBP: 'upbp' runs all six techniques, "
+                             "ptracer; on a scene with media vpt, or vlt). UPBP: 'upbp' runs all "
+                             "six techniques, "
                              "'upbp:T1+T2+...' any subset of bpt (connections, NEE, light "
                              "tracing), surf (surface merging), pp3d, pb2d, bp2d, bb1d (volumetric "
                              "points and beams), with MIS over exactly those; without bpt only "

@@ -110,9 +110,15 @@ std::string join(const std::vector<std::string>& v) {
 RenderOptions makeRenderOptions(const RenderArgs& args, const Scene& scene) {
     RenderOptions options;
     options.algorithm = args.algorithm;
-    // A scene may name its algorithm (Mitsuba's ptracer: lt); -a overrides it.
-    if (!args.algorithmGiven && !scene.settings.defaultAlgorithm.empty())
-        options.algorithm = scene.settings.defaultAlgorithm;
+    // A scene may name its algorithm (Mitsuba's ptracer: lt); -a overrides it. Without -a, a
+    // scene with media gets the volumetric twin (pt -> vpt, lt -> vlt), as Mitsuba's volpath
+    // renders what its path does and the media too.
+    if (!args.algorithmGiven) {
+        if (!scene.settings.defaultAlgorithm.empty())
+            options.algorithm = scene.settings.defaultAlgorithm;
+        if (scene.hasMedia() && (options.algorithm == "pt" || options.algorithm == "lt"))
+            options.algorithm = options.algorithm == "pt" ? "vpt" : "vlt";
+    }
     options.maxPathLength = args.maxLength ? *args.maxLength : scene.settings.maxPathLength;
     options.minPathLength = scene.settings.minPathLength;
     options.seed = args.seed ? *args.seed : scene.settings.seed;
@@ -191,9 +197,10 @@ int runRender(const RenderArgs& args) {
         scene->camera = scene->camera.resized(width, height, scene->settings.keepHorizontalFov);
     RenderOptions options = makeRenderOptions(args, *scene);
     if (options.algorithm != args.algorithm)
-        std::fprintf(stderr,
-                     "unibeam: the scene's integrator renders with %s (-a chooses another)\n",
-                     options.algorithm.c_str());
+        std::fprintf(
+            stderr, "unibeam: %s renders with %s (-a chooses another)\n",
+            scene->hasMedia() ? "the scene has participating media:" : "the scene's integrator",
+            options.algorithm.c_str());
     std::unique_ptr<Integrator> integrator = makeIntegrator(*scene, options);
     if (!integrator->setupNote().empty())
         std::fprintf(stderr, "unibeam: %s\n", integrator->setupNote().c_str());
