@@ -167,6 +167,8 @@ TEST(Bvh, StackNeedStaysWithinTheWalksStack) {
     Bvh shallow;
     shallow.build(geometric, 1, 20);
     EXPECT_LE(shallow.stackNeed(), 19);
+    // Still four-wide: about a third as many nodes as boxes, not a binary tree's one per box.
+    EXPECT_LT(shallow.nodeCount(), geometric.size() / 2);
     size_t reported = 0;
     shallow.queryPoint(Vec3(0.5f, 0.0f, 0.0f), [&](uint32_t) { ++reported; });
     size_t expected = 0;

@@ -2,6 +2,7 @@
 #include "estimators/bvh.h"
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -89,7 +90,7 @@ uint32_t Bvh::collapse(const std::vector<Node2>& tree, uint32_t self, bool shall
     int n = 1;
     while (n < 4) {
         int open = -1;
-        float best = -1.0f;
+        float best = -std::numeric_limits<float>::max();
         for (int k = 0; k < n; ++k) {
             const Node2& t = tree[kids[k]];
             const Vec3 e = t.box.hi - t.box.lo;
