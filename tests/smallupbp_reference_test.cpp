@@ -19,8 +19,12 @@
 //    an iteration, so pixel variances would understate it), at least that of one SmallUPBP
 //    run of 256 iterations (heavy tails, below), and se_S from the spread of the 16 runs; |z|
 //    below the Sidak bound for 48 tests at alpha 0.01 (3.72). References 5% darker or brighter
-//    fail (power). The vptmis references of mirrorballs and bunny are in the folder too; they
-//    are dominated by fireflies (standard errors of the mean 4% and 11%) and are not tested.
+//    fail (power).
+//  * mirrorballs the same way (16 SmallUPBP runs of 128 iterations; unibeam 128 iterations):
+//    its three regions lit through the glass balls carry errors of tens of percent, the
+//    other thirteen test to about 1%.
+// The vptmis references of mirrorballs and bunny are in the folder too; they are dominated
+// by fireflies (standard errors of the mean 4% and 11%) and are not tested.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -141,11 +145,18 @@ double maxRegionZ(const RegionMeans& mean, const RegionMeans& se, const RegionMe
     return worst;
 }
 
-}  // namespace
+struct RegionCheck {
+    double z = 0, zDark = 0, zBright = 0;
+};
 
-TEST(SmallUpbpReference, BunnyUpbpMatchesSmallUpbpRegionMeans) {
-    std::ifstream in(kRefs + "/bunny_upbp_ref.json");
-    ASSERT_TRUE(in) << "missing " << kRefs << "/bunny_upbp_ref.json";
+/// unibeam's upbp:bpt+surf+pp3d+pb2d+bb1d on scenes/smallupbp/NAME at SmallUPBP's settings
+/// against NAME_upbp_ref.json (file header); the largest region |z| against the reference and
+/// against it scaled by 0.95 and 1.05.
+RegionCheck checkUpbpRegions(const std::string& name, int iterations) {
+    RegionCheck out;
+    std::ifstream in(kRefs + "/" + name + "_upbp_ref.json");
+    EXPECT_TRUE(in) << "missing " << kRefs << "/" << name << "_upbp_ref.json";
+    if (!in) return out;
     const nlohmann::json j = nlohmann::json::parse(in);
     std::vector<RegionMeans> runs;
     for (const auto& run : j.at("region_means_per_run")) {
@@ -154,11 +165,11 @@ TEST(SmallUpbpReference, BunnyUpbpMatchesSmallUpbpRegionMeans) {
             for (size_t c = 0; c < 3; ++c) m[r][c] = run.at(r).at(c).get<double>();
         runs.push_back(m);
     }
-    ASSERT_GE(runs.size(), 8u);
+    EXPECT_GE(runs.size(), 8u);
     RegionMeans refMean, refSe;
     meanAndError(runs, &refMean, &refSe);
 
-    auto scene = loadAt64("bunny/bunny.obj", 12);
+    auto scene = loadAt64(name + "/" + name + ".obj", 12);
     RenderOptions opt;
     opt.algorithm = "upbp:bpt+surf+pp3d+pb2d+bb1d";
     opt.maxPathLength = scene->settings.maxPathLength;  // 12, SmallUPBP's -l 12
@@ -175,7 +186,6 @@ TEST(SmallUpbpReference, BunnyUpbpMatchesSmallUpbpRegionMeans) {
     opt.beamPaths = 64 * 64;  // SmallUPBP's -pbc -1: every light subpath
     opt.backend = "host";
     std::unique_ptr<Integrator> integrator = makeIntegrator(*scene, opt);
-    const int iterations = 256;
     std::vector<RegionMeans> samples;
     Image img(64, 64);
     for (int i = 0; i < iterations; ++i) {
@@ -185,26 +195,43 @@ TEST(SmallUpbpReference, BunnyUpbpMatchesSmallUpbpRegionMeans) {
     RegionMeans mean, se;
     meanAndError(samples, &mean, &se);
     // Heavy tails: a region's error is at least that of a SmallUPBP run of as many iterations
-    // (the same estimators at the same radii). Without this floor the blue channel of region
-    // 11 (rare caustic paths through the lamp glass) read 9% low at seed 1 with a
-    // per-iteration standard error of 1.3%, its tail unsampled in 256 iterations; four
+    // (the same estimators at the same radii). Without this floor the blue channel of the
+    // bunny's region 11 (rare caustic paths through the lamp glass) read 9% low at seed 1 with
+    // a per-iteration standard error of 1.3%, its tail unsampled in 256 iterations; four
     // unibeam runs of 1024 iterations agree with SmallUPBP there within 1% (docs/smallupbp.md).
+    // Regions that only such tails light (mirrorballs' lamps seen through the glass balls,
+    // whose means jump by factors between runs of either renderer) get errors that large.
     const double refIterations = j.at("iterations_per_run").get<double>();
     const double refRuns = double(runs.size());
     for (size_t r = 0; r < 16; ++r)
         for (size_t c = 0; c < 3; ++c)
             se[r][c] = std::max(
                 se[r][c], refSe[r][c] * std::sqrt(refRuns * refIterations / double(iterations)));
-    const double bound = 3.72;  // Sidak: 1 - 0.99^(1/48) two-sided
-    const double z = maxRegionZ(mean, se, refMean, refSe, 1.0, true);
-    const double zDark = maxRegionZ(mean, se, refMean, refSe, 0.95, false);
-    const double zBright = maxRegionZ(mean, se, refMean, refSe, 1.05, false);
+    out.z = maxRegionZ(mean, se, refMean, refSe, 1.0, true);
+    out.zDark = maxRegionZ(mean, se, refMean, refSe, 0.95, false);
+    out.zBright = maxRegionZ(mean, se, refMean, refSe, 1.05, false);
     std::printf(
-        "bunny upbp against SmallUPBP: max region |z| %.2f (references scaled by 0.95: "
-        "%.2f, by 1.05: %.2f; bound %.2f)\n",
-        z, zDark, zBright, bound);
-    EXPECT_LT(z, bound);
+        "%s upbp against SmallUPBP: max region |z| %.2f (references scaled by 0.95: %.2f, by "
+        "1.05: %.2f)\n",
+        name.c_str(), out.z, out.zDark, out.zBright);
+    return out;
+}
+
+constexpr double kRegionBound = 3.72;  // Sidak over 48 region-channel tests at 1%, two-sided
+
+}  // namespace
+
+TEST(SmallUpbpReference, BunnyUpbpMatchesSmallUpbpRegionMeans) {
+    const RegionCheck c = checkUpbpRegions("bunny", 256);
+    EXPECT_LT(c.z, kRegionBound);
     // Power: 5% darker or brighter references are told apart.
-    EXPECT_GT(zDark, bound);
-    EXPECT_GT(zBright, bound);
+    EXPECT_GT(c.zDark, kRegionBound);
+    EXPECT_GT(c.zBright, kRegionBound);
+}
+
+TEST(SmallUpbpReference, MirrorballsUpbpMatchesSmallUpbpRegionMeans) {
+    const RegionCheck c = checkUpbpRegions("mirrorballs", 128);
+    EXPECT_LT(c.z, kRegionBound);
+    EXPECT_GT(c.zDark, kRegionBound);
+    EXPECT_GT(c.zBright, kRegionBound);
 }
