@@ -213,10 +213,7 @@ TEST(Cli, MediaSceneRendersWithVptUnlessAIsGiven) {
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("use a volumetric algorithm"), std::string::npos) << r.err;
     // A ptracer integrator on the same scene: vlt.
-    std::ifstream in(scene);
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string xml = text.str();
+    std::string xml = readFile(scene);
     const size_t at = xml.find("<integrator type=\"volpath\">");
     ASSERT_NE(at, std::string::npos);
     xml.replace(at, std::string("<integrator type=\"volpath\">").size(),

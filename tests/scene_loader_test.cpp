@@ -816,6 +816,13 @@ std::string pngHeaderOnly(uint32_t width, uint32_t height) {
            pngChunk("IDAT", "xxxx") + pngChunk("IEND", "");
 }
 
+/// Writes a valid 2 x 2 OpenEXR file to `path` and returns its bytes, for tests that patch it.
+std::string writtenTinyExr(const std::string& path) {
+    writeExr(path, Image(2, 2));
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
 }  // namespace
 
 // Image headers announcing absurd sizes are errors before anything is allocated: a PNG of
@@ -847,12 +854,7 @@ TEST(JsonLoaderErrors, ImageHeaderWithAbsurdSizeIsAnError) {
     // size in int, which overflows for a corrupt window): a valid 2 x 2 file with the window's
     // maximum corner patched (the attribute is "dataWindow\0box2i\0", size, 4 int32).
     const std::string exr = (tmp.path / "huge.exr").string();
-    writeExr(exr, Image(2, 2));
-    std::string bytes;
-    {
-        std::ifstream in(exr, std::ios::binary);
-        bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    }
+    std::string bytes = writtenTinyExr(exr);
     const std::string tag("dataWindow\0box2i\0", 17);
     const size_t at = bytes.find(tag);
     ASSERT_NE(at, std::string::npos);
@@ -881,12 +883,7 @@ TEST(JsonLoaderErrors, ImageHeaderWithAbsurdSizeIsAnError) {
 TEST(JsonLoaderErrors, OpenExrChannelListIsCheckedBeforeOpening) {
     TempDir tmp;
     const std::string exr = (tmp.path / "bad.exr").string();
-    writeExr(exr, Image(2, 2));
-    std::string good;
-    {
-        std::ifstream in(exr, std::ios::binary);
-        good.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    }
+    const std::string good = writtenTinyExr(exr);
     const std::string tag("channels\0chlist\0", 16);
     const size_t at = good.find(tag);
     ASSERT_NE(at, std::string::npos);
@@ -916,12 +913,7 @@ TEST(JsonLoaderErrors, OpenExrChannelListIsCheckedBeforeOpening) {
 TEST(JsonLoaderErrors, OpenExrPreviewAndStringVectorMustFitTheirAttribute) {
     TempDir tmp;
     const std::string exr = (tmp.path / "attr.exr").string();
-    writeExr(exr, Image(2, 2));
-    std::string good;
-    {
-        std::ifstream in(exr, std::ios::binary);
-        good.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    }
+    const std::string good = writtenTinyExr(exr);
     // The end of the header: walk name, type, int32 size, value from byte 8.
     size_t at = 8;
     while (good[at] != '\0') {

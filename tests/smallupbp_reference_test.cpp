@@ -27,7 +27,6 @@
 // by fireflies (standard errors of the mean 4% and 11%) and are not tested.
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -37,6 +36,7 @@
 
 #include "scene/io/scene_loader.h"
 #include "tests/support/reference_render.h"
+#include "tests/support/render_stats.h"
 
 using namespace ub;
 namespace fs = std::filesystem;
@@ -95,52 +95,23 @@ TEST(SmallUpbpReference, CandleMatchesSmallUpbpPerPixelAndInTheMean) {
 
 namespace {
 
-using RegionMeans = std::vector<std::array<double, 3>>;  // 16 regions, row by row
-
-RegionMeans regionMeans(const Image& img) {
-    RegionMeans out(16, {0.0, 0.0, 0.0});
-    for (int y = 0; y < img.height; ++y)
-        for (int x = 0; x < img.width; ++x) {
-            const int r = (y * 4 / img.height) * 4 + x * 4 / img.width;
-            for (int c = 0; c < 3; ++c) out[size_t(r)][size_t(c)] += img.at(x, y)[c];
-        }
-    const double n = double(img.width) * img.height / 16.0;
-    for (auto& r : out)
-        for (double& v : r) v /= n;
-    return out;
-}
-
-/// Mean and standard error of the mean of samples of region means.
-void meanAndError(const std::vector<RegionMeans>& samples, RegionMeans* mean, RegionMeans* se) {
-    const double n = double(samples.size());
-    *mean = *se = RegionMeans(16, {0.0, 0.0, 0.0});
-    for (size_t r = 0; r < 16; ++r)
-        for (size_t c = 0; c < 3; ++c) {
-            double sum = 0.0, sumSq = 0.0;
-            for (const RegionMeans& s : samples) {
-                sum += s[r][c];
-                sumSq += s[r][c] * s[r][c];
-            }
-            const double m = sum / n;
-            (*mean)[r][c] = m;
-            (*se)[r][c] = std::sqrt(std::max(0.0, (sumSq - n * m * m) / (n - 1.0)) / n);
-        }
-}
-
-/// Largest |z| of the regions of `mean` against the reference scaled by refScale.
-double maxRegionZ(const RegionMeans& mean, const RegionMeans& se, const RegionMeans& refMean,
-                  const RegionMeans& refSe, double refScale, bool print) {
+/// Largest |z| of unibeam's 4 x 4 region means (u: blocks of 16 pixels) against the
+/// reference's (ref: one 4 x 4 image per SmallUPBP run) scaled by refScale; unibeam's error is
+/// at least floorScale times the reference's (heavy tails, checkUpbpRegions).
+double maxRegionZ(const test::BlockStats& u, const test::BlockStats& ref, double floorScale,
+                  double refScale, bool print) {
     double worst = 0.0;
-    for (size_t r = 0; r < 16; ++r)
-        for (size_t c = 0; c < 3; ++c) {
-            const double ref = refScale * refMean[r][c], refErr = refScale * refSe[r][c];
-            const double z = (mean[r][c] - ref) / std::sqrt(se[r][c] * se[r][c] + refErr * refErr);
+    for (int r = 0; r < 16; ++r)
+        for (int c = 0; c < 3; ++c) {
+            const double refMean = refScale * ref.mean(r, c), refErr = refScale * ref.stdErr(r, c);
+            const double se = std::max(u.stdErr(r, c), floorScale * ref.stdErr(r, c));
+            const double z = (u.mean(r, c) - refMean) / std::sqrt(se * se + refErr * refErr);
             worst = std::max(worst, std::fabs(z));
             if (print && std::fabs(z) > 2.0)
                 std::printf(
-                    "  region %2zu channel %zu: unibeam %.5f +- %.5f, SmallUPBP %.5f +- %.5f, z "
+                    "  region %2d channel %d: unibeam %.5f +- %.5f, SmallUPBP %.5f +- %.5f, z "
                     "%+.2f\n",
-                    r, c, mean[r][c], se[r][c], ref, refErr, z);
+                    r, c, u.mean(r, c), se, refMean, refErr, z);
         }
     return worst;
 }
@@ -158,16 +129,18 @@ RegionCheck checkUpbpRegions(const std::string& name, int iterations) {
     EXPECT_TRUE(in) << "missing " << kRefs << "/" << name << "_upbp_ref.json";
     if (!in) return out;
     const nlohmann::json j = nlohmann::json::parse(in);
-    std::vector<RegionMeans> runs;
+    // Each run's region means as a 4 x 4 image: one sample of the reference's block means.
+    test::BlockStats ref;
+    ref.blockSize = 1;
     for (const auto& run : j.at("region_means_per_run")) {
-        RegionMeans m(16);
-        for (size_t r = 0; r < 16; ++r)
-            for (size_t c = 0; c < 3; ++c) m[r][c] = run.at(r).at(c).get<double>();
-        runs.push_back(m);
+        Image regions(4, 4);
+        for (int r = 0; r < 16; ++r)
+            regions.at(r % 4, r / 4) =
+                Rgb(run.at(r).at(0).get<float>(), run.at(r).at(1).get<float>(),
+                    run.at(r).at(2).get<float>());
+        ref.add(regions);
     }
-    EXPECT_GE(runs.size(), 8u);
-    RegionMeans refMean, refSe;
-    meanAndError(runs, &refMean, &refSe);
+    EXPECT_GE(ref.n, 8);
 
     auto scene = loadAt64(name + "/" + name + ".obj", 12);
     RenderOptions opt;
@@ -186,14 +159,8 @@ RegionCheck checkUpbpRegions(const std::string& name, int iterations) {
     opt.beamPaths = 64 * 64;  // SmallUPBP's -pbc -1: every light subpath
     opt.backend = "host";
     std::unique_ptr<Integrator> integrator = makeIntegrator(*scene, opt);
-    std::vector<RegionMeans> samples;
-    Image img(64, 64);
-    for (int i = 0; i < iterations; ++i) {
-        integrator->renderIteration(i, img);
-        samples.push_back(regionMeans(img));
-    }
-    RegionMeans mean, se;
-    meanAndError(samples, &mean, &se);
+    // Per-iteration means of the 4 x 4 regions (blocks of 16 x 16 pixels).
+    const test::BlockStats u = test::renderBlockStats(*integrator, iterations, 16);
     // Heavy tails: a region's error is at least that of a SmallUPBP run of as many iterations
     // (the same estimators at the same radii). Without this floor the blue channel of the
     // bunny's region 11 (rare caustic paths through the lamp glass) read 9% low at seed 1 with
@@ -201,15 +168,11 @@ RegionCheck checkUpbpRegions(const std::string& name, int iterations) {
     // unibeam runs of 1024 iterations agree with SmallUPBP there within 1% (docs/smallupbp.md).
     // Regions that only such tails light (mirrorballs' lamps seen through the glass balls,
     // whose means jump by factors between runs of either renderer) get errors that large.
-    const double refIterations = j.at("iterations_per_run").get<double>();
-    const double refRuns = double(runs.size());
-    for (size_t r = 0; r < 16; ++r)
-        for (size_t c = 0; c < 3; ++c)
-            se[r][c] = std::max(
-                se[r][c], refSe[r][c] * std::sqrt(refRuns * refIterations / double(iterations)));
-    out.z = maxRegionZ(mean, se, refMean, refSe, 1.0, true);
-    out.zDark = maxRegionZ(mean, se, refMean, refSe, 0.95, false);
-    out.zBright = maxRegionZ(mean, se, refMean, refSe, 1.05, false);
+    const double floorScale =
+        std::sqrt(double(ref.n) * j.at("iterations_per_run").get<double>() / double(iterations));
+    out.z = maxRegionZ(u, ref, floorScale, 1.0, true);
+    out.zDark = maxRegionZ(u, ref, floorScale, 0.95, false);
+    out.zBright = maxRegionZ(u, ref, floorScale, 1.05, false);
     std::printf(
         "%s upbp against SmallUPBP: max region |z| %.2f (references scaled by 0.95: %.2f, by "
         "1.05: %.2f)\n",
@@ -217,7 +180,8 @@ RegionCheck checkUpbpRegions(const std::string& name, int iterations) {
     return out;
 }
 
-constexpr double kRegionBound = 3.72;  // Sidak over 48 region-channel tests at 1%, two-sided
+/// Sidak over 48 region-channel tests at 1%, two-sided: 3.72.
+const double kRegionBound = test::criticalZ(test::sidakLevel(0.01, 48));
 
 }  // namespace
 
