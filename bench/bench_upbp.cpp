@@ -11,7 +11,10 @@
 // query counts of the last iteration and the image mean (a sanity check). Not run by ctest.
 //
 // Usage: bench_upbp [--runs N] [--sets s1,s2,...] [--backends host,opencl] [--resolution WxH]
-//                   [--radius-of media|scene] [SCENE ...]
+//                   [--radius-of media|scene] [--rays cut,whole] [SCENE ...]
+//   --rays: with "whole" the bidirectional engine traces every ray through media to the next
+//   surface instead of cutting it where free-flight sampling stops (RenderOptions::
+//   cutRaysAtFlight; same image); both listed: an A/B in one run. Default: cut.
 //   --radius-of scene: the volumetric radii are 0.001 of the scene's bounding sphere (half the
 //   diagonal of the geometry's bounding box), SmallUPBP's convention, so that both renderers
 //   use the same absolute radius; media (default): 0.001 of the media's radius, unibeam's.
@@ -49,7 +52,7 @@ std::vector<std::string> splitList(const std::string& list) {
 }
 
 int runOne(const std::string& path, const std::string& set, int runs, int width, int height,
-           const std::string& backend, bool sceneRadius) {
+           const std::string& backend, bool sceneRadius, bool cutRays) {
     std::vector<Diagnostic> warnings;
     std::unique_ptr<Scene> scene = loadScene(path, &warnings);
     scene->camera = scene->camera.resized(width, height, scene->settings.keepHorizontalFov);
@@ -74,6 +77,7 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
     opt.shortQueryBeams = false;
     opt.beamPaths = 4000;
     opt.backend = backend;
+    opt.cutRaysAtFlight = cutRays;
     std::unique_ptr<Integrator> integrator = makeIntegrator(*scene, opt);
     Image img;
     integrator->renderIteration(0, img);
@@ -87,8 +91,9 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
     std::sort(times.begin(), times.end());
     const Rgb mean = img.mean();
     std::printf("%-14s %-16s %-6s %9.3f s/it  mean %.4g %.4g %.4g\n",
-                std::filesystem::path(path).stem().string().c_str(), set.c_str(), backend.c_str(),
-                times[times.size() / 2], mean.x, mean.y, mean.z);
+                std::filesystem::path(path).stem().string().c_str(), set.c_str(),
+                (backend + (cutRays ? "" : "/whole")).c_str(), times[times.size() / 2], mean.x,
+                mean.y, mean.z);
     const std::string summary = integrator->iterationSummary();
     if (!summary.empty()) std::printf("    %s\n", summary.c_str());
     std::fflush(stdout);
@@ -100,7 +105,7 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
 int main(int argc, char** argv) {
     int runs = 3, width = 256, height = 256;
     bool sceneRadius = false;
-    std::vector<std::string> backends = {"host"};
+    std::vector<std::string> backends = {"host"}, rays = {"cut"};
     std::vector<std::string> scenes,
         sets = {"upbp:bpt", "upbp:pp3d", "upbp:pb2d", "upbp:bp2d", "upbp:bb1d", "upbp"};
     for (int i = 1; i < argc; ++i) {
@@ -111,6 +116,13 @@ int main(int argc, char** argv) {
             sets = splitList(argv[++i]);
         } else if (a == "--backends" && i + 1 < argc) {
             backends = splitList(argv[++i]);
+        } else if (a == "--rays" && i + 1 < argc) {
+            rays = splitList(argv[++i]);
+            for (const std::string& r : rays)
+                if (r != "cut" && r != "whole") {
+                    std::fprintf(stderr, "bench_upbp: --rays expects cut, whole or cut,whole\n");
+                    return 2;
+                }
         } else if (a == "--radius-of" && i + 1 < argc) {
             const std::string of = argv[++i];
             if (of != "scene" && of != "media") {
@@ -126,7 +138,7 @@ int main(int argc, char** argv) {
         } else if (a == "--help" || a == "-h") {
             std::printf(
                 "usage: bench_upbp [--runs N] [--sets s1,s2,...] [--backends host,opencl] "
-                "[--resolution WxH] [--radius-of media|scene] [SCENE ...]\n");
+                "[--resolution WxH] [--radius-of media|scene] [--rays cut,whole] [SCENE ...]\n");
             return 0;
         } else if (!a.empty() && a[0] == '-') {
             std::fprintf(stderr, "bench_upbp: unknown option '%s' (or missing value; --help)\n",
@@ -147,27 +159,29 @@ int main(int argc, char** argv) {
                 height, runs);
     for (const std::string& scene : scenes)
         for (const std::string& set : sets)
-            for (const std::string& backend : backends) {
-                std::fflush(stdout);
-                const pid_t pid = fork();
-                if (pid < 0) {
-                    std::perror("fork");
-                    return 1;
-                }
-                if (pid == 0) {
-                    try {
-                        std::_Exit(runOne(scene, set, runs, width, height, backend, sceneRadius));
-                    } catch (const std::exception& e) {
-                        std::fprintf(stderr, "bench_upbp: %s %s: %s\n", scene.c_str(), set.c_str(),
-                                     e.what());
-                        std::_Exit(1);
+            for (const std::string& backend : backends)
+                for (const std::string& ray : rays) {
+                    std::fflush(stdout);
+                    const pid_t pid = fork();
+                    if (pid < 0) {
+                        std::perror("fork");
+                        return 1;
                     }
+                    if (pid == 0) {
+                        try {
+                            std::_Exit(runOne(scene, set, runs, width, height, backend, sceneRadius,
+                                              ray == "cut"));
+                        } catch (const std::exception& e) {
+                            std::fprintf(stderr, "bench_upbp: %s %s: %s\n", scene.c_str(),
+                                         set.c_str(), e.what());
+                            std::_Exit(1);
+                        }
+                    }
+                    int status = 0;
+                    rusage ru{};
+                    wait4(pid, &status, 0, &ru);
+                    std::printf("    peak memory %.0f MB%s\n", double(ru.ru_maxrss) / 1024.0,
+                                WIFEXITED(status) && WEXITSTATUS(status) == 0 ? "" : " (failed)");
                 }
-                int status = 0;
-                rusage ru{};
-                wait4(pid, &status, 0, &ru);
-                std::printf("    peak memory %.0f MB%s\n", double(ru.ru_maxrss) / 1024.0,
-                            WIFEXITED(status) && WEXITSTATUS(status) == 0 ? "" : " (failed)");
-            }
     return 0;
 }

@@ -442,9 +442,13 @@ bool VertexCM::traceToVertex(Rng& rng, SubPath& state, PathVertex* v, bool* esca
         return true;
     }
     // Media: the chain to the next real surface, then free-flight sampling along it.
+    // Long beams need the whole chain; otherwise the ray may stop where sampling will.
+    const bool shortBeams = state.fromLight ? options_.shortPhotonBeams : options_.shortQueryBeams;
+    Rng lookahead = rng;  // sampleChainVertex will draw these numbers again
+    const bool cut = options_.cutRaysAtFlight && (!beams || shortBeams);
     const MediumStack stackAtStart = state.stack;
     MediumTrace trace;
-    scene_.traceMedia(state.ray, &state.stack, &trace, &v->hit);
+    scene_.traceMedia(state.ray, &state.stack, &trace, &v->hit, cut ? &lookahead : nullptr);
     if (trace.overflow) return false;
     ChainVisit visit;
     const ChainVertex cv = sampleChainVertex(scene_, trace, state.ray.dir, state.rayFromMedium, rng,
@@ -456,7 +460,7 @@ bool VertexCM::traceToVertex(Rng& rng, SubPath& state, PathVertex* v, bool* esca
         src.pathLength = uint32_t(state.pathLength);
         src.fromMedium = state.rayFromMedium;
         src.applyDistSqr = state.applyDistSqr();
-        src.shortBeams = state.fromLight ? options_.shortPhotonBeams : options_.shortQueryBeams;
+        src.shortBeams = shortBeams;
         src.tag = tag;
         src.budgetName = state.fromLight ? "photon beams" : "query beams";
         appendChainBeams(scene_, trace, state.ray.dir, visit, cv, src, beams, budget_.get());
@@ -478,6 +482,9 @@ bool VertexCM::traceToVertex(Rng& rng, SubPath& state, PathVertex* v, bool* esca
         return true;
     }
     v->inMedium = false;
+    // A cut trace scatters in its last segment (sampling there runs to kMediumFarDistance);
+    // should rounding ever pass it, the path ends rather than escape.
+    if (trace.truncated) return false;
     if (!trace.hitSurface) {
         *escaped = true;
         return false;

@@ -330,6 +330,16 @@ MediumSegment evalMediumSegment(const Medium& m, const Vec3& origin, const Vec3&
     return seg;
 }
 
+float homogeneousFlightDistance(const Medium& m, float uChannel, float uDistance) {
+    // sampleFreeFlight's inversion below for the single piece [0, tMax) of a homogeneous
+    // medium: 0 + (tauTarget - 0) / sigmaT[c], evaluated with the same operations.
+    const int c = std::min(2, int(uChannel * 3.0f));
+    const float tauTarget = -std::log1p(-uDistance);
+    const Rgb sigmaT = m.sigmaA + m.sigmaS;
+    if (!(sigmaT[c] > 0.0f)) return kInf;
+    return 0.0f + (tauTarget - 0.0f) / sigmaT[c];
+}
+
 FreeFlightSample sampleFreeFlight(const Medium& m, const Vec3& origin, const Vec3& dir, float tMax,
                                   float uChannel, float uDistance) {
     if (m.type == MediumType::kGrid && m.filter == GridFilter::kTrilinear)

@@ -41,6 +41,12 @@ struct MediumTrace {
     bool overflow = false;    ///< more crossings than kMaxSegments or a full medium stack:
                               ///< the trace is unusable and the path must end
     float distance = 0.0f;    ///< from the ray origin to the real hit (sum of segment lengths)
+    /// The trace was cut short by a look-ahead (Scene::traceMedia): its ray stopped where
+    /// free-flight sampling with the look-ahead's numbers stops in the last segment, and met
+    /// nothing before. That segment's length is unknown and stored as kMediumFarDistance;
+    /// sampling with the same numbers scatters inside it, at the same distance as on the
+    /// whole chain. hitSurface is false and the trace did not escape.
+    bool truncated = false;
 };
 
 /// Transmittance of a segment chain a -> b and its distance pdfs (products over segments).

@@ -546,6 +546,10 @@ Vec3 Scene::offsetRayOrigin(const Vec3& p, const Vec3& n, const Vec3& dir) {
     return offsetOrigin(p, n, dir);
 }
 
+float Scene::rayOffsetLength(const Vec3& p) {
+    return kRayEpsilon * (1.0f + maxAbs(p));
+}
+
 void Scene::commit() {
     if (impl_->committed) throw std::logic_error("Scene::commit called twice");
     {

@@ -20,6 +20,8 @@
 
 namespace ub {
 
+class Rng;
+
 class Bsdf;
 struct SurfaceColors;
 
@@ -205,6 +207,8 @@ class Scene {
     /// The origin offset spawnRay/occluded use: p moved off the surface with unit normal n
     /// (zero: not on a surface, not moved) to the side of dir.
     static Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n, const Vec3& dir);
+    /// The length of that offset at p.
+    static float rayOffsetLength(const Vec3& p);
     /// Vertices of triangle `tri` of mesh shape shapeId (world space).
     void meshTriangle(uint32_t shapeId, uint32_t tri, Vec3 p[3]) const;
 
@@ -230,7 +234,16 @@ class Scene {
     /// it crosses; imaginary and skipped boundaries update *stack and create no vertex.
     /// On return *stack is the stack on the incoming side of the real hit, *hit the hit
     /// (valid if trace->hitSurface; hit->dist is the distance from the last crossing).
-    void traceMedia(const Ray& ray, MediumStack* stack, MediumTrace* trace, Hit* hit) const;
+    ///
+    /// lookahead (optional): a copy of the generator that will sample free flight along the
+    /// chain (render/medium_walk.h: two numbers per medium segment, channel then distance).
+    /// In a homogeneous segment the sampled distance t does not depend on where the segment
+    /// ends, so the ray is cut just past t: if it meets nothing there, sampling stops inside
+    /// this segment and what lies beyond is never needed (trace->truncated). A short ray
+    /// costs Embree far fewer nodes than one to the next wall. Callers that need the whole
+    /// chain (long beams) pass none.
+    void traceMedia(const Ray& ray, MediumStack* stack, MediumTrace* trace, Hit* hit,
+                    Rng* lookahead = nullptr) const;
     /// The media that traceMedia crossed up to (not including) segment k: applies the first
     /// k crossings of trace to *stack (which must be the stack the trace started with).
     void replayCrossings(const MediumTrace& trace, int k, MediumStack* stack) const;

@@ -341,10 +341,12 @@ MediumStack Scene::mediumStackAt(const Vec3& p) const {
     return stack;
 }
 
-void Scene::traceMedia(const Ray& ray, MediumStack* stack, MediumTrace* trace, Hit* hit) const {
+void Scene::traceMedia(const Ray& ray, MediumStack* stack, MediumTrace* trace, Hit* hit,
+                       Rng* lookahead) const {
     trace->count = 0;
     trace->hitSurface = false;
     trace->overflow = false;
+    trace->truncated = false;
     trace->distance = 0.0f;
     Ray r = ray;
     Vec3 segStart = ray.org + ray.dir * ray.tMin;
@@ -358,8 +360,31 @@ void Scene::traceMedia(const Ray& ray, MediumStack* stack, MediumTrace* trace, H
         seg.mediumId = stack->mediumId();
         seg.crossingShape = -1;
         seg.crossingEntering = 0;
+        // Where free-flight sampling will stop in this segment, if it is homogeneous.
+        float cut = kInf;
+        if (lookahead && seg.mediumId >= 0) {
+            const float uChannel = lookahead->uniform(), uDistance = lookahead->uniform();
+            const Medium& m = media[size_t(seg.mediumId)];
+            if (m.type == MediumType::kHomogeneous)
+                cut = homogeneousFlightDistance(m, uChannel, uDistance);
+        }
+        Ray rc = r;
+        if (cut < 0.5f * kMediumFarDistance) {
+            // Past the sampled distance by more than the distance between r's origin and
+            // the segment start (a crossing's offset) and the rounding of either: a hit up
+            // to there is found as without the cut, and no hit means the segment is longer.
+            const float margin = 4.0f * rayOffsetLength(segStart) + 1e-5f * cut;
+            rc.tMax = std::min(r.tMax, r.tMin + cut + margin);
+        }
         Hit h;
-        if (!intersect(r, &h)) {
+        if (!intersect(rc, &h)) {
+            if (rc.tMax < r.tMax) {  // cut: sampling stops in this segment
+                seg.length = kMediumFarDistance;
+                trace->distance = kInf;
+                trace->truncated = true;
+                ++trace->count;
+                return;
+            }
             seg.length = kMediumFarDistance;
             trace->distance = kInf;
             ++trace->count;
