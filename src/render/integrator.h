@@ -49,7 +49,8 @@ struct RenderOptions {
     int clPlatform = -1, clDevice = -1;  ///< OpenCL device (-1, -1: the first one)
     std::string clCache;  ///< OpenCL program cache folder ("": the user's cache, "-": none)
     /// Cut rays through homogeneous media where free-flight sampling will stop
-    /// (Scene::traceMedia's look-ahead) in the bidirectional engine (vlt, vbpt, vcm, upbp).
+    /// (Scene::traceMedia's look-ahead) in vpt and the bidirectional engine (vlt, vbpt, vcm,
+    /// upbp).
     /// The image is the same either way; tests and benchmarks turn it off to compare.
     bool cutRaysAtFlight = true;
     /// Tests only (never set by the command-line program): makes one technique's contributions

@@ -122,7 +122,10 @@ Rgb VolPathTracer::tracePixel(int x, int y, int iteration) const {
     for (int pathLength = 1;; ++pathLength) {
         const MediumStack stackAtStart = stack;
         Hit hit;
-        scene_.traceMedia(ray, &stack, &trace, &hit);
+        // The ray may stop where the sampling below will (Scene::traceMedia's look-ahead).
+        Rng lookahead = rng;
+        scene_.traceMedia(ray, &stack, &trace, &hit,
+                          options_.cutRaysAtFlight ? &lookahead : nullptr);
         if (trace.overflow) break;
 
         // ---- Free-flight sampling along the segment chain ----
@@ -195,6 +198,7 @@ Rgb VolPathTracer::tracePixel(int x, int y, int iteration) const {
             continue;
         }
 
+        if (trace.truncated) break;  // a cut trace scatters; never read it as an escape
         if (!trace.hitSurface) {
             // Escaped: environment light, if any.
             if (scene_.backgroundLightId >= 0 && pathLength >= minLength) {
