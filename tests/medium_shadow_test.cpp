@@ -70,3 +70,63 @@ TEST(NestedMedia, ShadowRaysReachAnAreaLightJustBeyondAnImaginaryBoundary) {
     // Exact: the fog cube is imaginary, so it changes no visibility.
     EXPECT_EQ(mismatches, 0) << "of " << samples << " shadow rays";
 }
+
+// Where every surface a shadow ray can meet is real for its medium stack (no imaginary
+// boundary; none of a lower priority), Scene::shadowTransmittance answers with one any-hit
+// query instead of walking nearest hits. Its results equal the walk's, compared exactly:
+// cornell-fog with a global fog instead of its imaginary cube (the glass sphere stays a
+// priority-1 boundary), against the same scene plus a small imaginary sphere far outside
+// the box, which makes every shadow ray walk.
+TEST(NestedMedia, AnyHitShadowQueryEqualsTheWalk) {
+    const std::string dir = std::string(UNIBEAM_SOURCE_DIR) + "/scenes";
+    std::ifstream in(dir + "/cornell-fog.json");
+    ASSERT_TRUE(in.good());
+    nlohmann::json j = nlohmann::json::parse(in);
+    nlohmann::json shapes = nlohmann::json::array();
+    for (const nlohmann::json& s : j["shapes"])
+        if (s.value("name", "") != "fog volume") shapes.push_back(s);
+    j["shapes"] = shapes;
+    j["medium"] = "fog";
+    nlohmann::json walked = j;
+    walked["shapes"].push_back({{"name", "far bubble"},
+                                {"type", "sphere"},
+                                {"center", {40.0, 40.0, 40.0}},
+                                {"radius", 0.5},
+                                {"interior_medium", "fog"},
+                                {"imaginary", true}});
+    auto fast = loadJsonSceneFromString(j.dump(), "cornell-fog.json", dir);
+    auto walk = loadJsonSceneFromString(walked.dump(), "cornell-fog.json", dir);
+    const Light& light = fast->lights[0];
+    Rng rng(17, 3);
+    int blocked = 0, open = 0, differ = 0;
+    auto same = [](const MediumShadow& a, const MediumShadow& b) {
+        return a.blocked == b.blocked && a.transmittance.x == b.transmittance.x &&
+               a.transmittance.y == b.transmittance.y && a.transmittance.z == b.transmittance.z &&
+               a.probPass == b.probPass && a.pdfScatterFwdL == b.pdfScatterFwdL &&
+               a.pdfScatterRevL == b.pdfScatterRevL;
+    };
+    for (int n = 0; n < 4000; ++n) {
+        // From a random point in the box (in the fog or in the glass sphere's vacuum): to a
+        // point of the light, and to another random point.
+        const Vec3 a(-0.95f + 1.9f * rng.uniform(), -0.95f + 1.9f * rng.uniform(),
+                     -0.95f + 1.9f * rng.uniform());
+        const Vec3 b(-0.95f + 1.9f * rng.uniform(), -0.95f + 1.9f * rng.uniform(),
+                     -0.95f + 1.9f * rng.uniform());
+        const MediumStack stack = fast->mediumStackAt(a);
+        Vec3 dirToLight;
+        float dist = 0, pdfW = 0, emissionPdfW = 0, cosLight = 0;
+        light.illuminate(fast->sceneSphere, a, rng.uniform2(), &dirToLight, &dist, &pdfW,
+                         &emissionPdfW, &cosLight);
+        const Vec3 targets[2] = {a + dirToLight * dist, b};
+        for (int t = 0; t < 2; ++t) {
+            const Vec3 n = t == 0 ? -dirToLight : Vec3(0.0f);
+            const MediumShadow f = fast->shadowTransmittance(a, Vec3(0.0f), stack, targets[t], n);
+            const MediumShadow w = walk->shadowTransmittance(a, Vec3(0.0f), stack, targets[t], n);
+            differ += !same(f, w);
+            (f.blocked ? blocked : open) += 1;
+        }
+    }
+    EXPECT_EQ(differ, 0);
+    EXPECT_GT(blocked, 400);  // the spheres and the light box block some
+    EXPECT_GT(open, 4000);
+}

@@ -271,6 +271,11 @@ struct Scene::Impl {
     RTCScene scene = nullptr;
     std::vector<ShapeGeom> geoms;
     bool committed = false;
+    /// Every medium boundary is a real surface for a stack of at most this priority (the
+    /// lowest boundary priority; INT32_MAX if there are none), unless some boundary is
+    /// imaginary. Set by commit().
+    int32_t allBoundariesRealUpTo = INT32_MAX;
+    bool anyImaginaryBoundary = false;
 
     ~Impl() {
         if (scene) rtcReleaseScene(scene);
@@ -618,6 +623,11 @@ void Scene::commit() {
     }
     sceneSphere.invRadiusSqr = 1.0f / (sceneSphere.radius * sceneSphere.radius);
     impl_->committed = true;
+    for (const ShapeInfo& s : shapes)
+        if (s.isMediumBoundary) {
+            impl_->anyImaginaryBoundary = impl_->anyImaginaryBoundary || s.imaginary;
+            impl_->allBoundariesRealUpTo = std::min(impl_->allBoundariesRealUpTo, s.mediumPriority);
+        }
     cameraMediumStack = mediumStackAt(camera.position());
 }
 
@@ -821,6 +831,17 @@ bool Scene::occludedToInfinity(const Vec3& from, const Vec3& geoNormal, const Ve
         throw std::logic_error("Scene::occludedToInfinity called before commit()");
     return occludedRay(impl_->scene, offsetOrigin(from, geoNormal, dir), dir,
                        std::numeric_limits<float>::infinity());
+}
+
+bool Scene::everyHitIsReal(const MediumStack& stack) const {
+    return !impl_->anyImaginaryBoundary && stack.priority() <= impl_->allBoundariesRealUpTo;
+}
+
+bool Scene::anyHitWithin(const Vec3& org, const Vec3& dir, float tMax) const {
+    if (!impl_->committed) throw std::logic_error("Scene::anyHitWithin called before commit()");
+    // intersect() finds nothing on a ray Embree would reject; neither does this.
+    if (!embreeRayValid(org, dir, 0.0f, tMax)) return false;
+    return occludedRay(impl_->scene, org, dir, tMax);
 }
 
 Ray Scene::spawnRay(const Hit& hit, const Vec3& dir) const {

@@ -209,6 +209,13 @@ class Scene {
     static Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n, const Vec3& dir);
     /// The length of that offset at p.
     static float rayOffsetLength(const Vec3& p);
+    /// True if every surface a ray starting with this medium stack can meet is real for it
+    /// (no boundary is imaginary or of a lower priority than the stack's): the first hit
+    /// ends a shadow walk, so an any-hit query answers it.
+    bool everyHitIsReal(const MediumStack& stack) const;
+    /// True if the ray org + t dir meets any surface for t in [0, tMax] (Embree's any-hit
+    /// query; false where intersect() would find nothing, e.g. on a NaN ray).
+    bool anyHitWithin(const Vec3& org, const Vec3& dir, float tMax) const;
     /// Vertices of triangle `tri` of mesh shape shapeId (world space).
     void meshTriangle(uint32_t shapeId, uint32_t tri, Vec3 p[3]) const;
 

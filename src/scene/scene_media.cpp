@@ -464,6 +464,14 @@ namespace {
 /// (an area light), reach that surface before the target (the end offset is ~eps as well).
 MediumShadow walkShadow(const Scene& scene, Vec3 from, Vec3 dir, float maxDist, MediumStack stack) {
     ChainPdfs chain;
+    if (scene.everyHitIsReal(stack)) {
+        // The walk below would stop at its first hit, blocked: one any-hit query, cheaper
+        // than the nearest hit, decides it, and the open segment is one of stack's medium.
+        if (scene.anyHitWithin(from, dir, maxDist)) return blockedShadow();
+        chain.add(scene, stack.mediumId(), from, dir,
+                  maxDist >= kInf ? kMediumFarDistance : maxDist);
+        return chain.result();
+    }
     const bool finite = maxDist < kInf;
     const Vec3 target = finite ? from + dir * maxDist : Vec3(0.0f);
     float remaining = maxDist;
