@@ -330,11 +330,18 @@ MediumSegment evalMediumSegment(const Medium& m, const Vec3& origin, const Vec3&
     return seg;
 }
 
+/// -ln(1 - u), an Exp(1) optical depth by inversion. logf of 1 - u rather than log1pf of -u
+/// (about three times as fast, 6% of a pp3d iteration in perf): for the generator's u =
+/// k 2^-24, 1 - u is exact, so the two agree to logf's rounding.
+static float opticalDepthTarget(float u) {
+    return -std::log(1.0f - u);
+}
+
 float homogeneousFlightDistance(const Medium& m, float uChannel, float uDistance) {
     // sampleFreeFlight's inversion below for the single piece [0, tMax) of a homogeneous
     // medium: 0 + (tauTarget - 0) / sigmaT[c], evaluated with the same operations.
     const int c = std::min(2, int(uChannel * 3.0f));
-    const float tauTarget = -std::log1p(-uDistance);
+    const float tauTarget = opticalDepthTarget(uDistance);
     const Rgb sigmaT = m.sigmaA + m.sigmaS;
     if (!(sigmaT[c] > 0.0f)) return kInf;
     return 0.0f + (tauTarget - 0.0f) / sigmaT[c];
@@ -346,7 +353,7 @@ FreeFlightSample sampleFreeFlight(const Medium& m, const Vec3& origin, const Vec
         return trilinearFreeFlight(m, origin, dir, tMax, uChannel, uDistance);
     const int c = std::min(2, int(uChannel * 3.0f));
     // Target optical depth in channel c: tau ~ Exp(1) by inversion.
-    const float tauTarget = -std::log1p(-uDistance);
+    const float tauTarget = opticalDepthTarget(uDistance);
     FreeFlightSample s;
     MediumSegment& seg = s.segment;
     Rgb tau(0.0f);
