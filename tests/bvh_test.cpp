@@ -8,9 +8,11 @@
 #include "estimators/bvh.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -208,4 +210,29 @@ TEST(Bvh, SseNodeTestEqualsTheSharedOne) {
         ASSERT_EQ(bvhMeets4(n, oo, invD, len), ub_bvh_meets(&n, oo, invD, len)) << "case " << k;
     }
     EXPECT_GT(nanCases, 1000);
+}
+
+// Ranges of 8192 boxes and more build their halves in parallel; the tree (every node's
+// boxes, children and counts) and the leaf order are those of a build on one thread, and
+// its walks report exactly the boxes they meet.
+TEST(Bvh, ParallelBuildEqualsTheBuildOnOneThread) {
+    Rng rng(21, 1);
+    const std::vector<Bounds3> walked = beamBoxes(rng, 20000);
+    for (uint32_t leaf : {1u, 8u}) checkWalks(walked, leaf, 300 + leaf);
+    const std::vector<Bounds3> boxes = beamBoxes(rng, 60000);
+    Bvh one, many;
+    std::vector<uint32_t> orderOne(boxes.size()), orderMany(boxes.size());
+    for (uint32_t i = 0; i < boxes.size(); ++i) orderOne[i] = orderMany[i] = i;
+    {
+        tbb::task_arena single(1);
+        single.execute([&] { one.build(boxes, 8); });
+    }
+    many.build(boxes, 8);
+    one.permuteToLeafOrder(&orderOne);
+    many.permuteToLeafOrder(&orderMany);
+    ASSERT_EQ(one.nodeCount(), many.nodeCount());
+    ASSERT_GT(one.nodeCount(), 60000u / 8 / 4);
+    EXPECT_EQ(
+        0, std::memcmp(one.nodes().data(), many.nodes().data(), one.nodeCount() * sizeof(BvhNode)));
+    EXPECT_EQ(orderOne, orderMany);
 }

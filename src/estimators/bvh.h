@@ -116,7 +116,7 @@ class Bvh {
         uint32_t first = 0;  // leaf: first primitive; inner: the right child (left is next)
         uint32_t count = 0;  // leaf: > 0
     };
-    uint32_t buildNode(const std::vector<Bounds3>& boxes, std::vector<Vec3>& centres,
+    uint32_t buildNode(const std::vector<Bounds3>& boxes, const std::vector<Vec3>& centres,
                        std::vector<Node2>& tree, uint32_t begin, uint32_t end);
     uint32_t collapse(const std::vector<Node2>& tree, uint32_t self, bool shallowFirst);
     int stackNeed(uint32_t node, int base) const;
