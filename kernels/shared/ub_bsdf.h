@@ -51,6 +51,17 @@
 #define UB_MATERIAL_PRINCIPLED 11u
 #define UB_MATERIAL_PRINCIPLED_THIN 12u
 
+/* The material types ub_bsdf_eval_local evaluates, a mask of 1 << UB_MATERIAL_*: every type,
+ * unless a program is built for the types of one scene (-DUB_BSDF_TYPES=..., clBsdfTypesOption
+ * in src/estimators/surface_merging.cpp). The switch then holds only those types: the surf
+ * kernel of a scene without the principled BSDFs compiles without their code, which PoCL runs
+ * faster (docs/performance.md, session 27). The mask must hold the type of every record the
+ * program evaluates; the others evaluate to zero. */
+#ifndef UB_BSDF_TYPES
+#define UB_BSDF_TYPES 0xFFFFFFFFu
+#endif
+#define UB_BSDF_HAS(t) ((((ub_uint)(UB_BSDF_TYPES)) >> (t)) & 1u)
+
 #define UB_BSDF_EVALUABLE 1u       /* valid, not all-delta, not black: evaluation can be > 0 */
 #define UB_BSDF_FROM_LIGHT 2u      /* light subpath: importance transport (bsdf.h) */
 #define UB_BSDF_GEOMETRIC_GUARD 4u /* the geometric-normal guard is on (bsdf.h) */
@@ -451,28 +462,36 @@ UB_INLINE ub_float3 ub_bsdf_eval_local(UB_PRIVATE const ub_bsdf* b, UB_GLOBAL co
     switch (b->type) {
         case UB_MATERIAL_DIFFUSE:
         case UB_MATERIAL_PHONG:
-            f = ub_bsdf_eval_phong(b, gen, directPdfW, reversePdfW);
+            if (UB_BSDF_HAS(UB_MATERIAL_DIFFUSE) || UB_BSDF_HAS(UB_MATERIAL_PHONG))
+                f = ub_bsdf_eval_phong(b, gen, directPdfW, reversePdfW);
             break;
         case UB_MATERIAL_ROUGH_CONDUCTOR:
-            f = ub_bsdf_eval_rough_conductor(b, gen, directPdfW, reversePdfW);
+            if (UB_BSDF_HAS(UB_MATERIAL_ROUGH_CONDUCTOR))
+                f = ub_bsdf_eval_rough_conductor(b, gen, directPdfW, reversePdfW);
             break;
         case UB_MATERIAL_ROUGH_DIELECTRIC:
-            f = ub_bsdf_eval_rough_dielectric(b, gen, directPdfW, reversePdfW);
+            if (UB_BSDF_HAS(UB_MATERIAL_ROUGH_DIELECTRIC))
+                f = ub_bsdf_eval_rough_dielectric(b, gen, directPdfW, reversePdfW);
             break;
         case UB_MATERIAL_PLASTIC:
-            f = ub_bsdf_eval_plastic(b, gen, directPdfW, reversePdfW);
+            if (UB_BSDF_HAS(UB_MATERIAL_PLASTIC))
+                f = ub_bsdf_eval_plastic(b, gen, directPdfW, reversePdfW);
             break;
         case UB_MATERIAL_ROUGH_PLASTIC:
-            f = ub_bsdf_eval_rough_plastic(b, coating, gen, directPdfW, reversePdfW);
+            if (UB_BSDF_HAS(UB_MATERIAL_ROUGH_PLASTIC))
+                f = ub_bsdf_eval_rough_plastic(b, coating, gen, directPdfW, reversePdfW);
             break;
         case UB_MATERIAL_MULTI_LOBE:
-            f = ub_bsdf_eval_multilobe(b, gen, directPdfW, reversePdfW);
+            if (UB_BSDF_HAS(UB_MATERIAL_MULTI_LOBE))
+                f = ub_bsdf_eval_multilobe(b, gen, directPdfW, reversePdfW);
             break;
         case UB_MATERIAL_PRINCIPLED:
-            f = ub_bsdf_eval_principled(b, gen, directPdfW, reversePdfW);
+            if (UB_BSDF_HAS(UB_MATERIAL_PRINCIPLED))
+                f = ub_bsdf_eval_principled(b, gen, directPdfW, reversePdfW);
             break;
         case UB_MATERIAL_PRINCIPLED_THIN:
-            f = ub_bsdf_eval_principled_thin(b, gen, directPdfW, reversePdfW);
+            if (UB_BSDF_HAS(UB_MATERIAL_PRINCIPLED_THIN))
+                f = ub_bsdf_eval_principled_thin(b, gen, directPdfW, reversePdfW);
             break;
         default:
             break;

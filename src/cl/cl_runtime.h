@@ -66,7 +66,8 @@ class ClRuntime {
     /// $XDG_CACHE_HOME/unibeam/opencl, else ~/.cache/unibeam/opencl; "-": no cache). Cache
     /// entries are keyed by the source, the build options, the device and the driver
     /// version; a corrupt or stale entry is rebuilt and replaced, never fatal. extraOptions
-    /// are appended to the build options (tests force a build failure with them).
+    /// are appended to the build options: the scene's material types (clBsdfTypesOption),
+    /// or a forced build failure in tests.
     /// Throws ClError.
     ClRuntime(int platform, int device, const std::string& cacheDir = "",
               const std::string& extraOptions = "");

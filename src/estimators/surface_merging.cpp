@@ -15,6 +15,7 @@
 #include "estimators/surface_merging.h"
 
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 
 #include "cl/cl_runtime.h"
@@ -53,6 +54,14 @@ std::vector<float> coatingTables(const Scene& scene) {
             std::copy(scene.materials[m].coatingTransmittance.begin(),
                       scene.materials[m].coatingTransmittance.end(), tables.begin() + m * n);
     return tables;
+}
+
+std::string clBsdfTypesOption(const std::vector<Material>& materials) {
+    uint32_t mask = 1u << UB_MATERIAL_DIFFUSE;
+    for (const Material& m : materials) mask |= 1u << uint32_t(m.type);
+    char text[40];
+    std::snprintf(text, sizeof(text), "-DUB_BSDF_TYPES=0x%xu", mask);
+    return text;
 }
 
 Rgb VertexCM::mergeVertices(const SubPath& state, const Hit& hit, const Bsdf& bsdf) const {

@@ -6,6 +6,7 @@
 // (VertexCM::mergeVertices) with the same function.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "core/vec.h"
@@ -17,6 +18,7 @@ namespace ub {
 class Bsdf;
 class HashGrid;
 class Scene;
+struct Material;
 
 /// The query of a camera vertex at pos with this BSDF (set up with dirFix towards the
 /// camera side) and camera state; materialId selects the coating table of a rough plastic.
@@ -28,6 +30,11 @@ ub_surface_query makeSurfaceQuery(const Bsdf& bsdf, const Vec3& pos, int pathLen
 /// material in Scene::materials order (zeros for other types): what the kernel reads at
 /// ub_surface_query::bsdf.tableIndex.
 std::vector<float> coatingTables(const Scene& scene);
+
+/// The OpenCL build option that specialises ub_bsdf_eval_local (kernels/shared/ub_bsdf.h) to
+/// the material types of these materials, "-DUB_BSDF_TYPES=0x...": every type a surface query
+/// of the scene can carry (a blend's record, not evaluable, has the diffuse type).
+std::string clBsdfTypesOption(const std::vector<Material>& materials);
 
 struct SurfaceMergeInput {
     ub_mis_constants mis{};

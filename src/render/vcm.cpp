@@ -189,8 +189,11 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
         backendNote_ = "estimate pass on the host";
         if (options.backend != "host" && (upbp_.anyVolume() || upbp_.surf)) {
             try {
+                // The program is specialised to the scene's material types (smaller surf
+                // kernel; the program cache keeps one binary per set of types).
                 cl_ = std::make_unique<ClRuntime>(options.clPlatform, options.clDevice,
-                                                  options.clCache);
+                                                  options.clCache,
+                                                  clBsdfTypesOption(scene.materials));
                 beamKernels_ = prepareDeviceMedia(scene, cl_.get(),
                                                   upbp_.pb2d || upbp_.photonBeams(), &deviceMedia_);
                 const bool beamKernels = beamKernels_ || (!upbp_.pb2d && !upbp_.photonBeams());
