@@ -50,8 +50,7 @@ struct RenderOptions {
     std::string clCache;  ///< OpenCL program cache folder ("": the user's cache, "-": none)
     /// Cut rays through homogeneous media where free-flight sampling will stop
     /// (Scene::traceMedia's look-ahead) in vpt and the bidirectional engine (vlt, vbpt, vcm,
-    /// upbp).
-    /// The image is the same either way; tests and benchmarks turn it off to compare.
+    /// upbp). The image is the same either way; tests and benchmarks turn it off to compare.
     bool cutRaysAtFlight = true;
     /// Tests only (never set by the command-line program): makes one technique's contributions
     /// invalid for some pixels, to check the contribution guard (render/contribution_guard.h).

@@ -337,10 +337,15 @@ static float opticalDepthTarget(float u) {
     return -std::log(1.0f - u);
 }
 
+/// The colour channel whose extinction free-flight sampling inverts (spectral MIS).
+static int flightChannel(float u) {
+    return std::min(2, int(u * 3.0f));
+}
+
 float homogeneousFlightDistance(const Medium& m, float uChannel, float uDistance) {
     // sampleFreeFlight's inversion below for the single piece [0, tMax) of a homogeneous
     // medium: 0 + (tauTarget - 0) / sigmaT[c], evaluated with the same operations.
-    const int c = std::min(2, int(uChannel * 3.0f));
+    const int c = flightChannel(uChannel);
     const float tauTarget = opticalDepthTarget(uDistance);
     const Rgb sigmaT = m.sigmaA + m.sigmaS;
     if (!(sigmaT[c] > 0.0f)) return kInf;
@@ -351,7 +356,7 @@ FreeFlightSample sampleFreeFlight(const Medium& m, const Vec3& origin, const Vec
                                   float uChannel, float uDistance) {
     if (m.type == MediumType::kGrid && m.filter == GridFilter::kTrilinear)
         return trilinearFreeFlight(m, origin, dir, tMax, uChannel, uDistance);
-    const int c = std::min(2, int(uChannel * 3.0f));
+    const int c = flightChannel(uChannel);
     // Target optical depth in channel c: tau ~ Exp(1) by inversion.
     const float tauTarget = opticalDepthTarget(uDistance);
     FreeFlightSample s;

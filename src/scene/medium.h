@@ -208,7 +208,7 @@ FreeFlightSample sampleFreeFlight(const Medium& m, const Vec3& origin, const Vec
 /// The distance sampleFreeFlight draws in a homogeneous medium from (uChannel, uDistance) when
 /// the segment is long enough to hold it, the same float (kInf if sigma_t is 0 in the chosen
 /// channel). The distance does not depend on the segment: Scene::traceMedia uses it to cut a
-/// ray where sampling will stop (see TraceLookahead in scene/medium_trace.h).
+/// ray where sampling will stop (MediumTrace::truncated).
 float homogeneousFlightDistance(const Medium& m, float uChannel, float uDistance);
 
 }  // namespace ub

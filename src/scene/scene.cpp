@@ -75,7 +75,7 @@ float maxAbs(const Vec3& p) {
 
 /// Origin offset of the comment block above; n is a unit normal or zero.
 Vec3 offsetOrigin(const Vec3& p, const Vec3& n, const Vec3& dir) {
-    float eps = kRayEpsilon * (1.0f + maxAbs(p));
+    const float eps = Scene::rayOffsetLength(p);
     return p + n * (dot(n, dir) >= 0.0f ? eps : -eps);
 }
 

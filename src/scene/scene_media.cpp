@@ -378,15 +378,10 @@ void Scene::traceMedia(const Ray& ray, MediumStack* stack, MediumTrace* trace, H
         }
         Hit h;
         if (!intersect(rc, &h)) {
-            if (rc.tMax < r.tMax) {  // cut: sampling stops in this segment
-                seg.length = kMediumFarDistance;
-                trace->distance = kInf;
-                trace->truncated = true;
-                ++trace->count;
-                return;
-            }
+            // Escaped, or cut: then sampling stops in this segment.
             seg.length = kMediumFarDistance;
             trace->distance = kInf;
+            trace->truncated = rc.tMax < r.tMax;
             ++trace->count;
             return;
         }
