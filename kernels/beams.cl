@@ -68,6 +68,7 @@
 
 /* pb2d: query beams x photon points (BVH over the photons' kernel spheres). */
 __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
+                               __global const ub_photon_key* keys,
                                __global const ub_bvh_node* nodes,
                                __global const ub_grid_info* grids, __global const uchar* gridData,
                                __global const ub_beam* queries, uint queryCount,
@@ -87,9 +88,10 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     ub_uint tableState = UB_TABLE_UNBUILT;
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     UB_BVH_WALK_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qb.length)) {
-        ub_photon_point ph = photons[k];
         float t = 0.0f;
-        if (!ub_pb2d_pair(ph, qb, radius * radius, minLength, maxLength, &t)) continue;
+        if (!ub_pb2d_near(keys[k], qb, radius * radius, &t)) continue;
+        ub_photon_point ph = photons[k];
+        if (!ub_pb2d_length_ok(ph.pathLength, qb, minLength, maxLength)) continue;
         ub_segment_eval s =
             ub_query_beam_segment(m, gi, &acc, qb, t, table, UB_QUERY_PIECES, &tableState);
         ub_float3 c = ub_pb2d_contribution(mis, ph, qb, s, t, m.g, normalization);

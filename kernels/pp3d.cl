@@ -63,6 +63,9 @@ __kernel void ub_layout_probe(__global uint* out) {
     ub_bvh_node node;
     out[14] = (uint)sizeof(ub_bvh_node);
     out[15] = (uint)((__private char*)&node.child - (__private char*)&node);
+    ub_photon_key key;
+    out[16] = (uint)sizeof(ub_photon_key);
+    out[17] = (uint)((__private char*)&key.mediumId - (__private char*)&key);
 }
 
 #ifdef UB_FORCE_BUILD_ERROR

@@ -26,16 +26,20 @@ UB_INLINE float ub_pb2d_normalization(float lightPaths, float radius) {
     return 1.0f / (lightPaths * UB_PI * radius * radius);
 }
 
-/* Whether photon ph and query beam qb make a pb2d pair: same medium, path length in
- * [minLength, maxLength], the photon within radius of the beam; writes its beam parameter. */
-UB_INLINE int ub_pb2d_pair(ub_photon_point ph, ub_beam qb, float radiusSqr, ub_uint minLength,
-                           ub_uint maxLength, UB_PRIVATE float* t) {
-    if (ph.mediumId != qb.mediumId) return 0;
-    ub_uint length = ph.pathLength + qb.pathLength;
-    if (length > maxLength || length < minLength) return 0;
-    float d2 = ub_point_beam_dist2(ub_f3_from(ph.pos), ub_f3_from(qb.origin), ub_f3_from(qb.dir),
+/* Whether a photon and query beam qb make a pb2d pair: same medium, the photon within radius
+ * of the beam (ub_pb2d_near, on the photon's key, which is where most candidates of a walk
+ * end; writes its beam parameter), and the path length in [minLength, maxLength]
+ * (ub_pb2d_length_ok, on the photon record, read for the near ones only). */
+UB_INLINE int ub_pb2d_near(ub_photon_key k, ub_beam qb, float radiusSqr, UB_PRIVATE float* t) {
+    if (k.mediumId != qb.mediumId) return 0;
+    float d2 = ub_point_beam_dist2(ub_f3_from(k.pos), ub_f3_from(qb.origin), ub_f3_from(qb.dir),
                                    qb.length, t);
     return d2 >= 0.0f && d2 <= radiusSqr;
+}
+UB_INLINE int ub_pb2d_length_ok(ub_uint photonLength, ub_beam qb, ub_uint minLength,
+                                ub_uint maxLength) {
+    ub_uint length = photonLength + qb.pathLength;
+    return length <= maxLength && length >= minLength;
 }
 
 /* Contribution of photon ph to query beam qb at parameter t (from

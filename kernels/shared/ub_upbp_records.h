@@ -32,6 +32,23 @@ typedef struct {
     float pad0, pad1;
 } ub_photon_point;
 
+/* What the pb2d walk reads of a photon point before it is a pair (ub_pb2d_near): its position and
+ * medium, 16 bytes, so that a leaf's four photons share one cache line (the 80-byte records are
+ * read for the pairs only). An array of them in the BVH's leaf order goes with the photons. */
+typedef struct {
+    float pos[3];
+    ub_uint mediumId;
+} ub_photon_key;
+
+UB_INLINE ub_photon_key ub_photon_key_of(ub_photon_point ph) {
+    ub_photon_key k;
+    k.pos[0] = ph.pos[0];
+    k.pos[1] = ph.pos[1];
+    k.pos[2] = ph.pos[2];
+    k.mediumId = ph.mediumId;
+    return k;
+}
+
 /* A query point: a camera-subpath vertex in a medium (pp3d, bp2d). 64 bytes. */
 typedef struct {
     float pos[3];
@@ -159,6 +176,8 @@ static_assert(offsetof(ub_photon_point, throughput) == 16, "ub_photon_point layo
 static_assert(offsetof(ub_photon_point, sigmaS) == 32, "ub_photon_point layout");
 static_assert(offsetof(ub_photon_point, dirFix) == 48, "ub_photon_point layout");
 static_assert(offsetof(ub_photon_point, dVCM) == 64, "ub_photon_point layout");
+static_assert(sizeof(ub_photon_key) == 16, "ub_photon_key layout");
+static_assert(offsetof(ub_photon_key, mediumId) == 12, "ub_photon_key layout");
 static_assert(sizeof(ub_query_point) == 64, "ub_query_point layout");
 static_assert(offsetof(ub_query_point, throughput) == 16, "ub_query_point layout");
 static_assert(offsetof(ub_query_point, dirFix) == 32, "ub_query_point layout");

@@ -340,7 +340,7 @@ ClRuntime::ClRuntime(int platform, int device, const std::string& cacheDir,
 }
 
 namespace {
-constexpr int kProbeEntries = 16;  // what kernels/pp3d.cl's ub_layout_probe writes
+constexpr int kProbeEntries = 18;  // what kernels/pp3d.cl's ub_layout_probe writes
 }  // namespace
 
 void ClRuntime::checkLayout() {
@@ -377,7 +377,9 @@ void ClRuntime::checkLayout() {
                                          cl_uint(sizeof(ub_beam_part)),
                                          cl_uint(offsetof(ub_beam_part, pathLength)),
                                          cl_uint(sizeof(ub_bvh_node)),
-                                         cl_uint(offsetof(ub_bvh_node, child))};
+                                         cl_uint(offsetof(ub_bvh_node, child)),
+                                         cl_uint(sizeof(ub_photon_key)),
+                                         cl_uint(offsetof(ub_photon_key, mediumId))};
     const char* what[kProbeEntries] = {"sizeof(ub_photon_point)",
                                        "sizeof(ub_query_point)",
                                        "sizeof(ub_beam)",
@@ -393,7 +395,9 @@ void ClRuntime::checkLayout() {
                                        "sizeof(ub_beam_part)",
                                        "offsetof(ub_beam_part, pathLength)",
                                        "sizeof(ub_bvh_node)",
-                                       "offsetof(ub_bvh_node, child)"};
+                                       "offsetof(ub_bvh_node, child)",
+                                       "sizeof(ub_photon_key)",
+                                       "offsetof(ub_photon_key, mediumId)"};
     for (int i = 0; i < kProbeEntries; ++i)
         if (device[i] != host[i])
             throw ClError("OpenCL: device '" + desc_.device +
@@ -620,14 +624,16 @@ void ClRuntime::estimatePP3D(const std::vector<ub_photon_point>& photons, const 
                 bufferArg(queries), queries.size(), a, out);
 }
 
-void ClRuntime::estimatePB2D(const std::vector<ub_photon_point>& photons, const Bvh& spheres,
+void ClRuntime::estimatePB2D(const std::vector<ub_photon_point>& photons,
+                             const std::vector<ub_photon_key>& keys, const Bvh& spheres,
                              const std::vector<ub_beam>& queries, const EstimateArgs& a,
                              std::vector<Rgb>* out) {
     if (photons.empty() || spheres.empty()) return out->assign(queries.size(), Rgb(0.0f));
     requireLeafOrder(spheres, "pb2d");
-    runEstimate(pb2d_, "clEnqueueNDRangeKernel(ub_pb2d_estimate)",
-                withGrids({bufferArg(photons), bufferArg(spheres.nodes())}, gridArgs(a)),
-                bufferArg(queries), queries.size(), a, out);
+    runEstimate(
+        pb2d_, "clEnqueueNDRangeKernel(ub_pb2d_estimate)",
+        withGrids({bufferArg(photons), bufferArg(keys), bufferArg(spheres.nodes())}, gridArgs(a)),
+        bufferArg(queries), queries.size(), a, out);
 }
 
 void ClRuntime::estimateBP2D(const std::vector<ub_beam>& beams,

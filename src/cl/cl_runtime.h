@@ -96,7 +96,9 @@ class ClRuntime {
     void estimatePP3D(const std::vector<ub_photon_point>& photons, const HashGrid& grid,
                       const std::vector<ub_query_point>& queries, const EstimateArgs& a,
                       std::vector<Rgb>* out);
-    void estimatePB2D(const std::vector<ub_photon_point>& photons, const Bvh& spheres,
+    /// keys[i] = ub_photon_key_of(photons[i]) (kernels/shared/ub_pb2d.h).
+    void estimatePB2D(const std::vector<ub_photon_point>& photons,
+                      const std::vector<ub_photon_key>& keys, const Bvh& spheres,
                       const std::vector<ub_beam>& queries, const EstimateArgs& a,
                       std::vector<Rgb>* out);
     /// bp2d and bb1d: pieces and ranges are the photon beams' medium tables

@@ -17,8 +17,8 @@
 namespace ub {
 
 void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres,
-                  const std::vector<ub_photon_point>& photons, std::vector<Rgb>* out,
-                  size_t* pairs) {
+                  const std::vector<ub_photon_point>& photons,
+                  const std::vector<ub_photon_key>& keys, std::vector<Rgb>* out, size_t* pairs) {
     const std::vector<ub_beam>& queries = *in.queryBeams;
     if (photons.empty() || queries.empty()) return;
     const float r = in.radius[UB_TECH_PB2D];
@@ -32,9 +32,11 @@ void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres,
         Rgb sum(0.0f);
         photonSpheres.querySegment(
             Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length, [&](uint32_t j) {
-                const ub_photon_point& ph = photons[j];
                 float t = 0.0f;
-                if (!ub_pb2d_pair(ph, qb, r * r, ub_uint(in.minLength), ub_uint(in.maxLength), &t))
+                if (!ub_pb2d_near(keys[j], qb, r * r, &t)) return;
+                const ub_photon_point& ph = photons[j];
+                if (!ub_pb2d_length_ok(ph.pathLength, qb, ub_uint(in.minLength),
+                                       ub_uint(in.maxLength)))
                     return;
                 if (!queryMedium.built()) queryMedium.build();
                 const ub_segment_eval s = queryMedium.eval(t);

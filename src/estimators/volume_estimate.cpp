@@ -75,6 +75,7 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     }
     Bvh spheres;
     std::vector<ub_photon_point> sphereOrder;
+    std::vector<ub_photon_key> sphereKeys;
     if (t.pb2d) {
         // Boxes, nodes (at most 2 n / leaf size + 1) and the primitive list.
         reserve(photons.size() * (sizeof(Bounds3) + sizeof(Vec3) + 4 + Bvh::kNodeBytesPerBox),
@@ -91,6 +92,11 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         reserve(photons.size() * sizeof(ub_photon_point), "pb2d lookup (photons in leaf order)");
         sphereOrder = photons;
         spheres.permuteToLeafOrder(&sphereOrder);
+        // What the walks test first, 16 bytes a photon (kernels/shared/ub_pb2d.h).
+        reserve(photons.size() * sizeof(ub_photon_key), "pb2d lookup (photon keys)");
+        sphereKeys.resize(sphereOrder.size());
+        for (size_t i = 0; i < sphereOrder.size(); ++i)
+            sphereKeys[i] = ub_photon_key_of(sphereOrder[i]);
     }
     Bvh beamBvh;
     std::vector<BeamPart> parts;
@@ -158,7 +164,8 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     st.lookupBytes += mediaBytes;
     st.buildSeconds = secondsSince(t0);
     st.lookupBytes += spheres.bytes() + sphereOrder.size() * sizeof(ub_photon_point) +
-                      beamBvh.bytes() + parts.size() * sizeof(BeamPart);
+                      sphereKeys.size() * sizeof(ub_photon_key) + beamBvh.bytes() +
+                      parts.size() * sizeof(BeamPart);
 
     t0 = std::chrono::steady_clock::now();
     std::vector<Rgb> perPoint[4], perBeam[4];
@@ -207,12 +214,13 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         perBeam[UB_TECH_PB2D].assign(nBeams, Rgb(0.0f));
         const float r = in.radius[UB_TECH_PB2D];
         if (beamCl) {
-            beamCl->estimatePB2D(sphereOrder, spheres, *in.queryBeams,
+            beamCl->estimatePB2D(sphereOrder, sphereKeys, spheres, *in.queryBeams,
                                  clArgs(UB_TECH_PB2D, ub_pb2d_normalization(in.lightPathCount, r)),
                                  &perBeam[UB_TECH_PB2D]);
             st.pairs[UB_TECH_PB2D] = VolumeEstimateStats::kNotCounted;
         } else {
-            estimatePB2D(in, spheres, sphereOrder, &perBeam[UB_TECH_PB2D], &st.pairs[UB_TECH_PB2D]);
+            estimatePB2D(in, spheres, sphereOrder, sphereKeys, &perBeam[UB_TECH_PB2D],
+                         &st.pairs[UB_TECH_PB2D]);
         }
     }
     if (t.bb1d) {

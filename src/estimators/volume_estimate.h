@@ -116,10 +116,11 @@ class BeamMedium;
 using BeamPart = ub_beam_part;  ///< a diced part of a photon beam (kernels/shared/ub_bvh.h)
 void estimatePP3D(const VolumeEstimateInput& in, const HashGrid& grid, std::vector<Rgb>* out,
                   size_t* pairs);
-/// photons: the photon points in the leaf order of photonSpheres (Bvh::permuteToLeafOrder).
+/// photons: the photon points in the leaf order of photonSpheres (Bvh::permuteToLeafOrder);
+/// keys[i] = ub_photon_key_of(photons[i]).
 void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres,
-                  const std::vector<ub_photon_point>& photons, std::vector<Rgb>* out,
-                  size_t* pairs);
+                  const std::vector<ub_photon_point>& photons,
+                  const std::vector<ub_photon_key>& keys, std::vector<Rgb>* out, size_t* pairs);
 /// photonMedia[i]: the medium along photon beam i, built (estimators/beam_medium.h).
 void estimateBP2D(const VolumeEstimateInput& in, const Bvh& beamParts,
                   const std::vector<BeamPart>& parts, const std::vector<BeamMedium>& photonMedia,
