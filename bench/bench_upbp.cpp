@@ -11,7 +11,13 @@
 // query counts of the last iteration and the image mean (a sanity check). Not run by ctest.
 //
 // Usage: bench_upbp [--runs N] [--sets s1,s2,...] [--backends host,opencl] [--resolution WxH]
-//                   [--radius-of media|scene] [--rays cut,whole] [SCENE ...]
+//                   [--radius-of media|scene] [--rays cut,whole] [--replay K] [SCENE ...]
+//   --replay K: after the timed iterations of an OpenCL run, the last iteration's estimate pass
+//   of each estimator of the set (surf, pp3d, pb2d, bp2d, bb1d) runs K more times on the host
+//   twin and K times as the kernel, alternately, on the same photons, beams and queries
+//   (VertexCM::replayEstimate); prints the median estimate times, queries per second, the
+//   ratio host / OpenCL and how far the two estimates' image sums differ. Ratios from one
+//   process and alternating runs are what docs/performance.md quotes for issue #11.
 //   --rays: with "whole" the bidirectional engine traces every ray through media to the next
 //   surface instead of cutting it where free-flight sampling stops (RenderOptions::
 //   cutRaysAtFlight; same image); both listed: an A/B in one run. Default: cut.
@@ -34,6 +40,7 @@
 
 #include "core/error.h"
 #include "render/integrator.h"
+#include "render/vcm.h"
 #include "scene/io/scene_loader.h"
 
 using namespace ub;
@@ -51,8 +58,49 @@ std::vector<std::string> splitList(const std::string& list) {
     return out;
 }
 
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
+/// --replay: the estimators' host twins against their kernels on the last iteration's records.
+void replayEstimates(VertexCM& vcm, const std::string& set, int replays, int width, int height) {
+    const UpbpTechniques& t = vcm.upbpTechniques();
+    const std::pair<const char*, bool> techniques[] = {
+        {"surf", t.surf}, {"pp3d", t.pp3d}, {"pb2d", t.pb2d}, {"bp2d", t.bp2d}, {"bb1d", t.bb1d}};
+    for (const auto& [name, on] : techniques) {
+        if (!on) continue;
+        std::vector<double> host, device;
+        size_t queries = 0;
+        Rgb sumHost(0.0f), sumDevice(0.0f);
+        for (int k = 0; k < replays; ++k)
+            for (bool onDevice : {false, true}) {
+                Image img(width, height);
+                const VertexCM::EstimateTiming timing = vcm.replayEstimate(name, onDevice, &img);
+                (onDevice ? device : host).push_back(timing.estimates);
+                queries = timing.queries;
+                (onDevice ? sumDevice : sumHost) = img.mean();
+            }
+        const double h = median(host), d = median(device);
+        if (queries == 0) {
+            std::printf("    replay %-5s %-16s no queries\n", name, set.c_str());
+            continue;
+        }
+        const double scale = std::max({double(sumHost.x), double(sumHost.y), double(sumHost.z)});
+        const double diff = std::max({std::abs(double(sumHost.x - sumDevice.x)),
+                                      std::abs(double(sumHost.y - sumDevice.y)),
+                                      std::abs(double(sumHost.z - sumDevice.z))});
+        std::printf(
+            "    replay %-5s %-16s %zu queries: host %.4f s (%.3g/s), OpenCL %.4f s (%.3g/s), "
+            "host/OpenCL %.3f (median of %d each, alternating); image means differ by %.2g "
+            "relative\n",
+            name, set.c_str(), queries, h, double(queries) / h, d, double(queries) / d, h / d,
+            replays, scale > 0.0 ? diff / scale : diff);
+    }
+}
+
 int runOne(const std::string& path, const std::string& set, int runs, int width, int height,
-           const std::string& backend, bool sceneRadius, bool cutRays) {
+           const std::string& backend, bool sceneRadius, bool cutRays, int replays) {
     std::vector<Diagnostic> warnings;
     std::unique_ptr<Scene> scene = loadScene(path, &warnings);
     scene->camera = scene->camera.resized(width, height, scene->settings.keepHorizontalFov);
@@ -96,6 +144,13 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
                 mean.y, mean.z);
     const std::string summary = integrator->iterationSummary();
     if (!summary.empty()) std::printf("    %s\n", summary.c_str());
+    if (replays > 0 && backend == "opencl") {
+        auto* vcm = dynamic_cast<VertexCM*>(integrator.get());
+        if (!vcm || !vcm->hasDeviceEstimates())
+            std::printf("    replay: this run has no OpenCL estimate pass\n");
+        else
+            replayEstimates(*vcm, set, replays, width, height);
+    }
     std::fflush(stdout);
     return 0;
 }
@@ -103,7 +158,7 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
 }  // namespace
 
 int main(int argc, char** argv) {
-    int runs = 3, width = 256, height = 256;
+    int runs = 3, width = 256, height = 256, replays = 0;
     bool sceneRadius = false;
     std::vector<std::string> backends = {"host"}, rays = {"cut"};
     std::vector<std::string> scenes,
@@ -112,6 +167,8 @@ int main(int argc, char** argv) {
         std::string a = argv[i];
         if (a == "--runs" && i + 1 < argc) {
             runs = std::max(1, std::atoi(argv[++i]));
+        } else if (a == "--replay" && i + 1 < argc) {
+            replays = std::max(1, std::atoi(argv[++i]));
         } else if (a == "--sets" && i + 1 < argc) {
             sets = splitList(argv[++i]);
         } else if (a == "--backends" && i + 1 < argc) {
@@ -138,7 +195,8 @@ int main(int argc, char** argv) {
         } else if (a == "--help" || a == "-h") {
             std::printf(
                 "usage: bench_upbp [--runs N] [--sets s1,s2,...] [--backends host,opencl] "
-                "[--resolution WxH] [--radius-of media|scene] [--rays cut,whole] [SCENE ...]\n");
+                "[--resolution WxH] [--radius-of media|scene] [--rays cut,whole] [--replay K] "
+                "[SCENE ...]\n");
             return 0;
         } else if (!a.empty() && a[0] == '-') {
             std::fprintf(stderr, "bench_upbp: unknown option '%s' (or missing value; --help)\n",
@@ -170,7 +228,7 @@ int main(int argc, char** argv) {
                     if (pid == 0) {
                         try {
                             std::_Exit(runOne(scene, set, runs, width, height, backend, sceneRadius,
-                                              ray == "cut"));
+                                              ray == "cut", replays));
                         } catch (const std::exception& e) {
                             std::fprintf(stderr, "bench_upbp: %s %s: %s\n", scene.c_str(),
                                          set.c_str(), e.what());

@@ -31,8 +31,8 @@ __kernel void ub_pp3d_estimate(__global const ub_photon_point* photons,
              * does: most candidates end there, and the 80-byte record straddles two cache
              * lines (ub_pp3d_contribution tests it again). */
             __global const ub_photon_point* pp = photons + indices[j];
-            ub_float3 d = ub_f3_sub(ub_make_float3(pp->pos[0], pp->pos[1], pp->pos[2]),
-                                    ub_f3_from(q.pos));
+            ub_float3 d =
+                ub_f3_sub(ub_make_float3(pp->pos[0], pp->pos[1], pp->pos[2]), ub_f3_from(q.pos));
             if (ub_f3_dot(d, d) > grid.radiusSqr) continue;
             ub_photon_point ph = *pp;
             ub_float3 c = ub_pp3d_contribution(mis, ph, q, g, radius * radius, normalization,

@@ -138,29 +138,7 @@ void VertexCM::estimateSurfaceQueries(Image& out, Image* layer) {
     for (const CameraRecords& rec : cameraRows_)
         surfaceQueries_.insert(surfaceQueries_.end(), rec.surf.begin(), rec.surf.end());
     std::vector<Rgb> perQuery;
-    if (cl_) {
-        ClRuntime::EstimateArgs a;
-        const std::vector<ub_medium_info> noMedia(1, ub_medium_info{});
-        a.media = &noMedia;
-        a.mis = mis_;
-        a.radius = grid_.radius();
-        a.normalization = vmNormalization_;
-        a.minLength = uint32_t(options_.minPathLength);
-        a.maxLength = uint32_t(options_.maxPathLength);
-        cl_->estimateSurf(surfacePhotons_, grid_, coatingTables_, surfaceQueries_, a, &perQuery);
-        lastSurfPairs_ = VolumeEstimateStats::kNotCounted;
-    } else {
-        SurfaceMergeInput in;
-        in.mis = mis_;
-        in.radius = grid_.radius();
-        in.normalization = vmNormalization_;
-        in.minLength = options_.minPathLength;
-        in.maxLength = options_.maxPathLength;
-        in.photons = &surfacePhotons_;
-        in.queries = &surfaceQueries_;
-        in.tables = &coatingTables_;
-        estimateSurface(in, grid_, &perQuery, &lastSurfPairs_);
-    }
+    surfaceEstimates(cl_.get(), &perQuery);
     // In query order (deterministic), each estimate through the technique's guard.
     const ContributionGuard& guard = guards_[size_t(surfTechnique_)];
     uint64_t& rejected = rejected_[size_t(surfTechnique_)];
@@ -174,6 +152,32 @@ void VertexCM::estimateSurfaceQueries(Image& out, Image* layer) {
         if (layer) layer->at(x, y) += m;
     }
     lastSurfSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void VertexCM::surfaceEstimates(ClRuntime* cl, std::vector<Rgb>* perQuery) {
+    if (cl) {
+        ClRuntime::EstimateArgs a;
+        const std::vector<ub_medium_info> noMedia(1, ub_medium_info{});
+        a.media = &noMedia;
+        a.mis = mis_;
+        a.radius = grid_.radius();
+        a.normalization = vmNormalization_;
+        a.minLength = uint32_t(options_.minPathLength);
+        a.maxLength = uint32_t(options_.maxPathLength);
+        cl->estimateSurf(surfacePhotons_, grid_, coatingTables_, surfaceQueries_, a, perQuery);
+        lastSurfPairs_ = VolumeEstimateStats::kNotCounted;
+    } else {
+        SurfaceMergeInput in;
+        in.mis = mis_;
+        in.radius = grid_.radius();
+        in.normalization = vmNormalization_;
+        in.minLength = options_.minPathLength;
+        in.maxLength = options_.maxPathLength;
+        in.photons = &surfacePhotons_;
+        in.queries = &surfaceQueries_;
+        in.tables = &coatingTables_;
+        estimateSurface(in, grid_, perQuery, &lastSurfPairs_);
+    }
 }
 
 }  // namespace ub

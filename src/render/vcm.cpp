@@ -6,8 +6,10 @@
 #include <tbb/parallel_for.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 
 #include "cl/cl_runtime.h"
@@ -395,25 +397,7 @@ void VertexCM::renderIteration(int iteration, Image& out) {
             queryPoints_.insert(queryPoints_.end(), rec.points.begin(), rec.points.end());
             queryBeams_.insert(queryBeams_.end(), rec.beams.begin(), rec.beams.end());
         }
-        VolumeEstimateInput in;
-        in.scene = &scene_;
-        in.mis = mis_;
-        in.techniques = upbp_;
-        for (int t = 0; t < 4; ++t) in.radius[t] = volumeRadius_[t];
-        in.lightPathCount = lightSubPathCount_;
-        in.beamPathCount = float(beamPaths_);
-        in.minLength = options_.minPathLength;
-        in.maxLength = options_.maxPathLength;
-        in.photonPoints = &photonPoints_;
-        in.photonBeams = &photonBeams_;
-        in.queryPoints = &queryPoints_;
-        in.queryBeams = &queryBeams_;
-        in.cl = cl_.get();
-        in.deviceMedia = &deviceMedia_;
-        in.beamKernels = beamKernels_;
-        in.budget = budget_.get();
-        for (int t = 0; t < 4; ++t)
-            if (volumeTechnique_[t] >= 0) in.guards[t] = guards_[size_t(volumeTechnique_[t])];
+        const VolumeEstimateInput in = volumeInput(upbp_, cl_.get(), beamKernels_);
         std::array<Image, 4> perTech;
         if (layered)
             for (int t = 0; t < 4; ++t)
@@ -429,6 +413,74 @@ void VertexCM::renderIteration(int iteration, Image& out) {
         lastBuildSeconds_ = stats.buildSeconds;
         lastEstimateSeconds_ = stats.estimateSeconds;
     }
+}
+
+VolumeEstimateInput VertexCM::volumeInput(const UpbpTechniques& techniques, ClRuntime* cl,
+                                          bool beamKernels) {
+    VolumeEstimateInput in;
+    in.scene = &scene_;
+    in.mis = mis_;
+    in.techniques = techniques;
+    for (int t = 0; t < 4; ++t) in.radius[t] = volumeRadius_[t];
+    in.lightPathCount = lightSubPathCount_;
+    in.beamPathCount = float(beamPaths_);
+    in.minLength = options_.minPathLength;
+    in.maxLength = options_.maxPathLength;
+    in.photonPoints = &photonPoints_;
+    in.photonBeams = &photonBeams_;
+    in.queryPoints = &queryPoints_;
+    in.queryBeams = &queryBeams_;
+    in.cl = cl;
+    in.deviceMedia = &deviceMedia_;
+    in.beamKernels = beamKernels;
+    in.budget = budget_.get();
+    for (int t = 0; t < 4; ++t)
+        if (volumeTechnique_[t] >= 0) in.guards[t] = guards_[size_t(volumeTechnique_[t])];
+    return in;
+}
+
+VertexCM::EstimateTiming VertexCM::replayEstimate(const std::string& technique, bool onDevice,
+                                                  Image* out) {
+    if (algorithm_ != Algorithm::Upbp)
+        throw std::invalid_argument("replayEstimate: the render is not upbp");
+    if (onDevice && !cl_)
+        throw std::invalid_argument("replayEstimate: the render has no OpenCL device");
+    EstimateTiming timing;
+    if (technique == "surf") {
+        if (!upbp_.surf) throw std::invalid_argument("replayEstimate: the render has no surf");
+        const auto t0 = std::chrono::steady_clock::now();
+        std::vector<Rgb> perQuery;
+        surfaceEstimates(onDevice ? cl_.get() : nullptr, &perQuery);
+        timing.estimates =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        timing.queries = surfaceQueries_.size();
+        const uint32_t width = uint32_t(out->width);
+        for (size_t i = 0; i < surfaceQueries_.size(); ++i) {
+            const uint32_t pixel = surfaceQueries_[i].pixel;
+            out->at(int(pixel % width), int(pixel / width)) += perQuery[i];
+        }
+        return timing;
+    }
+    UpbpTechniques one;
+    bool* flag = technique == "pp3d"   ? &one.pp3d
+                 : technique == "pb2d" ? &one.pb2d
+                 : technique == "bp2d" ? &one.bp2d
+                 : technique == "bb1d" ? &one.bb1d
+                                       : nullptr;
+    if (!flag) throw std::invalid_argument("replayEstimate: no estimator '" + technique + "'");
+    *flag = true;
+    const bool on[4] = {upbp_.pp3d, upbp_.pb2d, upbp_.bp2d, upbp_.bb1d};
+    const bool want[4] = {one.pp3d, one.pb2d, one.bp2d, one.bb1d};
+    for (int t = 0; t < 4; ++t)
+        if (want[t] && !on[t])
+            throw std::invalid_argument("replayEstimate: the render has no " + technique);
+    VolumeEstimateStats stats;
+    estimateVolume(volumeInput(one, onDevice ? cl_.get() : nullptr, onDevice && beamKernels_), out,
+                   nullptr, &stats);
+    timing.lookups = stats.buildSeconds;
+    timing.estimates = stats.estimateSeconds;
+    timing.queries = one.pp3d || one.bp2d ? queryPoints_.size() : queryBeams_.size();
+    return timing;
 }
 
 bool VertexCM::traceToVertex(Rng& rng, SubPath& state, PathVertex* v, bool* escaped,

@@ -74,6 +74,7 @@ namespace ub {
 class Rng;
 class ClRuntime;
 class VertexScatter;
+struct VolumeEstimateInput;
 struct ChainVertex;
 
 class VertexCM : public Integrator {
@@ -97,6 +98,22 @@ class VertexCM : public Integrator {
     RejectionCounts rejectedContributions() const override;
     /// Where the estimate pass runs, in words (UPBP; empty otherwise).
     std::string setupNote() const override { return backendNote_; }
+
+    /// What replayEstimate measured, in seconds: building the lookups (host, both backends)
+    /// and the estimates themselves; and how many queries the estimator evaluated.
+    struct EstimateTiming {
+        double lookups = 0, estimates = 0;
+        size_t queries = 0;
+    };
+    /// UPBP: runs the last iteration's estimate pass again for one technique ("surf", "pp3d",
+    /// "pb2d", "bp2d" or "bb1d", which the render must run) over the same photons, beams and
+    /// queries, with its OpenCL kernel (onDevice; the render must have one) or its host twin,
+    /// adding the estimates to `out` (width x height). For bench_upbp --replay, which times
+    /// the two backends alternately on the same buffers. Throws std::invalid_argument for
+    /// another technique.
+    EstimateTiming replayEstimate(const std::string& technique, bool onDevice, Image* out);
+    /// True if the estimate pass can run on an OpenCL device (replayEstimate's onDevice).
+    bool hasDeviceEstimates() const { return cl_ != nullptr; }
 
     Algorithm algorithm() const { return algorithm_; }
     /// True if subpaths are traced through participating media (vlt/vbpt on a scene with
@@ -210,6 +227,11 @@ class VertexCM : public Integrator {
     /// upbp's surface-merging pass (estimators/surface_merging.cpp) over the recorded surface
     /// queries: adds each query's estimate to its pixel of out and of layer, in query order.
     void estimateSurfaceQueries(Image& out, Image* layer);
+    /// Its estimates of surfaceQueries_, by the kernel (cl) or the host twin (cl null).
+    void surfaceEstimates(ClRuntime* cl, std::vector<Rgb>* perQuery);
+    /// The estimate pass's input for this iteration's records (renderIteration, replay).
+    VolumeEstimateInput volumeInput(const UpbpTechniques& techniques, ClRuntime* cl,
+                                    bool beamKernels);
 
     // Shared: samples the next direction (Russian roulette, MIS update [TR (34)-(36)],
     // [TR (53)-(55)]), updates the medium stack and spawns the ray. Returns false if the
