@@ -84,12 +84,14 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     if (!m.homogeneous) ub_grid_accessor_init(&acc, gridData, gi);
     ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
     ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+    const float qLength = qb.length, r2 = radius * radius;
+    const uint qMedium = qb.mediumId;
     ub_beam_piece table[UB_QUERY_PIECES];
     ub_uint tableState = UB_TABLE_UNBUILT;
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    UB_BVH_WALK_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qb.length)) {
+    UB_BVH_WALK_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qLength)) {
         float t = 0.0f;
-        if (!ub_pb2d_near(keys[k], qb, radius * radius, &t)) continue;
+        if (!ub_pb2d_near(keys[k], o, d, qLength, qMedium, r2, &t)) continue;
         ub_photon_point ph = photons[k];
         if (!ub_pb2d_length_ok(ph.pathLength, qb, minLength, maxLength)) continue;
         ub_segment_eval s =

@@ -30,10 +30,10 @@ UB_INLINE float ub_pb2d_normalization(float lightPaths, float radius) {
  * of the beam (ub_pb2d_near, on the photon's key, which is where most candidates of a walk
  * end; writes its beam parameter), and the path length in [minLength, maxLength]
  * (ub_pb2d_length_ok, on the photon record, read for the near ones only). */
-UB_INLINE int ub_pb2d_near(ub_photon_key k, ub_beam qb, float radiusSqr, UB_PRIVATE float* t) {
-    if (k.mediumId != qb.mediumId) return 0;
-    float d2 = ub_point_beam_dist2(ub_f3_from(k.pos), ub_f3_from(qb.origin), ub_f3_from(qb.dir),
-                                   qb.length, t);
+UB_INLINE int ub_pb2d_near(ub_photon_key k, ub_float3 origin, ub_float3 dir, float length,
+                           ub_uint mediumId, float radiusSqr, UB_PRIVATE float* t) {
+    if (k.mediumId != mediumId) return 0;
+    float d2 = ub_point_beam_dist2(ub_f3_from(k.pos), origin, dir, length, t);
     return d2 >= 0.0f && d2 <= radiusSqr;
 }
 UB_INLINE int ub_pb2d_length_ok(ub_uint photonLength, ub_beam qb, ub_uint minLength,

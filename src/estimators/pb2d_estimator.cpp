@@ -33,7 +33,7 @@ void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres,
         photonSpheres.querySegment(
             Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length, [&](uint32_t j) {
                 float t = 0.0f;
-                if (!ub_pb2d_near(keys[j], qb, r * r, &t)) return;
+                if (!ub_pb2d_near(keys[j], o, d, qb.length, qb.mediumId, r * r, &t)) return;
                 const ub_photon_point& ph = photons[j];
                 if (!ub_pb2d_length_ok(ph.pathLength, qb, ub_uint(in.minLength),
                                        ub_uint(in.maxLength)))
