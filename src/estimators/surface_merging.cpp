@@ -20,6 +20,7 @@
 
 #include "cl/cl_runtime.h"
 #include "core/memory_budget.h"
+#include "core/parallel_gather.h"
 #include "estimators/hash_grid.h"
 #include "estimators/volume_estimate.h"
 #include "render/medium_walk.h"
@@ -130,13 +131,9 @@ void estimateSurface(const SurfaceMergeInput& in, const HashGrid& grid, std::vec
 
 void VertexCM::estimateSurfaceQueries(Image& out, Image* layer) {
     const auto t0 = std::chrono::steady_clock::now();
-    surfaceQueries_.clear();
-    size_t n = 0;
-    for (const CameraRecords& rec : cameraRows_) n += rec.surf.size();
-    reserveFor(surfaceQueries_, n, budget_.get(), "surface queries",
-               "a smaller --resolution or --max-length needs less");
-    for (const CameraRecords& rec : cameraRows_)
-        surfaceQueries_.insert(surfaceQueries_.end(), rec.surf.begin(), rec.surf.end());
+    gatherParts(
+        surfaceQueries_, cameraRows_.size(), [&](size_t y) -> auto& { return cameraRows_[y].surf; },
+        budget_.get(), "surface queries", "a smaller --resolution or --max-length needs less");
     std::vector<Rgb> perQuery;
     surfaceEstimates(cl_.get(), &perQuery);
     // In query order (deterministic), each estimate through the technique's guard.

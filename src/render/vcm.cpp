@@ -14,6 +14,7 @@
 
 #include "cl/cl_runtime.h"
 #include "core/error.h"
+#include "core/parallel_gather.h"
 #include "core/rng.h"
 #include "estimators/grid_access.h"
 #include "estimators/surface_merging.h"
@@ -294,44 +295,55 @@ void VertexCM::renderIteration(int iteration, Image& out) {
         traceLightPaths(iteration, range.first, range.second, splats_.chunk(c),
                         lightChunks_[size_t(c)]);
     });
-    lightVertices_.clear();
-    photonPoints_.clear();
-    photonBeams_.clear();
-    pathEnds_.assign(pathCount, 0);
     {
-        size_t nv = 0, np = 0, nb = 0;
-        for (const LightChunk& chunk : lightChunks_) {
-            nv += chunk.vertices.size();
-            np += chunk.photons.size();
-            nb += chunk.beams.size();
-        }
         const char* advice =
             "a smaller --resolution (fewer light subpaths) or --max-length needs less";
-        reserveFor(lightVertices_, nv, budget_.get(), "light vertices", advice);
-        reserveFor(photonPoints_, np, budget_.get(), "photon points", advice);
-        reserveFor(photonBeams_, nb, budget_.get(), "photon beams",
-                   "fewer --beam-paths, a smaller --resolution or --max-length need less");
+        const size_t chunks = lightChunks_.size();
+        gatherParts(
+            lightVertices_, chunks, [&](size_t c) -> auto& { return lightChunks_[c].vertices; },
+            budget_.get(), "light vertices", advice);
+        gatherParts(
+            photonPoints_, chunks, [&](size_t c) -> auto& { return lightChunks_[c].photons; },
+            budget_.get(), "photon points", advice);
+        gatherParts(
+            photonBeams_, chunks, [&](size_t c) -> auto& { return lightChunks_[c].beams; },
+            budget_.get(), "photon beams",
+            "fewer --beam-paths, a smaller --resolution or --max-length need less");
     }
-    for (int c = 0; c < chunkCount; ++c) {
-        auto range = SplatBuffer::chunkRange(c, pathCount);
-        const LightChunk& chunk = lightChunks_[size_t(c)];
-        uint32_t offset = uint32_t(lightVertices_.size());
-        for (size_t i = range.first; i < range.second; ++i)
-            pathEnds_[i] = offset + chunk.pathEnds[i - range.first];
-        lightVertices_.insert(lightVertices_.end(), chunk.vertices.begin(), chunk.vertices.end());
-        photonPoints_.insert(photonPoints_.end(), chunk.photons.begin(), chunk.photons.end());
-        photonBeams_.insert(photonBeams_.end(), chunk.beams.begin(), chunk.beams.end());
+    pathEnds_.resize(pathCount);
+    {
+        std::vector<uint32_t> first(size_t(chunkCount), 0);
+        for (int c = 1; c < chunkCount; ++c)
+            first[size_t(c)] =
+                first[size_t(c - 1)] + uint32_t(lightChunks_[size_t(c - 1)].vertices.size());
+        tbb::parallel_for(0, chunkCount, [&](int c) {
+            auto range = SplatBuffer::chunkRange(c, pathCount);
+            const LightChunk& chunk = lightChunks_[size_t(c)];
+            for (size_t i = range.first; i < range.second; ++i)
+                pathEnds_[i] = first[size_t(c)] + chunk.pathEnds[i - range.first];
+        });
     }
 
     // (2) Hashed grid over the light vertices for merging (upbp: over the surface ones).
     if (surfBatch_) {
-        surfacePhotons_.clear();
-        size_t n = 0;
-        for (const LightVertex& lv : lightVertices_) n += lv.inMedium() ? 0 : 1;
-        reserveFor(surfacePhotons_, n, budget_.get(), "surface photons",
+        // The surface vertices in light-vertex order: counted per chunk, then each chunk's
+        // copied to its offset, in parallel.
+        const size_t chunks = lightChunks_.size();
+        std::vector<size_t> offset(chunks + 1, 0);
+        tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+            size_t n = 0;
+            for (const LightVertex& lv : lightChunks_[c].vertices) n += lv.inMedium() ? 0 : 1;
+            offset[c + 1] = n;
+        });
+        for (size_t c = 0; c < chunks; ++c) offset[c + 1] += offset[c];
+        reserveFor(surfacePhotons_, offset[chunks], budget_.get(), "surface photons",
                    "a smaller --resolution (fewer light subpaths) or --max-length needs less");
-        for (const LightVertex& lv : lightVertices_)
-            if (!lv.inMedium()) surfacePhotons_.push_back(lv);
+        surfacePhotons_.resize(offset[chunks]);
+        tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+            size_t k = offset[c];
+            for (const LightVertex& lv : lightChunks_[c].vertices)
+                if (!lv.inMedium()) surfacePhotons_[k++] = lv;
+        });
         grid_.build(surfacePhotons_, &LightVertex::position, radius);
     } else if (useVM_) {
         grid_.build(lightVertices_, &LightVertex::position, radius);
@@ -383,20 +395,15 @@ void VertexCM::renderIteration(int iteration, Image& out) {
     // (5) UPBP estimate pass: the volumetric estimators over the recorded queries, added to
     // their pixels in query order (estimators/volume_estimate.h).
     if (upbp_.anyVolume()) {
-        queryPoints_.clear();
-        queryBeams_.clear();
-        size_t nq = 0, nb = 0;
-        for (const CameraRecords& rec : cameraRows_) {
-            nq += rec.points.size();
-            nb += rec.beams.size();
-        }
         const char* advice = "a smaller --resolution or --max-length needs less";
-        reserveFor(queryPoints_, nq, budget_.get(), "query points", advice);
-        reserveFor(queryBeams_, nb, budget_.get(), "query beams", advice);
-        for (const CameraRecords& rec : cameraRows_) {
-            queryPoints_.insert(queryPoints_.end(), rec.points.begin(), rec.points.end());
-            queryBeams_.insert(queryBeams_.end(), rec.beams.begin(), rec.beams.end());
-        }
+        gatherParts(
+            queryPoints_,
+            cameraRows_.size(), [&](size_t y) -> auto& { return cameraRows_[y].points; },
+            budget_.get(), "query points", advice);
+        gatherParts(
+            queryBeams_,
+            cameraRows_.size(), [&](size_t y) -> auto& { return cameraRows_[y].beams; },
+            budget_.get(), "query beams", advice);
         const VolumeEstimateInput in = volumeInput(upbp_, cl_.get(), beamKernels_);
         std::array<Image, 4> perTech;
         if (layered)

@@ -1,0 +1,33 @@
+// gatherParts: the concatenation of many vectors (per-chunk or per-row records of a pass)
+// into one, copied in parallel, with its growth reserved in the memory budget.
+#pragma once
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+#include "core/memory_budget.h"
+
+namespace ub {
+
+/// dst = the concatenation of the vectors part(0), ..., part(count - 1), copied in parallel
+/// (the element order is the serial concatenation's). dst is resized, not cleared first, so
+/// only its growth beyond the last iteration's size is initialised; its capacity grows
+/// through the budget (reserveFor). The serial insert loops this replaces were, with the
+/// surface-photon filter and the hashed grid's build, 8% of the candle's upbp iteration on 2 cores.
+template <class T, class Part>
+void gatherParts(std::vector<T>& dst, size_t count, Part&& part, MemoryBudget* budget,
+                 const char* what, const char* advice) {
+    std::vector<size_t> offset(count + 1, 0);
+    for (size_t c = 0; c < count; ++c) offset[c + 1] = offset[c] + part(c).size();
+    reserveFor(dst, offset[count], budget, what, advice);
+    dst.resize(offset[count]);
+    tbb::parallel_for(size_t(0), count, [&](size_t c) {
+        const std::vector<T>& src = part(c);
+        std::copy(src.begin(), src.end(), dst.begin() + std::ptrdiff_t(offset[c]));
+    });
+}
+
+}  // namespace ub
