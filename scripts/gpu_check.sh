@@ -5,7 +5,8 @@
 #   2. the OpenCL tests (kernel against host twin per query, whole renders of both
 #      backends, layout probe, program cache, error paths) on the first device listed;
 #   3. the default scene rendered with `--backend host` and `--backend opencl`, compared;
-#   4. bench_upbp, host twin against the kernels, for each estimator and `upbp`.
+#   4. bench_upbp --replay: each estimator's kernel against its host twin on the same records;
+#   5. bench_upbp, host twin against the kernels, for each estimator and `upbp`.
 # Each step has its own time limit, and its log is written to LOGDIR as it runs.
 #
 # Usage: scripts/gpu_check.sh ARCHIVE LOGDIR [BENCH_SECONDS] [BENCH_SCENE ...]
@@ -72,6 +73,12 @@ for b in host opencl; do
 done
 timeout 60 "$root/bin/unibeam" compare "$root/smoke-opencl.exr" "$root/smoke-host.exr" 2>&1 |
     tee -a "$logs/summary.txt"
+
+step replay
+# Each estimator's kernel against its host twin on the same records, alternately (short).
+(cd "$src" && timeout "$benchSeconds" "$root/bin/bench_upbp" --runs 1 --replay 5 \
+    --radius-of scene --backends opencl --sets upbp "$@" 2>&1) | tee "$logs/replay.txt" |
+    grep -E 'replay|s/it' | tee -a "$logs/summary.txt"
 
 step bench
 (cd "$src" && timeout "$benchSeconds" "$root/bin/bench_upbp" --runs 3 --radius-of scene \
