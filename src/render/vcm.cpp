@@ -336,6 +336,8 @@ void VertexCM::renderIteration(int iteration, Image& out) {
             offset[c + 1] = n;
         });
         for (size_t c = 0; c < chunks; ++c) offset[c + 1] += offset[c];
+        if (offset[chunks] > surfacePhotons_.capacity())
+            surfacePhotons_.clear();  // see gatherParts
         reserveFor(surfacePhotons_, offset[chunks], budget_.get(), "surface photons",
                    "a smaller --resolution (fewer light subpaths) or --max-length needs less");
         surfacePhotons_.resize(offset[chunks]);
