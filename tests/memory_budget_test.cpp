@@ -12,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/parallel_gather.h"
 #include "render/progressive.h"
 
 using namespace ub;
@@ -103,4 +104,33 @@ TEST(MemoryBudget, CliRejectsARenderOverTheBudget) {
     std::tie(code, log) = run("--max-memory 256M");
     EXPECT_EQ(code, 0) << log;
     fs::remove_all(dir);
+}
+
+// gatherParts (core/parallel_gather.h): the serial concatenation, element for element; a
+// smaller gather keeps the capacity; growth is reserved in the budget, and growth beyond
+// the budget throws before anything is copied.
+TEST(ParallelGather, EqualsTheSerialConcatenationWithinTheBudget) {
+    std::vector<std::vector<int>> parts(300);
+    std::vector<int> serial;
+    for (size_t c = 0; c < parts.size(); ++c)
+        for (size_t k = 0; k < (c * 7) % 13; ++k) {  // some parts empty
+            parts[c].push_back(int(c * 100 + k));
+            serial.push_back(int(c * 100 + k));
+        }
+    MemoryBudget budget(size_t(1) << 20);
+    std::vector<int> dst;
+    auto part = [&](size_t c) -> auto& {
+        return parts[c];
+    };
+    gatherParts(dst, parts.size(), part, &budget, "test records", "less");
+    EXPECT_EQ(dst, serial);
+    EXPECT_GE(budget.used(), serial.size() * sizeof(int));
+    const size_t capacity = dst.capacity();
+    gatherParts(dst, 100, part, &budget, "test records", "less");
+    EXPECT_EQ(dst, std::vector<int>(serial.begin(), serial.begin() + std::ptrdiff_t(dst.size())));
+    EXPECT_EQ(dst.capacity(), capacity);
+    MemoryBudget small(64);
+    std::vector<int> other;
+    EXPECT_THROW(gatherParts(other, parts.size(), part, &small, "test records", "less"),
+                 MemoryBudgetError);
 }

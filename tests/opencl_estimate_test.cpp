@@ -204,6 +204,52 @@ TEST(OpenClEstimate, WholeRenderAgreesBetweenBackends) {
     expectBackendsAgree(*host, *cl, 1e-5f, {"bpt", "pp3d", "pb2d", "bp2d", "bb1d", "image"});
 }
 
+// VertexCM::replayEstimate (bench_upbp --replay): the last iteration's estimate pass of one
+// estimator, run again as the kernel (as the OpenCL render ran it), is that iteration's layer
+// of the estimator bit for bit (same records, same order, nothing rejected by the guard
+// here); run on the host twin it agrees within the per-query bound above; techniques the
+// render does not run are refused.
+TEST(OpenClEstimate, ReplayedEstimatesEqualTheIterationsLayers) {
+    auto scene = infiniteFog(24);
+    RenderOptions opt = pp3dOptions("opencl");
+    opt.algorithm = "upbp:bpt+pp3d+pb2d+bb1d";
+    opt.radiusPB2D = 0.08f;
+    opt.radiusBB1D = 0.04f;
+    opt.beamPaths = 256;
+    auto integrator = makeIntegrator(*scene, opt);
+    auto* vcm = dynamic_cast<VertexCM*>(integrator.get());
+    ASSERT_NE(vcm, nullptr);
+    ASSERT_TRUE(vcm->hasDeviceEstimates());
+    Image img;
+    vcm->renderIteration(1, img);
+    const std::vector<std::string> names = vcm->layerNames();
+    for (const char* tech : {"pp3d", "pb2d", "bb1d"}) {
+        const size_t l = size_t(std::find(names.begin(), names.end(), tech) - names.begin());
+        ASSERT_LT(l, names.size()) << tech;
+        const Image& layer = (*vcm->iterationLayers())[l];
+        for (bool onDevice : {false, true}) {
+            Image replay(img.width, img.height);
+            const VertexCM::EstimateTiming t = vcm->replayEstimate(tech, onDevice, &replay);
+            EXPECT_GT(t.queries, 0u) << tech;
+            double sum = 0;
+            for (size_t i = 0; i < layer.pixels.size(); ++i)
+                for (int c = 0; c < 3; ++c) {
+                    const float x = layer.pixels[i][c], y = replay.pixels[i][c];
+                    if (!onDevice)
+                        ASSERT_NEAR(y, x, 1e-5f * std::fabs(x) + 1e-9f) << tech << " " << i;
+                    else
+                        ASSERT_EQ(y, x) << tech << " pixel " << i;
+                    sum += x;
+                }
+            EXPECT_GT(sum, 0.0) << tech;
+        }
+    }
+    Image scratch(img.width, img.height);
+    EXPECT_THROW(vcm->replayEstimate("bp2d", false, &scratch), std::invalid_argument);
+    EXPECT_THROW(vcm->replayEstimate("surf", false, &scratch), std::invalid_argument);
+    EXPECT_THROW(vcm->replayEstimate("bpt", false, &scratch), std::invalid_argument);
+}
+
 // The same in a NanoVDB medium (the bundled smoke plume, nearest filtering): the beam
 // kernels track through the grid with CNanoVDB.h (kernels/shared/ub_grid_medium.h), the
 // host twins through their tabulated pieces (estimators/beam_medium.h), the kernels through
