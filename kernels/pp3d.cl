@@ -21,7 +21,8 @@ __kernel void ub_pp3d_estimate(__global const ub_photon_point* photons,
     ub_query_point q = queries[i];
     float g = media[q.mediumId].g;
     ub_uint buckets[8];
-    int nb = ub_hash_buckets(grid, ub_f3_from(q.pos), buckets);
+    ub_float3 qp = ub_f3_from(q.pos);
+    int nb = ub_hash_buckets(grid, qp, buckets);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     for (int k = 0; k < nb; ++k) {
         uint b = buckets[k];
@@ -31,9 +32,8 @@ __kernel void ub_pp3d_estimate(__global const ub_photon_point* photons,
              * does: most candidates end there, and the 80-byte record straddles two cache
              * lines (ub_pp3d_contribution tests it again). */
             __global const ub_photon_point* pp = photons + indices[j];
-            ub_float3 d =
-                ub_f3_sub(ub_make_float3(pp->pos[0], pp->pos[1], pp->pos[2]), ub_f3_from(q.pos));
-            if (ub_f3_dot(d, d) > grid.radiusSqr) continue;
+            if (!ub_hash_within(grid, ub_make_float3(pp->pos[0], pp->pos[1], pp->pos[2]), qp))
+                continue;
             ub_photon_point ph = *pp;
             ub_float3 c = ub_pp3d_contribution(mis, ph, q, g, radius * radius, normalization,
                                                minLength, maxLength);

@@ -34,9 +34,8 @@ __kernel void ub_surf_estimate(__global const ub_light_vertex* photons,
         uint begin = b == 0 ? 0u : cellEnds[b - 1], end = cellEnds[b];
         for (uint j = begin; j < end; ++j) {
             __global const ub_light_vertex* gp = photons + indices[j];
-            float dx = gp->position[0] - qp.x, dy = gp->position[1] - qp.y,
-                  dz = gp->position[2] - qp.z;
-            if (dx * dx + dy * dy + dz * dz > r2) continue;
+            ub_float3 pos = ub_make_float3(gp->position[0], gp->position[1], gp->position[2]);
+            if (!ub_hash_within(grid, pos, qp)) continue;
             if (!loaded) {
                 q = *gq;
                 loaded = 1;

@@ -187,14 +187,21 @@ void expectBackendsAgree(Integrator& host, Integrator& cl, float rel,
 // A whole upbp iteration (all six techniques; homogeneous medium, so every volumetric
 // estimator runs as a kernel) with a fixed seed: every technique layer and the image agree
 // between the backends per pixel within 1e-5 relative (seen: 8e-7).
-TEST(OpenClEstimate, WholeRenderAgreesBetweenBackends) {
-    auto scene = infiniteFog(24);
-    RenderOptions opt = pp3dOptions("host");
-    opt.algorithm = "upbp";
+/// pp3dOptions with algorithm `algorithm` and the beam estimators' radii and beam paths of
+/// the whole-render tests in infiniteFog(24).
+RenderOptions fogUpbpOptions(const std::string& backend, const std::string& algorithm) {
+    RenderOptions opt = pp3dOptions(backend);
+    opt.algorithm = algorithm;
     opt.radiusPB2D = 0.08f;
     opt.radiusBP2D = 0.08f;
     opt.radiusBB1D = 0.04f;
     opt.beamPaths = 256;
+    return opt;
+}
+
+TEST(OpenClEstimate, WholeRenderAgreesBetweenBackends) {
+    auto scene = infiniteFog(24);
+    RenderOptions opt = fogUpbpOptions("host", "upbp");
     auto host = makeIntegrator(*scene, opt);
     opt.backend = "opencl";
     auto cl = makeIntegrator(*scene, opt);
@@ -211,11 +218,7 @@ TEST(OpenClEstimate, WholeRenderAgreesBetweenBackends) {
 // render does not run are refused.
 TEST(OpenClEstimate, ReplayedEstimatesEqualTheIterationsLayers) {
     auto scene = infiniteFog(24);
-    RenderOptions opt = pp3dOptions("opencl");
-    opt.algorithm = "upbp:bpt+pp3d+pb2d+bb1d";
-    opt.radiusPB2D = 0.08f;
-    opt.radiusBB1D = 0.04f;
-    opt.beamPaths = 256;
+    const RenderOptions opt = fogUpbpOptions("opencl", "upbp:bpt+pp3d+pb2d+bb1d");
     auto integrator = makeIntegrator(*scene, opt);
     auto* vcm = dynamic_cast<VertexCM*>(integrator.get());
     ASSERT_NE(vcm, nullptr);

@@ -58,4 +58,11 @@ UB_INLINE int ub_hash_buckets(ub_hash_grid g, ub_float3 q, UB_PRIVATE ub_uint* b
     return nb;
 }
 
+/* Whether point p lies within the grid's radius of q: the range test of a query, the host's
+ * (HashGrid::query) and the kernels' before they read a candidate's record. */
+UB_INLINE int ub_hash_within(ub_hash_grid g, ub_float3 p, ub_float3 q) {
+    ub_float3 d = ub_f3_sub(p, q);
+    return ub_f3_dot(d, d) <= g.radiusSqr;
+}
+
 #endif /* UB_HASH_GRID_H */

@@ -80,13 +80,15 @@ template <class Visit>
 void HashGrid::query(const Vec3& q, const Vec3* positions, size_t stride, Visit&& visit) const {
     if (indices_.empty()) return;
     uint32_t buckets[8];
-    const int nb = ub_hash_buckets(params_, ub_make_float3(q.x, q.y, q.z), buckets);
+    const ub_float3 qf = ub_make_float3(q.x, q.y, q.z);
+    const int nb = ub_hash_buckets(params_, qf, buckets);
     for (int j = 0; j < nb; ++j) {
         uint32_t b = buckets[j];
         uint32_t begin = b == 0 ? 0 : cellEnds_[b - 1], end = cellEnds_[b];
         for (uint32_t i = begin; i < end; ++i) {
             uint32_t idx = indices_[i];
-            if (lengthSqr(at(positions, stride, idx) - q) <= params_.radiusSqr) visit(idx);
+            const Vec3& p = at(positions, stride, idx);
+            if (ub_hash_within(params_, ub_make_float3(p.x, p.y, p.z), qf)) visit(idx);
         }
     }
 }

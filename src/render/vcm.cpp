@@ -326,26 +326,12 @@ void VertexCM::renderIteration(int iteration, Image& out) {
 
     // (2) Hashed grid over the light vertices for merging (upbp: over the surface ones).
     if (surfBatch_) {
-        // The surface vertices in light-vertex order: counted per chunk, then each chunk's
-        // copied to its offset, in parallel.
-        const size_t chunks = lightChunks_.size();
-        std::vector<size_t> offset(chunks + 1, 0);
-        tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-            size_t n = 0;
-            for (const LightVertex& lv : lightChunks_[c].vertices) n += lv.inMedium() ? 0 : 1;
-            offset[c + 1] = n;
-        });
-        for (size_t c = 0; c < chunks; ++c) offset[c + 1] += offset[c];
-        if (offset[chunks] > surfacePhotons_.capacity())
-            surfacePhotons_.clear();  // see gatherParts
-        reserveFor(surfacePhotons_, offset[chunks], budget_.get(), "surface photons",
-                   "a smaller --resolution (fewer light subpaths) or --max-length needs less");
-        surfacePhotons_.resize(offset[chunks]);
-        tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-            size_t k = offset[c];
-            for (const LightVertex& lv : lightChunks_[c].vertices)
-                if (!lv.inMedium()) surfacePhotons_[k++] = lv;
-        });
+        // The surface vertices, in light-vertex order.
+        gatherPartsIf(
+            surfacePhotons_,
+            lightChunks_.size(), [&](size_t c) -> auto& { return lightChunks_[c].vertices; },
+            [](const LightVertex& lv) { return !lv.inMedium(); }, budget_.get(), "surface photons",
+            "a smaller --resolution (fewer light subpaths) or --max-length needs less");
         grid_.build(surfacePhotons_, &LightVertex::position, radius);
     } else if (useVM_) {
         grid_.build(lightVertices_, &LightVertex::position, radius);
@@ -454,9 +440,22 @@ VertexCM::EstimateTiming VertexCM::replayEstimate(const std::string& technique, 
         throw std::invalid_argument("replayEstimate: the render is not upbp");
     if (onDevice && !cl_)
         throw std::invalid_argument("replayEstimate: the render has no OpenCL device");
+    UpbpTechniques one;
+    try {
+        one = parseUpbpTechniques("upbp:" + technique);
+    } catch (const InputError&) {
+        one.bpt = true;  // not one technique: refused below
+    }
+    const bool single =
+        int(one.surf) + int(one.pp3d) + int(one.pb2d) + int(one.bp2d) + int(one.bb1d) == 1;
+    const bool runs = (one.surf && upbp_.surf) || (one.pp3d && upbp_.pp3d) ||
+                      (one.pb2d && upbp_.pb2d) || (one.bp2d && upbp_.bp2d) ||
+                      (one.bb1d && upbp_.bb1d);
+    if (one.bpt || !single || !runs)
+        throw std::invalid_argument("replayEstimate: '" + technique +
+                                    "' is not an estimator this render runs");
     EstimateTiming timing;
-    if (technique == "surf") {
-        if (!upbp_.surf) throw std::invalid_argument("replayEstimate: the render has no surf");
+    if (one.surf) {
         const auto t0 = std::chrono::steady_clock::now();
         std::vector<Rgb> perQuery;
         surfaceEstimates(onDevice ? cl_.get() : nullptr, &perQuery);
@@ -470,19 +469,6 @@ VertexCM::EstimateTiming VertexCM::replayEstimate(const std::string& technique, 
         }
         return timing;
     }
-    UpbpTechniques one;
-    bool* flag = technique == "pp3d"   ? &one.pp3d
-                 : technique == "pb2d" ? &one.pb2d
-                 : technique == "bp2d" ? &one.bp2d
-                 : technique == "bb1d" ? &one.bb1d
-                                       : nullptr;
-    if (!flag) throw std::invalid_argument("replayEstimate: no estimator '" + technique + "'");
-    *flag = true;
-    const bool on[4] = {upbp_.pp3d, upbp_.pb2d, upbp_.bp2d, upbp_.bb1d};
-    const bool want[4] = {one.pp3d, one.pb2d, one.bp2d, one.bb1d};
-    for (int t = 0; t < 4; ++t)
-        if (want[t] && !on[t])
-            throw std::invalid_argument("replayEstimate: the render has no " + technique);
     VolumeEstimateStats stats;
     estimateVolume(volumeInput(one, onDevice ? cl_.get() : nullptr, onDevice && beamKernels_), out,
                    nullptr, &stats);
