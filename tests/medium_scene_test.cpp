@@ -225,6 +225,53 @@ TEST(NestedMedia, ShadowRaysPassImaginaryBoundariesWithTransmittance) {
     EXPECT_TRUE(isBlack(blocked.transmittance));
 }
 
+TEST(NestedMedia, ShadowRaysThroughEdgesAndCornersCrossOnce) {
+    // The imaginary cube [-1, 1]^3 of the test above. Rays that leave it through the centre
+    // of a face (on the diagonal of its two triangles), through an edge (four triangles) and
+    // through a corner meet several triangles at one point; the one-traversal shadow query
+    // (Scene::shadowCrossings) reports each such crossing once, so the stack leaves the cube
+    // once and the transmittance is that of the chord.
+    const char* media =
+        R"("m": {"type": "homogeneous", "sigma_a": [0.5, 1, 1.5], "sigma_s": [0.5, 1, 1.5]})";
+    const char* shapes =
+        R"({"type": "cube", "name": "box", "interior_medium": "m", "imaginary": true})";
+    auto scene = loadJsonSceneFromString(mediaScene(media, "", shapes), "imag.json", "");
+    const Vec3 exits[6] = {Vec3(0, 0, 1), Vec3(0, 0, -1), Vec3(1, 0, 0),
+                           Vec3(1, 1, 0), Vec3(-1, 0, 1), Vec3(1, 1, 1)};
+    for (const Vec3& e : exits) {
+        const float chord = length(e);
+        const Vec3 dir = e / chord;
+        Scene::ShadowCrossing crossings[8];
+        int count = -1;
+        ASSERT_EQ(scene->shadowCrossings(Vec3(0.0f), dir, 3.0f * chord, crossings, 8, &count),
+                  Scene::ShadowQuery::kOpen);
+        ASSERT_EQ(count, 1) << "exit " << e.x << " " << e.y << " " << e.z;
+        EXPECT_NEAR(crossings[0].t, chord, 1e-5f);
+        EXPECT_GT(dot(crossings[0].geoNormal, dir), 0.0f);  // leaving
+        const MediumStack inside = scene->mediumStackAt(Vec3(0.0f));
+        ASSERT_EQ(inside.mediumId(), 0);
+        const MediumShadow sh =
+            scene->shadowTransmittance(Vec3(0.0f), Vec3(0.0f), inside, e * 3.0f, Vec3(0.0f));
+        ASSERT_FALSE(sh.blocked);
+        EXPECT_EQ(sh.segmentCount, 2);
+        for (int c = 0; c < 3; ++c) {
+            const float T = std::exp(-float(c + 1) * chord);
+            EXPECT_NEAR(sh.transmittance[c], T, 1e-4f * T);
+        }
+    }
+    // In and out through the centres of two opposite faces.
+    Scene::ShadowCrossing crossings[8];
+    int count = -1;
+    ASSERT_EQ(scene->shadowCrossings(Vec3(-3, 0, 0), Vec3(1, 0, 0), 6.0f, crossings, 8, &count),
+              Scene::ShadowQuery::kOpen);
+    ASSERT_EQ(count, 2);
+    EXPECT_LT(dot(crossings[0].geoNormal, Vec3(1, 0, 0)), 0.0f);  // entering
+    EXPECT_GT(dot(crossings[1].geoNormal, Vec3(1, 0, 0)), 0.0f);
+    // Fewer entries than crossings: the caller walks instead.
+    EXPECT_EQ(scene->shadowCrossings(Vec3(-3, 0, 0), Vec3(1, 0, 0), 6.0f, crossings, 1, &count),
+              Scene::ShadowQuery::kUnavailable);
+}
+
 TEST(MediumValidation, OpenMeshBoundaryIsAnError) {
     const char* shapes =
         R"({"type": "rectangle", "name": "sheet", "material": "white", "interior_medium": "fog"})";

@@ -276,6 +276,10 @@ struct Scene::Impl {
     /// imaginary. Set by commit().
     int32_t allBoundariesRealUpTo = INT32_MAX;
     bool anyImaginaryBoundary = false;
+    /// Per shape: real for every medium stack (shadowCrossings). Set by commit().
+    std::vector<uint8_t> alwaysReal;
+    /// Every shape that is not always real is a triangle mesh (shadowCrossings).
+    bool crossingsByFilter = false;
 
     ~Impl() {
         if (scene) rtcReleaseScene(scene);
@@ -308,7 +312,8 @@ Scene::Scene() : impl_(std::make_unique<Impl>()) {
     rtcSetDeviceErrorFunction(impl_->device, embreeErrorCallback, nullptr);
     impl_->scene = rtcNewScene(impl_->device);
     impl_->check("creating the scene");
-    rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
+    // The context filter serves shadowCrossings; other queries leave it null.
+    rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
 }
 
@@ -628,6 +633,21 @@ void Scene::commit() {
             impl_->anyImaginaryBoundary = impl_->anyImaginaryBoundary || s.imaginary;
             impl_->allBoundariesRealUpTo = std::min(impl_->allBoundariesRealUpTo, s.mediumPriority);
         }
+    // A stack's priority is the global one or a boundary's, so a boundary that is not
+    // imaginary and of the highest priority is real for every stack; so is a shape that is
+    // not a boundary (scene/medium_stack.h).
+    int32_t highest = INT32_MIN;
+    for (const ShapeInfo& s : shapes)
+        if (s.isMediumBoundary) highest = std::max(highest, s.mediumPriority);
+    impl_->alwaysReal.assign(shapes.size(), 1);
+    impl_->crossingsByFilter = true;
+    for (size_t i = 0; i < shapes.size(); ++i) {
+        const ShapeInfo& s = shapes[i];
+        if (!s.isMediumBoundary || (!s.imaginary && s.mediumPriority >= highest)) continue;
+        impl_->alwaysReal[i] = 0;
+        const ShapeGeom& g = impl_->geoms[i];
+        if (g.isSphere || g.sdf) impl_->crossingsByFilter = false;
+    }
     cameraMediumStack = mediumStackAt(camera.position());
 }
 
@@ -842,6 +862,117 @@ bool Scene::anyHitWithin(const Vec3& org, const Vec3& dir, float tMax) const {
     // intersect() finds nothing on a ray Embree would reject; neither does this.
     if (!embreeRayValid(org, dir, 0.0f, tMax)) return false;
     return occludedRay(impl_->scene, org, dir, tMax);
+}
+
+namespace {
+
+/// What the filter of a shadowCrossings traversal records: Embree's context first, so the
+/// filter reaches the rest through the context pointer it is given.
+struct CrossingContext {
+    RTCIntersectContext embree;
+    const uint8_t* alwaysReal;
+    struct Entry {
+        float t;
+        uint32_t shapeId, primId;
+    } * entries;
+    int capacity;
+    int count;
+};
+
+/// Accepts a hit on a surface real for every stack (the any-hit query then ends, blocked);
+/// records any other hit and rejects it, so the traversal goes on.
+void crossingFilter(const RTCFilterFunctionNArguments* args) {
+    auto* c = reinterpret_cast<CrossingContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        const unsigned geomID = RTCHitN_geomID(args->hit, args->N, i);
+        if (c->alwaysReal[geomID]) continue;
+        if (c->count < c->capacity)
+            c->entries[c->count] = {RTCRayN_tfar(args->ray, args->N, i), geomID,
+                                    RTCHitN_primID(args->hit, args->N, i)};
+        ++c->count;  // past capacity: counted, so the caller sees the overflow
+        args->valid[i] = 0;
+    }
+}
+
+}  // namespace
+
+Scene::ShadowQuery Scene::shadowCrossings(const Vec3& org, const Vec3& dir, float tMax,
+                                          ShadowCrossing* crossings, int capacity,
+                                          int* count) const {
+    if (!impl_->committed) throw std::logic_error("Scene::shadowCrossings called before commit()");
+    *count = 0;
+    if (!impl_->crossingsByFilter || capacity <= 0) return ShadowQuery::kUnavailable;
+    // intersect() finds nothing on a ray Embree would reject; neither does this.
+    if (!embreeRayValid(org, dir, 0.0f, tMax)) return ShadowQuery::kOpen;
+    // Twice the capacity: a crossing can be reported twice (shared edges, split references).
+    constexpr int kMaxEntries = 64;
+    CrossingContext::Entry entries[kMaxEntries];
+    CrossingContext c;
+    rtcInitIntersectContext(&c.embree);
+    c.embree.filter = crossingFilter;
+    c.alwaysReal = impl_->alwaysReal.data();
+    c.entries = entries;
+    c.capacity = std::min(kMaxEntries, 2 * capacity);
+    c.count = 0;
+    RTCRay r;
+    r.org_x = org.x;
+    r.org_y = org.y;
+    r.org_z = org.z;
+    r.dir_x = dir.x;
+    r.dir_y = dir.y;
+    r.dir_z = dir.z;
+    r.tnear = 0.0f;
+    r.tfar = tMax;
+    r.time = 0.0f;
+    r.mask = ~0u;
+    r.id = 0;
+    r.flags = 0;
+    rtcOccluded1(impl_->scene, &c.embree, &r);
+    if (r.tfar < 0.0f) return ShadowQuery::kBlocked;  // Embree sets tfar = -inf on a hit
+    if (c.count > c.capacity) return ShadowQuery::kUnavailable;
+    // By increasing t (ties by shape and triangle, so the order never depends on Embree's):
+    // insertion sort, a handful of entries.
+    for (int i = 1; i < c.count; ++i) {
+        const CrossingContext::Entry e = entries[i];
+        int j = i;
+        for (; j > 0; --j) {
+            const CrossingContext::Entry& p = entries[j - 1];
+            const bool after =
+                p.t > e.t || (p.t == e.t && (p.shapeId > e.shapeId ||
+                                             (p.shapeId == e.shapeId && p.primId > e.primId)));
+            if (!after) break;
+            entries[j] = p;
+        }
+        entries[j] = e;
+    }
+    for (int i = 0; i < c.count; ++i) {
+        const CrossingContext::Entry& e = entries[i];
+        const ShapeGeom& g = impl_->geoms[e.shapeId];
+        const uint32_t* tri = g.indices + 3 * size_t(e.primId);
+        const Vec3 p0 = impl_->vertex(g, tri[0]), p1 = impl_->vertex(g, tri[1]),
+                   p2 = impl_->vertex(g, tri[2]);
+        // The geometric normal as intersect() computes it, so the crossing's side is the same.
+        const Vec3 ng = cross(p1 - p0, p2 - p0);
+        const float ngLen = length(ng);
+        const Vec3 n = ngLen > 0.0f ? ng / ngLen : -dir;
+        const bool entering = dot(dir, n) < 0.0f;
+        // The same crossing again: the previous crossing of this shape, on the same side and
+        // within the origin offset a walk moves past after a crossing (a closed boundary is
+        // left before it is entered again, so two real crossings alternate sides).
+        bool again = false;
+        for (int k = *count - 1; k >= 0; --k) {
+            const ShadowCrossing& q = crossings[k];
+            if (q.shapeId != e.shapeId) continue;
+            again = (dot(dir, q.geoNormal) < 0.0f) == entering &&
+                    e.t - q.t <= 4.0f * rayOffsetLength(org + dir * e.t);
+            break;
+        }
+        if (again) continue;
+        if (*count == capacity) return ShadowQuery::kUnavailable;
+        crossings[(*count)++] = {e.t, e.shapeId, n};
+    }
+    return ShadowQuery::kOpen;
 }
 
 Ray Scene::spawnRay(const Hit& hit, const Vec3& dir) const {

@@ -216,6 +216,26 @@ class Scene {
     /// True if the ray org + t dir meets any surface for t in [0, tMax] (Embree's any-hit
     /// query; false where intersect() would find nothing, e.g. on a NaN ray).
     bool anyHitWithin(const Vec3& org, const Vec3& dir, float tMax) const;
+    /// A surface a shadow ray passes without being blocked by it for certain: a medium
+    /// boundary that is imaginary, or of a priority some medium stack can exceed.
+    struct ShadowCrossing {
+        float t;           ///< ray parameter
+        uint32_t shapeId;  ///< a triangle mesh
+        Vec3 geoNormal;    ///< the triangle's unit geometric normal, as intersect() gives it
+    };
+    /// How shadowCrossings answered.
+    enum class ShadowQuery { kBlocked, kOpen, kUnavailable };
+    /// One Embree any-hit traversal of the open segment org + t dir, t in (0, tMax) (tMax
+    /// kInf: to infinity), for a shadow walk through media (walkShadow in scene_media.cpp).
+    /// kBlocked: the segment meets a surface that is real for every medium stack (not a
+    /// boundary, or a boundary that is not imaginary and of the highest priority). kOpen: it
+    /// does not; crossings[0 .. *count) are the other surfaces it meets, by increasing t, a
+    /// crossing reported twice (a ray through a shared edge or vertex, a triangle Embree
+    /// references from two leaves) once. kUnavailable: the caller walks hit by hit instead (a
+    /// sphere or SDF boundary could be such a surface, since their intersectors do not call
+    /// Embree's filter, or more than `capacity` crossings).
+    ShadowQuery shadowCrossings(const Vec3& org, const Vec3& dir, float tMax,
+                                ShadowCrossing* crossings, int capacity, int* count) const;
     /// Vertices of triangle `tri` of mesh shape shapeId (world space).
     void meshTriangle(uint32_t shapeId, uint32_t tri, Vec3 p[3]) const;
 
