@@ -26,17 +26,18 @@
 
 /* The walk of kernels/shared/ub_bvh.h, in the host twin's order (src/estimators/bvh.h): pop
  * a node; MASK (an expression of `n`, the node in global memory) gives the children that pass;
- * the statements between UB_BVH_WALK_BEGIN and UB_BVH_WALK_END run for the primitives of those
- * that are leaves, child 0 first, with `k` the index of the item (the items are in the BVH's
- * leaf order, Bvh::permuteToLeafOrder, so a leaf's entries are items, read without an index
- * array; `continue` skips a primitive); then the walk pushes those that are inner nodes,
+ * the statements between UB_BVH_LEAVES_BEGIN and UB_BVH_LEAVES_END run for those that are
+ * leaves, child 0 first, with the leaf's entries leafFirst .. leafEnd - 1 (the items are in the
+ * BVH's leaf order, Bvh::permuteToLeafOrder, so a leaf's entries are items, read without an
+ * index array), and those between UB_BVH_WALK_BEGIN and UB_BVH_WALK_END for each entry `k` of
+ * them (`continue` skips a primitive); then the walk pushes those that are inner nodes,
  * child 3 first. The children come from bit masks, leaves lowest bit first and pushes highest
  * bit first, rather than from a loop over the four with two branches each: 10% off the pb2d
  * walk on cornell-fog, host and kernel alike (docs/performance.md). A begin/end pair rather than
  * one macro taking the block: a block with commas needs a variadic macro, which OpenCL C 1.2 does
  * not have (NVIDIA's compiler rejects it: "variadic macros not supported in OpenCL", seen on an
  * H200, docs/opencl.md). */
-#define UB_BVH_WALK_BEGIN(nodes, MASK)                                                         \
+#define UB_BVH_LEAVES_BEGIN(nodes, MASK)                                                       \
     {                                                                                          \
         uint ubStack[UB_BVH_STACK];                                                            \
         int ubTop = 0;                                                                         \
@@ -53,10 +54,8 @@
             while (ubLeaf) {                                                                   \
                 uint ubC = 31u - clz(ubLeaf & (0u - ubLeaf));                                  \
                 ubLeaf &= ubLeaf - 1u;                                                         \
-                uint ubEnd = n->child[ubC] + n->count[ubC];                                    \
-                for (uint k = n->child[ubC]; k < ubEnd; ++k) {
-#define UB_BVH_WALK_END                   \
-    }                                     \
+                uint leafFirst = n->child[ubC], leafEnd = leafFirst + n->count[ubC];
+#define UB_BVH_LEAVES_END                 \
     }                                     \
     while (ubInner) {                     \
         uint ubC = 31u - clz(ubInner);    \
@@ -65,6 +64,13 @@
     }                                     \
     }                                     \
     }
+/* The walk item by item (`k`) within UB_BVH_LEAVES_BEGIN/END's leaves. */
+#define UB_BVH_WALK_BEGIN(nodes, MASK) \
+    UB_BVH_LEAVES_BEGIN(nodes, MASK)   \
+    for (uint k = leafFirst; k < leafEnd; ++k) {
+#define UB_BVH_WALK_END \
+    }                   \
+    UB_BVH_LEAVES_END
 
 /* pb2d: query beams x photon points (BVH over the photons' kernel spheres). */
 __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
@@ -142,6 +148,7 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
 
 /* bb1d: query beams x photon beams (BVH over the diced beam parts). */
 __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_beam_part* parts,
+                               __global const ub_beam_keys4* lines,
                                __global const ub_beam_piece* beamPieces,
                                __global const uint* beamRanges, __global const ub_bvh_node* nodes,
                                __global const ub_grid_info* grids, __global const uchar* gridData,
@@ -161,23 +168,31 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
     ub_beam_piece table[UB_QUERY_PIECES];
     ub_uint tableState = UB_TABLE_UNBUILT;
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    UB_BVH_WALK_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qb.length)) {
-        ub_beam_part part = parts[k];
-        float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
-        if (!ub_bb1d_pair(qb, part, radius * radius, minLength, maxLength, &tc, &tl, &sinTheta))
-            continue;
-        ub_beam pb = beams[part.beam];
-        ub_segment_eval sl =
-            ub_photon_beam_segment(m, gi, &acc, pb, tl, beamPieces + beamRanges[2u * part.beam],
-                                   beamRanges[2u * part.beam + 1u]);
-        ub_segment_eval sc =
-            ub_query_beam_segment(m, gi, &acc, qb, tc, table, UB_QUERY_PIECES, &tableState);
-        ub_float3 c =
-            ub_bb1d_contribution(mis, pb, qb, sl, sc, tl, tc, sinTheta, m.g, normalization);
-        sx += c.x;
-        sy += c.y;
-        sz += c.z;
+    /* A leaf's candidates four at a time by their lines first, as the host twin does
+     * (src/estimators/bb1d_estimator.cpp). */
+    UB_BVH_LEAVES_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qb.length))
+    for (uint b = leafFirst / 4u; b * 4u < leafEnd; ++b) {
+        uint near = ub_beam_lines_near4_global(lines + b, o, d, radius * radius) &
+                    ub_block_lanes(b, leafFirst, leafEnd);
+        for (; near != 0u; near &= near - 1u) {
+            uint k = b * 4u + (31u - clz(near & (0u - near)));
+            ub_beam_part part = parts[k];
+            float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
+            if (!ub_bb1d_pair(qb, part, radius * radius, minLength, maxLength, &tc, &tl, &sinTheta))
+                continue;
+            ub_beam pb = beams[part.beam];
+            ub_segment_eval sl =
+                ub_photon_beam_segment(m, gi, &acc, pb, tl, beamPieces + beamRanges[2u * part.beam],
+                                       beamRanges[2u * part.beam + 1u]);
+            ub_segment_eval sc =
+                ub_query_beam_segment(m, gi, &acc, qb, tc, table, UB_QUERY_PIECES, &tableState);
+            ub_float3 c =
+                ub_bb1d_contribution(mis, pb, qb, sl, sc, tl, tc, sinTheta, m.g, normalization);
+            sx += c.x;
+            sy += c.y;
+            sz += c.z;
+        }
     }
-    UB_BVH_WALK_END
+    UB_BVH_LEAVES_END
     ub_store_f3(out, i, sx, sy, sz);
 }

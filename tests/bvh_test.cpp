@@ -19,6 +19,8 @@
 #include <string>
 
 #include "core/rng.h"
+#include "core/sampling.h"
+#include "kernels/shared/ub_beam_geometry.h"
 
 using namespace ub;
 
@@ -235,4 +237,50 @@ TEST(Bvh, ParallelBuildEqualsTheBuildOnOneThread) {
     EXPECT_EQ(
         0, std::memcmp(one.nodes().data(), many.nodes().data(), one.nodeCount() * sizeof(BvhNode)));
     EXPECT_EQ(orderOne, orderMany);
+}
+
+// bb1d's first test of a leaf (kernels/shared/ub_bvh.h): the host's SSE form equals the shared
+// one bit for bit, a line it rejects ub_beam_beam_near rejects too (the filter never drops a
+// pair), and ub_block_lanes masks exactly the block's lanes inside a leaf's range. Lines at
+// every angle (parallel ones included) and separations around the radius.
+TEST(Bvh, BeamLineFilterEqualsTheSharedOneAndDropsNoPair) {
+    Rng rng(31, 4);
+    int near = 0, pairs = 0;
+    for (int k = 0; k < 50000; ++k) {
+        const Vec3 o = randomIn(rng, -2.0f, 2.0f);
+        const Vec3 d = sampleUniformSphere(rng.uniform2());
+        ub_beam_keys4 keys{};
+        ub_float3 oB[4], dB[4];
+        for (int j = 0; j < 4; ++j) {
+            Vec3 dj = sampleUniformSphere(rng.uniform2());
+            if (k % 17 == j) dj = d;  // parallel
+            const Vec3 oj = o + d * (4.0f * rng.uniform()) + randomIn(rng, -0.3f, 0.3f);
+            keys.ox[j] = oj.x, keys.oy[j] = oj.y, keys.oz[j] = oj.z;
+            keys.dx[j] = dj.x, keys.dy[j] = dj.y, keys.dz[j] = dj.z;
+            oB[j] = ub_make_float3(oj.x, oj.y, oj.z);
+            dB[j] = ub_make_float3(dj.x, dj.y, dj.z);
+        }
+        const ub_float3 oo = ub_make_float3(o.x, o.y, o.z), dd = ub_make_float3(d.x, d.y, d.z);
+        const float r2 = 0.01f;
+        const uint32_t mask = ub_beam_lines_near4(&keys, oo, dd, r2);
+        ASSERT_EQ(beamLinesNear4(keys, oo, dd, r2), mask) << "case " << k;
+        for (int j = 0; j < 4; ++j) {
+            float tA = 0, tB = 0, sinTheta = 0;
+            const bool pair =
+                ub_beam_beam_near(oo, dd, 4.0f, oB[j], dB[j], 4.0f, r2, &tA, &tB, &sinTheta);
+            pairs += pair;
+            near += (mask >> j) & 1u;
+            if (pair) ASSERT_TRUE((mask >> j) & 1u) << "case " << k << " lane " << j;
+        }
+    }
+    EXPECT_GT(pairs, 10000);
+    EXPECT_GT(near, pairs);
+    for (uint32_t first = 0; first < 12; ++first)
+        for (uint32_t end = first + 1; end < 20; ++end)
+            for (uint32_t b = first / 4; b * 4 < end; ++b)
+                for (uint32_t j = 0; j < 4; ++j) {
+                    const uint32_t i = 4 * b + j;
+                    EXPECT_EQ((ub_block_lanes(b, first, end) >> j) & 1u,
+                              uint32_t(i >= first && i < end));
+                }
 }

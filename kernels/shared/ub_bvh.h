@@ -37,6 +37,40 @@ typedef struct {
     ub_uint pathLength;
 } ub_beam_part;
 
+/* What a bb1d walk tests first of four consecutive beam parts (in leaf order: parts 4 j ..
+ * 4 j + 3 are block j, the last block padded with zeros): their lines, as a structure of
+ * arrays, so one load tests four candidates (ub_beam_lines_near4). 96 bytes. */
+typedef struct {
+    float ox[4], oy[4], oz[4];
+    float dx[4], dy[4], dz[4];
+} ub_beam_keys4;
+
+/* Bit j set when line j of the block passes within sqrt(radiusSqr) of the line o + t d, by
+ * the first two tests of ub_beam_beam_near (not parallel; separation along d x d_j) with the
+ * same operations: a candidate it rejects, ub_beam_beam_near rejects. A filter ahead of the
+ * pair test, which still decides; the lanes are the caller's to mask. */
+UB_INLINE ub_uint ub_beam_lines_near4(UB_PRIVATE const ub_beam_keys4* k, ub_float3 o, ub_float3 d,
+                                      float radiusSqr) {
+    ub_uint mask = 0u;
+    for (int j = 0; j < 4; ++j) {
+        ub_float3 oB = ub_make_float3(k->ox[j], k->oy[j], k->oz[j]);
+        ub_float3 dB = ub_make_float3(k->dx[j], k->dy[j], k->dz[j]);
+        float b = ub_f3_dot(d, dB);
+        float sin2 = 1.0f - b * b;
+        float sep = ub_f3_dot(ub_f3_sub(o, oB), ub_f3_cross(d, dB));
+        mask |= (sin2 > 1e-7f && !(sep * sep > radiusSqr * sin2)) ? (1u << j) : 0u;
+    }
+    return mask;
+}
+
+/* The lanes of block `block` that hold parts first .. end - 1. */
+UB_INLINE ub_uint ub_block_lanes(ub_uint block, ub_uint first, ub_uint end) {
+    ub_uint base = block * 4u;
+    ub_uint lo = first > base ? first - base : 0u;
+    ub_uint hi = end - base < 4u ? end - base : 4u;
+    return ((1u << hi) - 1u) & ~((1u << lo) - 1u);
+}
+
 /* Bit c set when child c exists and its box contains p. */
 UB_INLINE ub_uint ub_bvh_contains(UB_PRIVATE const ub_bvh_node* n, ub_float3 p) {
     ub_uint mask = 0u;
@@ -102,6 +136,20 @@ UB_INLINE ub_uint ub_bvh_meets_global(__global const ub_bvh_node* n, ub_float3 o
     return (ub_uint)((hit.x & 1) | (hit.y & 2) | (hit.z & 4) | (hit.w & 8));
 }
 
+/* The kernels' ub_beam_lines_near4: the four lines as float4 lanes, the same operations. */
+UB_INLINE ub_uint ub_beam_lines_near4_global(__global const ub_beam_keys4* k, ub_float3 o,
+                                             ub_float3 d, float radiusSqr) {
+    float4 oBx = vload4(0, k->ox), oBy = vload4(0, k->oy), oBz = vload4(0, k->oz);
+    float4 dBx = vload4(0, k->dx), dBy = vload4(0, k->dy), dBz = vload4(0, k->dz);
+    float4 b = d.x * dBx + d.y * dBy + d.z * dBz;
+    float4 sin2 = 1.0f - b * b;
+    float4 wx = o.x - oBx, wy = o.y - oBy, wz = o.z - oBz;
+    float4 cx = d.y * dBz - d.z * dBy, cy = d.z * dBx - d.x * dBz, cz = d.x * dBy - d.y * dBx;
+    float4 sep = wx * cx + wy * cy + wz * cz;
+    int4 near = (sin2 > 1e-7f) & !(sep * sep > radiusSqr * sin2);
+    return (ub_uint)((near.x & 1) | (near.y & 2) | (near.z & 4) | (near.w & 8));
+}
+
 /* The kernels' ub_bvh_contains, the same way. */
 UB_INLINE ub_uint ub_bvh_contains_global(__global const ub_bvh_node* n, ub_float3 p) {
     int4 in = (vload4(0, n->loX) <= p.x) & (vload4(0, n->hiX) >= p.x) & (vload4(0, n->loY) <= p.y) &
@@ -121,6 +169,8 @@ UB_INLINE int ub_beam_part_holds(ub_beam_part p, float t, float beamLength) {
 static_assert(sizeof(ub_bvh_node) == 128, "ub_bvh_node layout");
 static_assert(offsetof(ub_bvh_node, child) == 96, "ub_bvh_node layout");
 static_assert(sizeof(ub_beam_part) == 48, "ub_beam_part layout");
+static_assert(sizeof(ub_beam_keys4) == 96, "ub_beam_keys4 layout");
+static_assert(offsetof(ub_beam_keys4, dx) == 48, "ub_beam_keys4 layout");
 static_assert(offsetof(ub_beam_part, dir) == 16, "ub_beam_part layout");
 static_assert(offsetof(ub_beam_part, beam) == 32, "ub_beam_part layout");
 static_assert(offsetof(ub_beam_part, pathLength) == 44, "ub_beam_part layout");

@@ -672,6 +672,7 @@ void ClRuntime::estimateBP2D(const std::vector<ub_beam>& beams,
 
 void ClRuntime::estimateBB1D(const std::vector<ub_beam>& beams,
                              const std::vector<ub_beam_part>& parts,
+                             const std::vector<ub_beam_keys4>& lines,
                              const std::vector<ub_beam_piece>& pieces,
                              const std::vector<uint32_t>& ranges, const Bvh& bvh,
                              const std::vector<ub_beam>& queries, const EstimateArgs& a,
@@ -679,8 +680,8 @@ void ClRuntime::estimateBB1D(const std::vector<ub_beam>& beams,
     if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
     requireLeafOrder(bvh, "bb1d");
     runEstimate(bb1d_, "clEnqueueNDRangeKernel(ub_bb1d_estimate)",
-                withGrids({bufferArg(beams), bufferArg(parts), bufferArg(pieces), bufferArg(ranges),
-                           bufferArg(bvh.nodes())},
+                withGrids({bufferArg(beams), bufferArg(parts), bufferArg(lines), bufferArg(pieces),
+                           bufferArg(ranges), bufferArg(bvh.nodes())},
                           gridArgs(a)),
                 bufferArg(queries), queries.size(), a, out);
 }

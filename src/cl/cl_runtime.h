@@ -109,6 +109,7 @@ class ClRuntime {
                       const Bvh& bvh, const std::vector<ub_query_point>& queries,
                       const EstimateArgs& a, std::vector<Rgb>* out);
     void estimateBB1D(const std::vector<ub_beam>& beams, const std::vector<ub_beam_part>& parts,
+                      const std::vector<ub_beam_keys4>& lines,
                       const std::vector<ub_beam_piece>& pieces, const std::vector<uint32_t>& ranges,
                       const Bvh& bvh, const std::vector<ub_beam>& queries, const EstimateArgs& a,
                       std::vector<Rgb>* out);

@@ -107,6 +107,10 @@ class Bvh {
     /// visit(i) for every primitive whose box meets the segment o + t d, t in [0, len].
     template <class Visit>
     void querySegment(const Vec3& o, const Vec3& d, float len, Visit&& visit) const;
+    /// The same walk, leaf by leaf: visitRange(first, end) for the leaf-order positions
+    /// first .. end - 1 of each leaf met, in querySegment's order. Needs leafOrdered().
+    template <class VisitRange>
+    void querySegmentLeaves(const Vec3& o, const Vec3& d, float len, VisitRange&& visitRange) const;
 
   private:
     /// The walk of kernels/shared/ub_bvh.h: visit(i) for the primitives of every leaf whose
@@ -116,6 +120,9 @@ class Bvh {
     /// The walk itself: visit(i) with i the leaf-order position.
     template <class ChildMask, class Visit>
     void walk(ChildMask&& childMask, Visit&& visit) const;
+    /// The walk, leaf by leaf: visitRange(first, end) over leaf-order positions.
+    template <class ChildMask, class VisitRange>
+    void walkLeaves(ChildMask&& childMask, VisitRange&& visitRange) const;
     /// A node of the binary tree built first.
     struct Node2 {
         Bounds3 box;
@@ -144,6 +151,13 @@ void Bvh::traverse(ChildMask&& childMask, Visit&& visit) const {
 
 template <class ChildMask, class Visit>
 void Bvh::walk(ChildMask&& childMask, Visit&& visit) const {
+    walkLeaves(childMask, [&](uint32_t first, uint32_t end) {
+        for (uint32_t i = first; i < end; ++i) visit(i);
+    });
+}
+
+template <class ChildMask, class VisitRange>
+void Bvh::walkLeaves(ChildMask&& childMask, VisitRange&& visitRange) const {
     if (nodes_.empty()) return;
     uint32_t stack[kStackSize];  // stackNeed() <= kStackSize entries (checked by build)
     int top = 0;
@@ -157,8 +171,7 @@ void Bvh::walk(ChildMask&& childMask, Visit&& visit) const {
         const uint32_t inner = mask & bvhInnerChildren(n);
         for (uint32_t leaves = mask & ~inner; leaves != 0; leaves &= leaves - 1) {
             const int c = __builtin_ctz(leaves);
-            const uint32_t end = n.child[c] + n.count[c];
-            for (uint32_t i = n.child[c]; i < end; ++i) visit(i);
+            visitRange(n.child[c], n.child[c] + n.count[c]);
         }
         for (uint32_t rest = inner; rest != 0;) {
             const int c = 31 - __builtin_clz(rest);
@@ -190,6 +203,42 @@ void Bvh::querySegment(const Vec3& o, const Vec3& d, float len, Visit&& visit) c
     const ub_float3 oo = ub_make_float3(o.x, o.y, o.z);
     const ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
     traverse([&](const BvhNode& n) { return bvhMeets4(n, oo, invD, len); }, visit);
+}
+
+template <class VisitRange>
+void Bvh::querySegmentLeaves(const Vec3& o, const Vec3& d, float len,
+                             VisitRange&& visitRange) const {
+    const ub_float3 oo = ub_make_float3(o.x, o.y, o.z);
+    const ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+    walkLeaves([&](const BvhNode& n) { return bvhMeets4(n, oo, invD, len); }, visitRange);
+}
+
+/// ub_beam_lines_near4 (kernels/shared/ub_bvh.h) in SSE: the same operations in the same order
+/// per lane, so the same mask.
+inline uint32_t beamLinesNear4(const ub_beam_keys4& k, const ub_float3& o, const ub_float3& d,
+                               float radiusSqr) {
+#if defined(__SSE2__)
+    const __m128 oBx = _mm_loadu_ps(k.ox), oBy = _mm_loadu_ps(k.oy), oBz = _mm_loadu_ps(k.oz);
+    const __m128 dBx = _mm_loadu_ps(k.dx), dBy = _mm_loadu_ps(k.dy), dBz = _mm_loadu_ps(k.dz);
+    const __m128 dx = _mm_set1_ps(d.x), dy = _mm_set1_ps(d.y), dz = _mm_set1_ps(d.z);
+    const __m128 b =
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dBx), _mm_mul_ps(dy, dBy)), _mm_mul_ps(dz, dBz));
+    const __m128 sin2 = _mm_sub_ps(_mm_set1_ps(1.0f), _mm_mul_ps(b, b));
+    const __m128 wx = _mm_sub_ps(_mm_set1_ps(o.x), oBx), wy = _mm_sub_ps(_mm_set1_ps(o.y), oBy),
+                 wz = _mm_sub_ps(_mm_set1_ps(o.z), oBz);
+    const __m128 cx = _mm_sub_ps(_mm_mul_ps(dy, dBz), _mm_mul_ps(dz, dBy));
+    const __m128 cy = _mm_sub_ps(_mm_mul_ps(dz, dBx), _mm_mul_ps(dx, dBz));
+    const __m128 cz = _mm_sub_ps(_mm_mul_ps(dx, dBy), _mm_mul_ps(dy, dBx));
+    const __m128 sep =
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(wx, cx), _mm_mul_ps(wy, cy)), _mm_mul_ps(wz, cz));
+    // sin2 > 1e-7 and not sep^2 > r^2 sin2 (a NaN separation passes, as in the shared test).
+    const __m128 near =
+        _mm_and_ps(_mm_cmpgt_ps(sin2, _mm_set1_ps(1e-7f)),
+                   _mm_cmpngt_ps(_mm_mul_ps(sep, sep), _mm_mul_ps(_mm_set1_ps(radiusSqr), sin2)));
+    return uint32_t(_mm_movemask_ps(near));
+#else
+    return ub_beam_lines_near4(&k, o, d, radiusSqr);
+#endif
 }
 
 }  // namespace ub

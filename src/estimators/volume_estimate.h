@@ -125,8 +125,9 @@ void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres,
 void estimateBP2D(const VolumeEstimateInput& in, const Bvh& beamParts,
                   const std::vector<BeamPart>& parts, const std::vector<BeamMedium>& photonMedia,
                   std::vector<Rgb>* out, size_t* pairs);
+/// lines: the parts' lines four to a block, in leaf order (kernels/shared/ub_bvh.h).
 void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
-                  const std::vector<BeamPart>& parts, const std::vector<BeamMedium>& photonMedia,
-                  std::vector<Rgb>* out, size_t* pairs);
+                  const std::vector<BeamPart>& parts, const std::vector<ub_beam_keys4>& lines,
+                  const std::vector<BeamMedium>& photonMedia, std::vector<Rgb>* out, size_t* pairs);
 
 }  // namespace ub
