@@ -9,6 +9,11 @@
  * built by its work-item at its first pair in UB_QUERY_PIECES private pieces (a longer beam
  * walks per pair). Grid media with an albedo grid or trilinear filtering run these
  * estimators on the host. out: 3 floats per query. */
+/* No contraction of a * b + c into fma: the host twins compute without it (x86-64 baseline), and
+ * the candidate tests (ub_pb2d_near4_global, ub_beam_lines_near4_global) then give the host's
+ * answers at the radius, where one contracted rounding moved a pair in or out (mirrorballs pb2d:
+ * image means 8e-5 apart, docs/performance.md). */
+#pragma OPENCL FP_CONTRACT OFF
 #include "ub_bb1d.h"
 #include "ub_bp2d.h"
 #include "ub_bvh.h"
@@ -74,7 +79,7 @@
 
 /* pb2d: query beams x photon points (BVH over the photons' kernel spheres). */
 __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
-                               __global const ub_photon_key* keys,
+                               __global const ub_photon_keys4* keys,
                                __global const ub_bvh_node* nodes,
                                __global const ub_grid_info* grids, __global const uchar* gridData,
                                __global const ub_beam* queries, uint queryCount,
@@ -95,19 +100,26 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     ub_beam_piece table[UB_QUERY_PIECES];
     ub_uint tableState = UB_TABLE_UNBUILT;
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    UB_BVH_WALK_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qLength)) {
-        float t = 0.0f;
-        if (!ub_pb2d_near(keys[k], o, d, qLength, qMedium, r2, &t)) continue;
-        ub_photon_point ph = photons[k];
-        if (!ub_pb2d_length_ok(ph.pathLength, qb, minLength, maxLength)) continue;
-        ub_segment_eval s =
-            ub_query_beam_segment(m, gi, &acc, qb, t, table, UB_QUERY_PIECES, &tableState);
-        ub_float3 c = ub_pb2d_contribution(mis, ph, qb, s, t, m.g, normalization);
-        sx += c.x;
-        sy += c.y;
-        sz += c.z;
+    /* A leaf's photons four at a time by their keys, as the host twin does
+     * (src/estimators/pb2d_estimator.cpp). */
+    UB_BVH_LEAVES_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qLength))
+    for (uint b = leafFirst / 4u; b * 4u < leafEnd; ++b) {
+        float t[4];
+        uint near = ub_pb2d_near4_global(keys + b, o, d, qLength, qMedium, r2, t) &
+                    ub_block_lanes(b, leafFirst, leafEnd);
+        for (; near != 0u; near &= near - 1u) {
+            uint lane = 31u - clz(near & (0u - near));
+            ub_photon_point ph = photons[b * 4u + lane];
+            if (!ub_pb2d_length_ok(ph.pathLength, qb, minLength, maxLength)) continue;
+            ub_segment_eval s = ub_query_beam_segment(m, gi, &acc, qb, t[lane], table,
+                                                      UB_QUERY_PIECES, &tableState);
+            ub_float3 c = ub_pb2d_contribution(mis, ph, qb, s, t[lane], m.g, normalization);
+            sx += c.x;
+            sy += c.y;
+            sz += c.z;
+        }
     }
-    UB_BVH_WALK_END
+    UB_BVH_LEAVES_END
     ub_store_f3(out, i, sx, sy, sz);
 }
 

@@ -70,9 +70,12 @@ __kernel void ub_layout_probe(__global uint* out) {
     ub_bvh_node node;
     out[14] = (uint)sizeof(ub_bvh_node);
     out[15] = (uint)((__private char*)&node.child - (__private char*)&node);
-    ub_photon_key key;
-    out[16] = (uint)sizeof(ub_photon_key);
-    out[17] = (uint)((__private char*)&key.mediumId - (__private char*)&key);
+    ub_photon_keys4 keys;
+    out[16] = (uint)sizeof(ub_photon_keys4);
+    out[17] = (uint)((__private char*)&keys.mediumId - (__private char*)&keys);
+    ub_beam_keys4 lines;
+    out[18] = (uint)sizeof(ub_beam_keys4);
+    out[19] = (uint)((__private char*)&lines.dx - (__private char*)&lines);
 }
 
 #ifdef UB_FORCE_BUILD_ERROR

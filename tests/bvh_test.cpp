@@ -20,7 +20,9 @@
 
 #include "core/rng.h"
 #include "core/sampling.h"
+#include "estimators/volume_estimate.h"
 #include "kernels/shared/ub_beam_geometry.h"
+#include "kernels/shared/ub_pb2d.h"
 
 using namespace ub;
 
@@ -283,4 +285,40 @@ TEST(Bvh, BeamLineFilterEqualsTheSharedOneAndDropsNoPair) {
                     EXPECT_EQ((ub_block_lanes(b, first, end) >> j) & 1u,
                               uint32_t(i >= first && i < end));
                 }
+}
+
+// pb2d's test of a leaf's photons four at a time: the host's SSE form (pb2dNear4ForTests) gives
+// the shared ub_pb2d_near4's mask and beam parameters bit for bit, which are ub_pb2d_near's per
+// photon; photons around the radius and the beam's ends, in two media, with padded lanes.
+TEST(Bvh, PhotonKeyTestEqualsTheSharedOne) {
+    Rng rng(37, 2);
+    int near = 0;
+    for (int k = 0; k < 50000; ++k) {
+        const Vec3 o = randomIn(rng, -2.0f, 2.0f);
+        const Vec3 d = sampleUniformSphere(rng.uniform2());
+        const float len = 3.0f * rng.uniform();
+        ub_photon_keys4 keys{};
+        for (int j = 0; j < 4; ++j) {
+            const Vec3 p = o + d * (-0.5f + 4.0f * rng.uniform()) + randomIn(rng, -0.15f, 0.15f);
+            keys.px[j] = p.x, keys.py[j] = p.y, keys.pz[j] = p.z;
+            keys.mediumId[j] = k % 5 == j ? UB_NO_MEDIUM : rng.nextU32() % 2;
+        }
+        const ub_float3 oo = ub_make_float3(o.x, o.y, o.z), dd = ub_make_float3(d.x, d.y, d.z);
+        float tShared[4], tSse[4];
+        const uint32_t mask = ub_pb2d_near4(&keys, oo, dd, len, 1u, 0.01f, tShared);
+        ASSERT_EQ(pb2dNear4ForTests(keys, oo, dd, len, 1u, 0.01f, tSse), mask) << "case " << k;
+        for (int j = 0; j < 4; ++j) {
+            ub_photon_key key;
+            key.pos[0] = keys.px[j], key.pos[1] = keys.py[j], key.pos[2] = keys.pz[j];
+            key.mediumId = keys.mediumId[j];
+            float t = 0.0f;
+            ASSERT_EQ(ub_pb2d_near(key, oo, dd, len, 1u, 0.01f, &t), int((mask >> j) & 1u));
+            if ((mask >> j) & 1u) {
+                ASSERT_EQ(tSse[j], t);
+                ASSERT_EQ(tShared[j], t);
+                ++near;
+            }
+        }
+    }
+    EXPECT_GT(near, 10000);
 }

@@ -36,6 +36,41 @@ UB_INLINE int ub_pb2d_near(ub_photon_key k, ub_float3 origin, ub_float3 dir, flo
     float d2 = ub_point_beam_dist2(ub_f3_from(k.pos), origin, dir, length, t);
     return d2 >= 0.0f && d2 <= radiusSqr;
 }
+/* ub_pb2d_near for the four photons of a block: bit j set for a pair candidate, t[j] its beam
+ * parameter. The walks test a leaf block by block (the host in SSE, estimators/pb2d_estimator.cpp;
+ * the kernel in float4, ub_pb2d_near4_global), with these operations per lane. */
+UB_INLINE ub_uint ub_pb2d_near4(UB_PRIVATE const ub_photon_keys4* k, ub_float3 origin,
+                                ub_float3 dir, float length, ub_uint mediumId, float radiusSqr,
+                                UB_PRIVATE float* t) {
+    ub_uint mask = 0u;
+    for (int j = 0; j < 4; ++j) {
+        ub_photon_key key;
+        key.pos[0] = k->px[j];
+        key.pos[1] = k->py[j];
+        key.pos[2] = k->pz[j];
+        key.mediumId = k->mediumId[j];
+        t[j] = 0.0f;
+        mask |= ub_pb2d_near(key, origin, dir, length, mediumId, radiusSqr, &t[j]) ? (1u << j) : 0u;
+    }
+    return mask;
+}
+
+#ifdef __OPENCL_C_VERSION__
+/* The kernel's ub_pb2d_near4: the four photons as float4 lanes, read in place. */
+UB_INLINE ub_uint ub_pb2d_near4_global(__global const ub_photon_keys4* k, ub_float3 o, ub_float3 d,
+                                       float length, ub_uint mediumId, float radiusSqr,
+                                       UB_PRIVATE float* t) {
+    float4 opx = vload4(0, k->px) - o.x, opy = vload4(0, k->py) - o.y, opz = vload4(0, k->pz) - o.z;
+    float4 tp = opx * d.x + opy * d.y + opz * d.z;
+    float4 qx = opx - d.x * tp, qy = opy - d.y * tp, qz = opz - d.z * tp;
+    float4 d2 = qx * qx + qy * qy + qz * qz;
+    int4 near = (tp >= 0.0f) & (tp <= length) & (d2 <= radiusSqr) &
+                (vload4(0, k->mediumId) == (uint4)(mediumId));
+    vstore4(tp, 0, t);
+    return (ub_uint)((near.x & 1) | (near.y & 2) | (near.z & 4) | (near.w & 8));
+}
+#endif
+
 UB_INLINE int ub_pb2d_length_ok(ub_uint photonLength, ub_beam qb, ub_uint minLength,
                                 ub_uint maxLength) {
     ub_uint length = photonLength + qb.pathLength;

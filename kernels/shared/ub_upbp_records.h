@@ -40,6 +40,15 @@ typedef struct {
     ub_uint mediumId;
 } ub_photon_key;
 
+/* The keys of four consecutive photons in the BVH's leaf order (photons 4 j .. 4 j + 3 are
+ * block j; the last block's missing lanes hold medium UB_NO_MEDIUM, which no query is in), as a
+ * structure of arrays, so one load tests four candidates (ub_pb2d_near4). 64 bytes. */
+#define UB_NO_MEDIUM 0xFFFFFFFFu
+typedef struct {
+    float px[4], py[4], pz[4];
+    ub_uint mediumId[4];
+} ub_photon_keys4;
+
 UB_INLINE ub_photon_key ub_photon_key_of(ub_photon_point ph) {
     ub_photon_key k;
     k.pos[0] = ph.pos[0];
@@ -177,6 +186,8 @@ static_assert(offsetof(ub_photon_point, sigmaS) == 32, "ub_photon_point layout")
 static_assert(offsetof(ub_photon_point, dirFix) == 48, "ub_photon_point layout");
 static_assert(offsetof(ub_photon_point, dVCM) == 64, "ub_photon_point layout");
 static_assert(sizeof(ub_photon_key) == 16, "ub_photon_key layout");
+static_assert(sizeof(ub_photon_keys4) == 64, "ub_photon_keys4 layout");
+static_assert(offsetof(ub_photon_keys4, mediumId) == 48, "ub_photon_keys4 layout");
 static_assert(offsetof(ub_photon_key, mediumId) == 12, "ub_photon_key layout");
 static_assert(sizeof(ub_query_point) == 64, "ub_query_point layout");
 static_assert(offsetof(ub_query_point, throughput) == 16, "ub_query_point layout");

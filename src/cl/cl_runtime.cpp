@@ -340,7 +340,7 @@ ClRuntime::ClRuntime(int platform, int device, const std::string& cacheDir,
 }
 
 namespace {
-constexpr int kProbeEntries = 18;  // what kernels/pp3d.cl's ub_layout_probe writes
+constexpr int kProbeEntries = 20;  // what kernels/pp3d.cl's ub_layout_probe writes
 }  // namespace
 
 void ClRuntime::checkLayout() {
@@ -378,8 +378,10 @@ void ClRuntime::checkLayout() {
                                          cl_uint(offsetof(ub_beam_part, pathLength)),
                                          cl_uint(sizeof(ub_bvh_node)),
                                          cl_uint(offsetof(ub_bvh_node, child)),
-                                         cl_uint(sizeof(ub_photon_key)),
-                                         cl_uint(offsetof(ub_photon_key, mediumId))};
+                                         cl_uint(sizeof(ub_photon_keys4)),
+                                         cl_uint(offsetof(ub_photon_keys4, mediumId)),
+                                         cl_uint(sizeof(ub_beam_keys4)),
+                                         cl_uint(offsetof(ub_beam_keys4, dx))};
     const char* what[kProbeEntries] = {"sizeof(ub_photon_point)",
                                        "sizeof(ub_query_point)",
                                        "sizeof(ub_beam)",
@@ -396,8 +398,10 @@ void ClRuntime::checkLayout() {
                                        "offsetof(ub_beam_part, pathLength)",
                                        "sizeof(ub_bvh_node)",
                                        "offsetof(ub_bvh_node, child)",
-                                       "sizeof(ub_photon_key)",
-                                       "offsetof(ub_photon_key, mediumId)"};
+                                       "sizeof(ub_photon_keys4)",
+                                       "offsetof(ub_photon_keys4, mediumId)",
+                                       "sizeof(ub_beam_keys4)",
+                                       "offsetof(ub_beam_keys4, dx)"};
     for (int i = 0; i < kProbeEntries; ++i)
         if (device[i] != host[i])
             throw ClError("OpenCL: device '" + desc_.device +
@@ -644,7 +648,7 @@ void ClRuntime::estimatePP3D(const std::vector<ub_photon_point>& photons, const 
 }
 
 void ClRuntime::estimatePB2D(const std::vector<ub_photon_point>& photons,
-                             const std::vector<ub_photon_key>& keys, const Bvh& spheres,
+                             const std::vector<ub_photon_keys4>& keys, const Bvh& spheres,
                              const std::vector<ub_beam>& queries, const EstimateArgs& a,
                              std::vector<Rgb>* out) {
     if (photons.empty() || spheres.empty()) return out->assign(queries.size(), Rgb(0.0f));

@@ -16,9 +16,47 @@
 
 namespace ub {
 
+namespace {
+
+/// ub_pb2d_near4 (kernels/shared/ub_pb2d.h) in SSE: the same operations in the same order per
+/// lane, so the same mask and parameters (tests/bvh_test.cpp).
+uint32_t pb2dNear4(const ub_photon_keys4& k, const ub_float3& o, const ub_float3& d, float length,
+                   uint32_t mediumId, float radiusSqr, float* t) {
+#if defined(__SSE2__)
+    const __m128 dx = _mm_set1_ps(d.x), dy = _mm_set1_ps(d.y), dz = _mm_set1_ps(d.z);
+    const __m128 opx = _mm_sub_ps(_mm_loadu_ps(k.px), _mm_set1_ps(o.x));
+    const __m128 opy = _mm_sub_ps(_mm_loadu_ps(k.py), _mm_set1_ps(o.y));
+    const __m128 opz = _mm_sub_ps(_mm_loadu_ps(k.pz), _mm_set1_ps(o.z));
+    const __m128 tp =
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(opx, dx), _mm_mul_ps(opy, dy)), _mm_mul_ps(opz, dz));
+    const __m128 qx = _mm_sub_ps(opx, _mm_mul_ps(dx, tp));
+    const __m128 qy = _mm_sub_ps(opy, _mm_mul_ps(dy, tp));
+    const __m128 qz = _mm_sub_ps(opz, _mm_mul_ps(dz, tp));
+    const __m128 d2 =
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(qx, qx), _mm_mul_ps(qy, qy)), _mm_mul_ps(qz, qz));
+    const __m128 inRange =
+        _mm_and_ps(_mm_cmpge_ps(tp, _mm_setzero_ps()), _mm_cmple_ps(tp, _mm_set1_ps(length)));
+    const __m128 near = _mm_and_ps(inRange, _mm_cmple_ps(d2, _mm_set1_ps(radiusSqr)));
+    const __m128i sameMedium =
+        _mm_cmpeq_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(k.mediumId)),
+                        _mm_set1_epi32(int(mediumId)));
+    _mm_storeu_ps(t, tp);
+    return uint32_t(_mm_movemask_ps(_mm_and_ps(near, _mm_castsi128_ps(sameMedium))));
+#else
+    return ub_pb2d_near4(&k, o, d, length, mediumId, radiusSqr, t);
+#endif
+}
+
+}  // namespace
+
+uint32_t pb2dNear4ForTests(const ub_photon_keys4& k, const ub_float3& o, const ub_float3& d,
+                           float length, uint32_t mediumId, float radiusSqr, float* t) {
+    return pb2dNear4(k, o, d, length, mediumId, radiusSqr, t);
+}
+
 void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres,
                   const std::vector<ub_photon_point>& photons,
-                  const std::vector<ub_photon_key>& keys, std::vector<Rgb>* out, size_t* pairs) {
+                  const std::vector<ub_photon_keys4>& keys, std::vector<Rgb>* out, size_t* pairs) {
     const std::vector<ub_beam>& queries = *in.queryBeams;
     if (photons.empty() || queries.empty()) return;
     const float r = in.radius[UB_TECH_PB2D];
@@ -30,19 +68,28 @@ void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres,
         BeamMedium queryMedium;  // tabulated when the first pair is found
         queryMedium.reset(*in.scene, qb);
         Rgb sum(0.0f);
-        photonSpheres.querySegment(
-            Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length, [&](uint32_t j) {
-                float t = 0.0f;
-                if (!ub_pb2d_near(keys[j], o, d, qb.length, qb.mediumId, r * r, &t)) return;
-                const ub_photon_point& ph = photons[j];
-                if (!ub_pb2d_length_ok(ph.pathLength, qb, ub_uint(in.minLength),
-                                       ub_uint(in.maxLength)))
-                    return;
-                if (!queryMedium.built()) queryMedium.build();
-                const ub_segment_eval s = queryMedium.eval(t);
-                const ub_float3 c = ub_pb2d_contribution(in.mis, ph, qb, s, t, g, normalization);
-                sum += Rgb(c.x, c.y, c.z);
-                ++*found;
+        // A leaf's photons four at a time (their keys as a structure of arrays), then the
+        // 80-byte records of the pairs only.
+        photonSpheres.querySegmentLeaves(
+            Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length, [&](uint32_t first, uint32_t end) {
+                for (uint32_t b = first / 4; b * 4 < end; ++b) {
+                    float t[4];
+                    uint32_t near = pb2dNear4(keys[b], o, d, qb.length, qb.mediumId, r * r, t) &
+                                    ub_block_lanes(b, first, end);
+                    for (; near != 0; near &= near - 1) {
+                        const int lane = __builtin_ctz(near);
+                        const ub_photon_point& ph = photons[b * 4 + uint32_t(lane)];
+                        if (!ub_pb2d_length_ok(ph.pathLength, qb, ub_uint(in.minLength),
+                                               ub_uint(in.maxLength)))
+                            continue;
+                        if (!queryMedium.built()) queryMedium.build();
+                        const ub_segment_eval s = queryMedium.eval(t[lane]);
+                        const ub_float3 c =
+                            ub_pb2d_contribution(in.mis, ph, qb, s, t[lane], g, normalization);
+                        sum += Rgb(c.x, c.y, c.z);
+                        ++*found;
+                    }
+                }
             });
         return sum;
     });

@@ -117,10 +117,13 @@ using BeamPart = ub_beam_part;  ///< a diced part of a photon beam (kernels/shar
 void estimatePP3D(const VolumeEstimateInput& in, const HashGrid& grid, std::vector<Rgb>* out,
                   size_t* pairs);
 /// photons: the photon points in the leaf order of photonSpheres (Bvh::permuteToLeafOrder);
-/// keys[i] = ub_photon_key_of(photons[i]).
+/// keys: the photons' keys four to a block (ub_photon_keys4), in the same order.
 void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres,
                   const std::vector<ub_photon_point>& photons,
-                  const std::vector<ub_photon_key>& keys, std::vector<Rgb>* out, size_t* pairs);
+                  const std::vector<ub_photon_keys4>& keys, std::vector<Rgb>* out, size_t* pairs);
+/// The host's SSE form of ub_pb2d_near4 (kernels/shared/ub_pb2d.h), for tests.
+uint32_t pb2dNear4ForTests(const ub_photon_keys4& k, const ub_float3& o, const ub_float3& d,
+                           float length, uint32_t mediumId, float radiusSqr, float* t);
 /// photonMedia[i]: the medium along photon beam i, built (estimators/beam_medium.h).
 void estimateBP2D(const VolumeEstimateInput& in, const Bvh& beamParts,
                   const std::vector<BeamPart>& parts, const std::vector<BeamMedium>& photonMedia,
