@@ -51,11 +51,14 @@ struct ChainVertex {
 /// What free-flight sampling saw of each segment it visited (for the beams of UPBP): the
 /// visited part of segment k is [0, length[k]) (the whole segment if it was passed).
 struct ChainVisit {
-    int count = 0;  ///< segments visited: 0 .. count-1 (the last holds the vertex if scattered)
+    ChainVisit() {}  // entries past count are not initialised (as MediumTrace's segments)
+    int count = 0;   ///< segments visited: 0 .. count-1 (the last holds the vertex if scattered)
     float length[MediumTrace::kMaxSegments];
     float passProb[MediumTrace::kMaxSegments];       ///< probPass of the visited part
     float stopRevStartL[MediumTrace::kMaxSegments];  ///< pdfScatterRevL of the visited part
-    Rgb transmittance[MediumTrace::kMaxSegments];    ///< T of the visited part
+    union {
+        Rgb transmittance[MediumTrace::kMaxSegments];  ///< T of the visited part
+    };
 };
 
 /// Samples the vertex that follows a chain traced along unit direction dir. prevInMedium:

@@ -964,13 +964,12 @@ Scene::ShadowQuery Scene::shadowCrossings(const Vec3& org, const Vec3& dir, floa
         for (int k = *count - 1; k >= 0; --k) {
             const ShadowCrossing& q = crossings[k];
             if (q.shapeId != e.shapeId) continue;
-            again = (dot(dir, q.geoNormal) < 0.0f) == entering &&
-                    e.t - q.t <= 4.0f * rayOffsetLength(org + dir * e.t);
+            again = q.entering == entering && e.t - q.t <= 4.0f * rayOffsetLength(org + dir * e.t);
             break;
         }
         if (again) continue;
         if (*count == capacity) return ShadowQuery::kUnavailable;
-        crossings[(*count)++] = {e.t, e.shapeId, n};
+        crossings[(*count)++] = {e.t, e.shapeId, entering};
     }
     return ShadowQuery::kOpen;
 }

@@ -221,7 +221,7 @@ class Scene {
     struct ShadowCrossing {
         float t;           ///< ray parameter
         uint32_t shapeId;  ///< a triangle mesh
-        Vec3 geoNormal;    ///< the triangle's unit geometric normal, as intersect() gives it
+        bool entering;     ///< against the geometric normal intersect() gives (crossBoundary)
     };
     /// How shadowCrossings answered.
     enum class ShadowQuery { kBlocked, kOpen, kUnavailable };

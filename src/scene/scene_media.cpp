@@ -487,8 +487,7 @@ MediumShadow walkShadow(const Scene& scene, Vec3 from, Vec3 dir, float maxDist, 
                     !s.isMediumBoundary || (!s.imaginary && s.mediumPriority >= stack.priority());
                 if (real) return blockedShadow();
                 chain.add(scene, stack.mediumId(), from + dir * t, dir, c.t - t);
-                if (!scene.crossBoundary(c.shapeId, c.geoNormal, dir, &stack))
-                    return blockedShadow();
+                if (!scene.applyCrossing(c.shapeId, c.entering, &stack)) return blockedShadow();
                 t = c.t;
             }
             chain.add(scene, stack.mediumId(), from + dir * t, dir,
