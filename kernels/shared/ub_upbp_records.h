@@ -33,8 +33,8 @@ typedef struct {
 } ub_photon_point;
 
 /* What the pb2d walk reads of a photon point before it is a pair (ub_pb2d_near): its position and
- * medium, 16 bytes, so that a leaf's four photons share one cache line (the 80-byte records are
- * read for the pairs only). An array of them in the BVH's leaf order goes with the photons. */
+ * medium, 16 bytes (the 80-byte records are read for the pairs only). The walks read them four
+ * photons to a block (ub_photon_keys4, below), in the BVH's leaf order beside the photons. */
 typedef struct {
     float pos[3];
     ub_uint mediumId;
