@@ -45,6 +45,16 @@ typedef struct {
     float dx[4], dy[4], dz[4];
 } ub_beam_keys4;
 
+/* Lane j of a block: part p's line. */
+UB_INLINE void ub_beam_keys4_set(UB_PRIVATE ub_beam_keys4* k, int j, ub_beam_part p) {
+    k->ox[j] = p.origin[0];
+    k->oy[j] = p.origin[1];
+    k->oz[j] = p.origin[2];
+    k->dx[j] = p.dir[0];
+    k->dy[j] = p.dir[1];
+    k->dz[j] = p.dir[2];
+}
+
 /* Bit j set when line j of the block passes within sqrt(radiusSqr) of the line o + t d, by
  * the first two tests of ub_beam_beam_near (not parallel; separation along d x d_j) with the
  * same operations: a candidate it rejects, ub_beam_beam_near rejects. A filter ahead of the

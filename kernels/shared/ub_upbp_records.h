@@ -49,6 +49,14 @@ typedef struct {
     ub_uint mediumId[4];
 } ub_photon_keys4;
 
+/* Lane j of a block: photon ph's key. */
+UB_INLINE void ub_photon_keys4_set(UB_PRIVATE ub_photon_keys4* k, int j, ub_photon_point ph) {
+    k->px[j] = ph.pos[0];
+    k->py[j] = ph.pos[1];
+    k->pz[j] = ph.pos[2];
+    k->mediumId[j] = ph.mediumId;
+}
+
 UB_INLINE ub_photon_key ub_photon_key_of(ub_photon_point ph) {
     ub_photon_key k;
     k.pos[0] = ph.pos[0];

@@ -101,14 +101,8 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         sphereKeys.assign((sphereOrder.size() + 3) / 4, ub_photon_keys4{});
         for (ub_photon_keys4& k : sphereKeys)
             for (int j = 0; j < 4; ++j) k.mediumId[j] = UB_NO_MEDIUM;
-        for (size_t i = 0; i < sphereOrder.size(); ++i) {
-            ub_photon_keys4& k = sphereKeys[i / 4];
-            const size_t j = i % 4;
-            k.px[j] = sphereOrder[i].pos[0];
-            k.py[j] = sphereOrder[i].pos[1];
-            k.pz[j] = sphereOrder[i].pos[2];
-            k.mediumId[j] = sphereOrder[i].mediumId;
-        }
+        for (size_t i = 0; i < sphereOrder.size(); ++i)
+            ub_photon_keys4_set(&sphereKeys[i / 4], int(i % 4), sphereOrder[i]);
     }
     Bvh beamBvh;
     std::vector<BeamPart> parts;
@@ -162,16 +156,8 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
             // What the bb1d walks test first, four parts a block (kernels/shared/ub_bvh.h).
             reserve((parts.size() / 4 + 1) * sizeof(ub_beam_keys4), "bb1d lookup (part lines)");
             partLines.assign((parts.size() + 3) / 4, ub_beam_keys4{});
-            for (size_t i = 0; i < parts.size(); ++i) {
-                ub_beam_keys4& k = partLines[i / 4];
-                const size_t j = i % 4;
-                k.ox[j] = parts[i].origin[0];
-                k.oy[j] = parts[i].origin[1];
-                k.oz[j] = parts[i].origin[2];
-                k.dx[j] = parts[i].dir[0];
-                k.dy[j] = parts[i].dir[1];
-                k.dz[j] = parts[i].dir[2];
-            }
+            for (size_t i = 0; i < parts.size(); ++i)
+                ub_beam_keys4_set(&partLines[i / 4], int(i % 4), parts[i]);
         }
     }
     // The medium along every photon beam, tabulated once (estimators/beam_medium.h).

@@ -62,6 +62,24 @@ bool embreeRayValid(const Vec3& o, const Vec3& d, float tNear, float tFar) {
     return !std::isnan(tNear) && !std::isnan(tFar);
 }
 
+/// Embree's ray for org + t dir, t in [tNear, tFar], every mask bit set.
+RTCRay embreeRay(const Vec3& org, const Vec3& dir, float tNear, float tFar) {
+    RTCRay r;
+    r.org_x = org.x;
+    r.org_y = org.y;
+    r.org_z = org.z;
+    r.dir_x = dir.x;
+    r.dir_y = dir.y;
+    r.dir_z = dir.z;
+    r.tnear = tNear;
+    r.tfar = tFar;
+    r.time = 0.0f;
+    r.mask = ~0u;
+    r.id = 0;
+    r.flags = 0;
+    return r;
+}
+
 }  // namespace
 
 namespace {
@@ -642,8 +660,7 @@ void Scene::commit() {
     impl_->alwaysReal.assign(shapes.size(), 1);
     impl_->crossingsByFilter = true;
     for (size_t i = 0; i < shapes.size(); ++i) {
-        const ShapeInfo& s = shapes[i];
-        if (!s.isMediumBoundary || (!s.imaginary && s.mediumPriority >= highest)) continue;
+        if (realFor(uint32_t(i), highest)) continue;
         impl_->alwaysReal[i] = 0;
         const ShapeGeom& g = impl_->geoms[i];
         if (g.isSphere || g.sdf) impl_->crossingsByFilter = false;
@@ -656,18 +673,7 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh;
-    rh.ray.org_x = ray.org.x;
-    rh.ray.org_y = ray.org.y;
-    rh.ray.org_z = ray.org.z;
-    rh.ray.dir_x = ray.dir.x;
-    rh.ray.dir_y = ray.dir.y;
-    rh.ray.dir_z = ray.dir.z;
-    rh.ray.tnear = ray.tMin;
-    rh.ray.tfar = ray.tMax;
-    rh.ray.time = 0.0f;
-    rh.ray.mask = ~0u;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
+    rh.ray = embreeRay(ray.org, ray.dir, ray.tMin, ray.tMax);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
@@ -815,19 +821,7 @@ bool occludedRay(RTCScene scene, const Vec3& org, const Vec3& dir, float tMax) {
     if (!embreeRayValid(org, dir, 0.0f, tMax)) return true;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    RTCRay r;
-    r.org_x = org.x;
-    r.org_y = org.y;
-    r.org_z = org.z;
-    r.dir_x = dir.x;
-    r.dir_y = dir.y;
-    r.dir_z = dir.z;
-    r.tnear = 0.0f;
-    r.tfar = tMax;
-    r.time = 0.0f;
-    r.mask = ~0u;
-    r.id = 0;
-    r.flags = 0;
+    RTCRay r = embreeRay(org, dir, 0.0f, tMax);
     rtcOccluded1(scene, &ctx, &r);
     return r.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
 }
@@ -915,19 +909,7 @@ Scene::ShadowQuery Scene::shadowCrossings(const Vec3& org, const Vec3& dir, floa
     c.entries = entries;
     c.capacity = std::min(kMaxEntries, 2 * capacity);
     c.count = 0;
-    RTCRay r;
-    r.org_x = org.x;
-    r.org_y = org.y;
-    r.org_z = org.z;
-    r.dir_x = dir.x;
-    r.dir_y = dir.y;
-    r.dir_z = dir.z;
-    r.tnear = 0.0f;
-    r.tfar = tMax;
-    r.time = 0.0f;
-    r.mask = ~0u;
-    r.id = 0;
-    r.flags = 0;
+    RTCRay r = embreeRay(org, dir, 0.0f, tMax);
     rtcOccluded1(impl_->scene, &c.embree, &r);
     if (r.tfar < 0.0f) return ShadowQuery::kBlocked;  // Embree sets tfar = -inf on a hit
     if (c.count > c.capacity) return ShadowQuery::kUnavailable;

@@ -252,6 +252,13 @@ class Scene {
                        MediumStack* stack) const;
     /// Crosses boundary shapeId, entering or leaving it, by the scene's MediumTransitions.
     bool applyCrossing(uint32_t shapeId, bool entering, MediumStack* stack) const;
+    /// Whether a hit on shape shapeId is a real surface for a medium stack of this priority
+    /// (scene/medium_stack.h): not a boundary, or a boundary that is not imaginary and of at
+    /// least that priority; else the path passes it and crosses.
+    bool realFor(uint32_t shapeId, int32_t stackPriority) const {
+        const ShapeInfo& s = shapes[shapeId];
+        return !s.isMediumBoundary || (!s.imaginary && s.mediumPriority >= stackPriority);
+    }
     /// At a real surface hit reached along -dirFix with stack *stack (the incoming side):
     /// updates the stack for a continuation dirGen (crosses the shape if dirGen leaves on the
     /// other side of the geometric surface). False on stack overflow.

@@ -388,10 +388,7 @@ void Scene::traceMedia(const Ray& ray, MediumStack* stack, MediumTrace* trace, H
         seg.length = length(h.pos - segStart);
         trace->distance += seg.length;
         ++trace->count;
-        const ShapeInfo& s = shapes[h.shapeId];
-        const bool real =
-            !s.isMediumBoundary || (!s.imaginary && s.mediumPriority >= stack->priority());
-        if (real) {
+        if (realFor(h.shapeId, stack->priority())) {
             trace->hitSurface = true;
             *hit = h;
             return;
@@ -483,10 +480,7 @@ MediumShadow walkShadow(const Scene& scene, Vec3 from, Vec3 dir, float maxDist, 
             float t = 0.0f;
             for (int i = 0; i < count; ++i) {
                 const Scene::ShadowCrossing& c = crossings[i];
-                const ShapeInfo& s = scene.shapes[c.shapeId];
-                const bool real =
-                    !s.isMediumBoundary || (!s.imaginary && s.mediumPriority >= stack.priority());
-                if (real) return blockedShadow();
+                if (scene.realFor(c.shapeId, stack.priority())) return blockedShadow();
                 chain.add(scene, stack.mediumId(), from + dir * t, dir, c.t - t);
                 if (!scene.applyCrossing(c.shapeId, c.entering, &stack)) return blockedShadow();
                 t = c.t;
@@ -512,10 +506,7 @@ MediumShadow walkShadow(const Scene& scene, Vec3 from, Vec3 dir, float maxDist, 
             chain.add(scene, stack.mediumId(), from, dir, len);
             return chain.result();
         }
-        const ShapeInfo& s = scene.shapes[h.shapeId];
-        const bool real =
-            !s.isMediumBoundary || (!s.imaginary && s.mediumPriority >= stack.priority());
-        if (real) return blockedShadow();
+        if (scene.realFor(h.shapeId, stack.priority())) return blockedShadow();
         chain.add(scene, stack.mediumId(), from, dir, length(h.pos - from));
         if (!scene.crossBoundary(h.shapeId, h.geoNormal, dir, &stack)) return blockedShadow();
         Vec3 next = Scene::offsetRayOrigin(h.pos, h.geoNormal, dir);
