@@ -550,11 +550,13 @@ TEST(JsonLoaderErrors, MaxPathLengthBelowOne) {
 }
 
 TEST(JsonLoaderErrors, ZeroAreaEmitter) {
-    // Scale factors so small that the squared edge lengths underflow in float: the
-    // transform is invertible but the rectangle's area is 0.
+    // Scale factors so small in the rectangle's plane that the squared edge lengths underflow
+    // in float: the transform is invertible (determinant 1e-20; the third factor keeps it a
+    // normal float, which the renderer's flush-to-zero mode would otherwise make 0, singular)
+    // but the rectangle's area is 0.
     std::string e = onlyError(sceneWith(
         kWhite,
-        R"json({"type": "rectangle", "emission": 1, "transform": {"scale": [1e-20, 1e-20, 1]}})json",
+        R"json({"type": "rectangle", "emission": 1, "transform": {"scale": [1e-20, 1e-20, 1e20]}})json",
         kPoint));
     EXPECT_EQ(e,
               "scene.json:4:12: error: at /shapes/0: zero-area emitter: the surface area of this "

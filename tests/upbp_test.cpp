@@ -20,6 +20,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -417,6 +418,68 @@ TEST(Upbp, CuttingRaysAtTheSampledDistanceKeepsTheImage) {
                                   << (v.shortQueryBeams ? "short" : "long") << ")";
             EXPECT_GT(lit, 0u) << c.name << ", " << v.algorithm;
         }
+}
+
+// With photon beams as the only light-side technique, only the first N_B light subpaths are
+// traced (render/vcm.cpp, light pass): they make the same photon beams (but for the MIS
+// partials, which depend on the technique set) as when every light subpath is traced (pp3d on
+// too), record no light vertex or photon point, and the image does
+// not depend on the thread count. Cornell fog (global fog) and the SmallUPBP bunny (nested
+// media), short and long photon beams, N_B below and above the subpath count.
+TEST(Upbp, BeamOnlySetsTraceOnlyTheBeamPaths) {
+    const std::string dir = std::string(UNIBEAM_SOURCE_DIR) + "/scenes";
+    std::vector<std::pair<std::string, std::unique_ptr<Scene>>> scenes;
+    scenes.emplace_back("cornell-fog", loadJsonFile(dir, "cornell-fog.json", 24));
+    {
+        std::vector<Diagnostic> warnings;
+        auto bunny = loadScene(dir + "/smallupbp/bunny/bunny.obj", &warnings);
+        bunny->camera = bunny->camera.resized(24, 24);
+        scenes.emplace_back("bunny", std::move(bunny));
+    }
+    for (const auto& [name, scene] : scenes)
+        for (const char* set : {"upbp:bb1d", "upbp:bp2d", "upbp:bp2d+bb1d"})
+            for (bool shortBeams : {true, false})
+                for (int beamPaths : {40, 1000}) {
+                    RenderOptions opt;
+                    opt.algorithm = set;
+                    opt.seed = 17;
+                    opt.shortPhotonBeams = shortBeams;
+                    opt.beamPaths = beamPaths;
+                    VertexCM only(*scene, opt);
+                    opt.algorithm = std::string(set) + "+pp3d";
+                    VertexCM all(*scene, opt);
+                    Image a, b;
+                    only.renderIteration(2, a);
+                    all.renderIteration(2, b);
+                    const std::string what = name + ", " + set +
+                                             (shortBeams ? ", short" : ", long") + ", N_B " +
+                                             std::to_string(beamPaths);
+                    EXPECT_TRUE(only.lightVertices().empty()) << what;
+                    EXPECT_TRUE(only.photonPoints().empty()) << what;
+                    EXPECT_FALSE(all.photonPoints().empty()) << what;
+                    const auto& pa = only.photonBeams();
+                    const auto& pb = all.photonBeams();
+                    ASSERT_GT(pa.size(), 0u) << what;
+                    ASSERT_EQ(pa.size(), pb.size()) << what;
+                    // Equal but for the MIS partials, which depend on the technique set.
+                    size_t beamsDiffer = 0;
+                    for (size_t i = 0; i < pa.size(); ++i) {
+                        ub_beam x = pa[i], y = pb[i];
+                        x.dVCM = y.dVCM = x.dVM = y.dVM = x.dOut = y.dOut = 0.0f;
+                        beamsDiffer += std::memcmp(&x, &y, sizeof(ub_beam)) != 0;
+                    }
+                    EXPECT_EQ(beamsDiffer, 0u) << what;
+                    opt.algorithm = set;
+                    Image d;
+                    {
+                        tbb::task_arena one(1);
+                        one.execute([&] { VertexCM(*scene, opt).renderIteration(2, d); });
+                    }
+                    size_t differ = 0;
+                    for (size_t i = 0; i < a.pixels.size(); ++i)
+                        for (int ch = 0; ch < 3; ++ch) differ += a.pixels[i][ch] != d.pixels[i][ch];
+                    EXPECT_EQ(differ, 0u) << what << ": one thread against two";
+                }
 }
 
 TEST(Upbp, RejectsBadOptions) {

@@ -5,6 +5,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -287,11 +288,20 @@ void VertexCM::renderIteration(int iteration, Image& out) {
 
     // (1) Light pass: a fixed partition of the light subpaths into chunks, each traced by one
     // task in index order, so vertices and splats do not depend on the thread count.
+    // With photon beams as the only light-side technique (upbp:bb1d, upbp:bp2d+bb1d, ...) a
+    // light subpath past the first N_B contributes nothing (no connection, light tracing,
+    // photon point or surface photon), so only the N_B beam paths are traced. Each subpath
+    // draws its own random numbers (Rng::forPath), so the image is the same as when all are
+    // traced; N_L (lightSubPathCount_) stays the pixel count, as the estimators' normalisations
+    // and MIS need.
+    const bool beamsOnly = algorithm_ == Algorithm::Upbp && upbp_.photonBeams() && !upbp_.bpt &&
+                           !upbp_.surf && !upbp_.photonPoints();
+    const size_t tracedPaths = beamsOnly ? std::min(pathCount, size_t(beamPaths_)) : pathCount;
     splats_.clear();
     const int chunkCount = SplatBuffer::kChunkCount;
     lightChunks_.resize(static_cast<size_t>(chunkCount));
     tbb::parallel_for(0, chunkCount, [&](int c) {
-        auto range = SplatBuffer::chunkRange(c, pathCount);
+        auto range = SplatBuffer::chunkRange(c, tracedPaths);
         traceLightPaths(iteration, range.first, range.second, splats_.chunk(c),
                         lightChunks_[size_t(c)]);
     });
@@ -317,11 +327,14 @@ void VertexCM::renderIteration(int iteration, Image& out) {
             first[size_t(c)] =
                 first[size_t(c - 1)] + uint32_t(lightChunks_[size_t(c - 1)].vertices.size());
         tbb::parallel_for(0, chunkCount, [&](int c) {
-            auto range = SplatBuffer::chunkRange(c, pathCount);
+            auto range = SplatBuffer::chunkRange(c, tracedPaths);
             const LightChunk& chunk = lightChunks_[size_t(c)];
             for (size_t i = range.first; i < range.second; ++i)
                 pathEnds_[i] = first[size_t(c)] + chunk.pathEnds[i - range.first];
         });
+        // Subpaths not traced are empty.
+        std::fill(pathEnds_.begin() + std::ptrdiff_t(tracedPaths), pathEnds_.end(),
+                  uint32_t(lightVertices_.size()));
     }
 
     // (2) Hashed grid over the light vertices for merging (upbp: over the surface ones).

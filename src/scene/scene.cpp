@@ -36,6 +36,9 @@
 #include "scene/scene.h"
 
 #include <embree3/rtcore.h>
+#if defined(__SSE2__)
+#include <pmmintrin.h>
+#endif
 
 #include <cmath>
 #include <limits>
@@ -51,6 +54,23 @@
 namespace ub {
 
 namespace {
+
+#if defined(__SSE2__)
+/// One floating-point mode for every rendering thread: denormal results flushed to zero and
+/// denormal inputs read as zero (MXCSR's FTZ and DAZ bits), as Embree asks of every thread
+/// that traces (Embree 3 API manual, "Performance Recommendations"). Embree's scene builds
+/// leave TBB's worker threads in that mode, and TBB applies to its tasks the mode of the
+/// thread that started the arena, so before this setting whether a render flushed depended on
+/// which came first, and a one-thread arena the main thread started later did not flush: two
+/// of 576 bunny pixels (upbp:bb1d, long photon beams) differed between one thread and two, at
+/// 2e-36 and 3e-42 (Upbp.BeamOnlySetsTraceOnlyTheBeamPaths, tests/upbp_test.cpp). Set before
+/// main() on the main thread, so every thread started later (TBB's, PoCL's) inherits it and
+/// every arena captures it.
+[[maybe_unused]] const bool kFlushDenormals = [] {
+    _mm_setcsr(_mm_getcsr() | _MM_FLUSH_ZERO_ON | _MM_DENORMALS_ZERO_ON);
+    return true;
+}();
+#endif
 
 /// Embree's own check (RayK::valid): finite origin and direction within 1.844e18, tnear and
 /// tfar not NaN. An invalid ray would abort in Embree's assertion; such rays come only from
