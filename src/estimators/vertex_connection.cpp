@@ -17,8 +17,9 @@
 
 namespace ub {
 
-Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const PathVertex& v,
-                              const VertexScatter& scatter) const {
+Rgb VertexCM::connectVertices(const LightVertex& lv, uint32_t lightIndex,
+                              LightScatterCache& lightScatters, const SubPath& state,
+                              const PathVertex& v, const VertexScatter& scatter) const {
     Vec3 dir = lv.pos3() - v.pos;
     const float distSqr = lengthSqr(dir);
     if (!(distSqr > 0.0f)) return Rgb(0.0f);
@@ -32,16 +33,12 @@ Rgb VertexCM::connectVertices(const LightVertex& lv, const SubPath& state, const
     cameraDirPdfW *= cameraCont;
     cameraRevPdfW *= cameraCont;
 
-    // The light vertex's scattering function: its BSDF, or its medium's phase function.
-    VertexScatter lightScatter;
-    if (lv.inMedium())
-        lightScatter.setupMedium(scene_.media[size_t(lv.mediumId())].g, lv.dirFix3(), lv.contProb);
-    else if (!lightScatter.setupSurface(scene_, int(lv.materialId), lv.uv2(), lv.attribute3(),
-                                        lv.dirFix3(), lv.geoNormal3(), lv.shadingNormal3(),
-                                        lv.tangent3(), /*fromLight=*/true))
-        return Rgb(0.0f);
+    // The light vertex's scattering function: its BSDF, or its medium's phase function, set
+    // up at its first connection from this camera subpath.
+    const VertexScatter* lightScatter = lightScatters.get(scene_, lv, lightIndex);
+    if (!lightScatter) return Rgb(0.0f);
     float cosLight = 0.0f, lightDirPdfW = 0.0f, lightRevPdfW = 0.0f;
-    Rgb fLight = lightScatter.evaluate(-dir, &cosLight, &lightDirPdfW, &lightRevPdfW);
+    Rgb fLight = lightScatter->evaluate(-dir, &cosLight, &lightDirPdfW, &lightRevPdfW);
     if (isBlack(fLight)) return Rgb(0.0f);
     lightDirPdfW *= lv.contProb;
     lightRevPdfW *= lv.contProb;

@@ -74,6 +74,7 @@ namespace ub {
 class Rng;
 class ClRuntime;
 class VertexScatter;
+class LightScatterCache;
 struct VolumeEstimateInput;
 struct ChainVertex;
 
@@ -219,7 +220,10 @@ class VertexCM : public Integrator {
                          const Vec3& hitPos, const Vec3& hitNormal, const Vec2& hitUv) const;
     Rgb directIllumination(Rng& rng, const SubPath& state, const PathVertex& v,
                            const VertexScatter& scatter) const;
-    Rgb connectVertices(const LightVertex& lv, const SubPath& state, const PathVertex& v,
+    /// lv is the lightIndex-th stored vertex of its light subpath; lightScatters holds the
+    /// scattering functions of that subpath's vertices set up so far (vertex_scatter.h).
+    Rgb connectVertices(const LightVertex& lv, uint32_t lightIndex,
+                        LightScatterCache& lightScatters, const SubPath& state, const PathVertex& v,
                         const VertexScatter& scatter) const;
     Rgb mergeVertices(const SubPath& state, const Hit& hit, const Bsdf& bsdf) const;
     /// mergeVertices for a Blend (no kernel-side BSDF state; surface_merging.cpp).

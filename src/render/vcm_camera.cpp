@@ -48,6 +48,7 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
     if (useMedia_) state.stack = scene_.cameraMediumStack;
 
     Rgb color(0.0f);
+    LightScatterCache lightScatters;  // of the light subpath this one connects to
     for (;; ++state.pathLength) {
         PathVertex v;
         bool escaped = false;
@@ -123,8 +124,8 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
                 const int length = int(lv.pathLength) + 1 + state.pathLength;
                 if (length < minLength) continue;
                 if (length > maxLength) break;  // vertices are stored in path order
-                color +=
-                    state.throughput * lv.throughput3() * connectVertices(lv, state, v, scatter);
+                color += state.throughput * lv.throughput3() *
+                         connectVertices(lv, i - first, lightScatters, state, v, scatter);
             }
         }
         if (!atLimit && !scatter.isDelta() && useVM_ && !v.inMedium) {

@@ -17,6 +17,8 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
+#include <new>
 
 #include "kernels/shared/ub_phase.h"
 #include "render/vcm.h"
@@ -109,6 +111,52 @@ class VertexScatter {
     float g_ = 0.0f;
     Vec3 dirFix_;
     float contProb_ = 0.0f;
+};
+
+/// The scattering functions of one light subpath's vertices, each set up at its first
+/// connection and reused by the camera subpath's later vertices. A camera vertex connects to
+/// every vertex of the light subpath with the same index, so without this each surface light
+/// vertex's BSDF, with its texture lookups, was set up again for every camera vertex. One per
+/// camera subpath; vertices past kSlots share one more slot, set up for each connection.
+class LightScatterCache {
+  public:
+    static constexpr uint32_t kSlots = 16;
+    LightScatterCache() {}
+    LightScatterCache(const LightScatterCache&) = delete;
+    LightScatterCache& operator=(const LightScatterCache&) = delete;
+    ~LightScatterCache() {
+        for (uint32_t k = 0; k <= kSlots; ++k)
+            if (state_[k] != kUnset) slot(k)->~VertexScatter();
+    }
+    /// The scattering function of lv, the k-th stored vertex of its light subpath, or null
+    /// where it has none (a degenerate surface configuration, as setupSurface decides).
+    const VertexScatter* get(const Scene& scene, const LightVertex& lv, uint32_t k) {
+        if (k >= kSlots) {
+            k = kSlots;
+            if (state_[k] != kUnset) slot(k)->~VertexScatter();
+            state_[k] = kUnset;
+        }
+        if (state_[k] == kUnset)
+            state_[k] = setup(scene, lv, new (storage_[k]) VertexScatter()) ? kReady : kNone;
+        return state_[k] == kReady ? slot(k) : nullptr;
+    }
+
+  private:
+    enum : uint8_t { kUnset, kReady, kNone };
+    static bool setup(const Scene& scene, const LightVertex& lv, VertexScatter* s) {
+        if (lv.inMedium()) {
+            s->setupMedium(scene.media[size_t(lv.mediumId())].g, lv.dirFix3(), lv.contProb);
+            return true;
+        }
+        return s->setupSurface(scene, int(lv.materialId), lv.uv2(), lv.attribute3(), lv.dirFix3(),
+                               lv.geoNormal3(), lv.shadingNormal3(), lv.tangent3(),
+                               /*fromLight=*/true);
+    }
+    VertexScatter* slot(uint32_t k) {
+        return std::launder(reinterpret_cast<VertexScatter*>(storage_[k]));
+    }
+    alignas(VertexScatter) unsigned char storage_[kSlots + 1][sizeof(VertexScatter)];
+    uint8_t state_[kSlots + 1] = {};
 };
 
 }  // namespace ub
