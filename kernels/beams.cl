@@ -90,6 +90,7 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     if (i >= queryCount) return;
     ub_beam qb = queries[i];
     ub_medium_info m = media[qb.mediumId];
+    const float mCont = ub_homogeneous_cont_prob(m);
     ub_grid_info gi = grids[qb.mediumId];
     ub_grid_accessor acc;
     if (!m.homogeneous) ub_grid_accessor_init(&acc, gridData, gi);
@@ -111,7 +112,7 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
             uint lane = 31u - clz(near & (0u - near));
             ub_photon_point ph = photons[b * 4u + lane];
             if (!ub_pb2d_length_ok(ph.pathLength, qb, minLength, maxLength)) continue;
-            ub_segment_eval s = ub_query_beam_segment(m, gi, &acc, qb, t[lane], table,
+            ub_segment_eval s = ub_query_beam_segment(m, mCont, gi, &acc, qb, t[lane], table,
                                                       UB_QUERY_PIECES, &tableState);
             ub_float3 c = ub_pb2d_contribution(mis, ph, qb, s, t[lane], m.g, normalization);
             sx += c.x;
@@ -136,6 +137,7 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
     if (i >= queryCount) return;
     ub_query_point q = queries[i];
     ub_medium_info m = media[q.mediumId];
+    const float mCont = ub_homogeneous_cont_prob(m);
     ub_grid_info gi = grids[q.mediumId];
     ub_grid_accessor acc;
     if (!m.homogeneous) ub_grid_accessor_init(&acc, gridData, gi);
@@ -146,9 +148,9 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
         float t = 0.0f;
         if (!ub_bp2d_pair(q, part, radius * radius, minLength, maxLength, &t)) continue;
         ub_beam pb = beams[part.beam];
-        ub_segment_eval s =
-            ub_photon_beam_segment(m, gi, &acc, pb, t, beamPieces + beamRanges[2u * part.beam],
-                                   beamRanges[2u * part.beam + 1u]);
+        ub_segment_eval s = ub_photon_beam_segment(m, mCont, gi, &acc, pb, t,
+                                                   beamPieces + beamRanges[2u * part.beam],
+                                                   beamRanges[2u * part.beam + 1u]);
         ub_float3 c = ub_bp2d_contribution(mis, pb, q, s, t, m.g, normalization);
         sx += c.x;
         sy += c.y;
@@ -172,6 +174,7 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
     if (i >= queryCount) return;
     ub_beam qb = queries[i];
     ub_medium_info m = media[qb.mediumId];
+    const float mCont = ub_homogeneous_cont_prob(m);
     ub_grid_info gi = grids[qb.mediumId];
     ub_grid_accessor acc;
     if (!m.homogeneous) ub_grid_accessor_init(&acc, gridData, gi);
@@ -193,11 +196,11 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
             if (!ub_bb1d_pair(qb, part, radius * radius, minLength, maxLength, &tc, &tl, &sinTheta))
                 continue;
             ub_beam pb = beams[part.beam];
-            ub_segment_eval sl =
-                ub_photon_beam_segment(m, gi, &acc, pb, tl, beamPieces + beamRanges[2u * part.beam],
-                                       beamRanges[2u * part.beam + 1u]);
-            ub_segment_eval sc =
-                ub_query_beam_segment(m, gi, &acc, qb, tc, table, UB_QUERY_PIECES, &tableState);
+            ub_segment_eval sl = ub_photon_beam_segment(m, mCont, gi, &acc, pb, tl,
+                                                        beamPieces + beamRanges[2u * part.beam],
+                                                        beamRanges[2u * part.beam + 1u]);
+            ub_segment_eval sc = ub_query_beam_segment(m, mCont, gi, &acc, qb, tc, table,
+                                                       UB_QUERY_PIECES, &tableState);
             ub_float3 c =
                 ub_bb1d_contribution(mis, pb, qb, sl, sc, tl, tc, sinTheta, m.g, normalization);
             sx += c.x;

@@ -183,19 +183,20 @@ UB_INLINE ub_segment_eval ub_grid_segment(ub_grid_info g, UB_PRIVATE ub_grid_acc
 }
 
 /* The medium along beam b from its piece start to t, whatever kind medium m is: the closed
- * form in a homogeneous medium, regular tracking through grid g otherwise (the kernels). */
-UB_INLINE ub_segment_eval ub_beam_segment(ub_medium_info m, ub_grid_info g,
+ * form in a homogeneous medium, regular tracking through grid g otherwise (the kernels).
+ * mCont: ub_homogeneous_cont_prob(m), computed once per query by the callers. */
+UB_INLINE ub_segment_eval ub_beam_segment(ub_medium_info m, float mCont, ub_grid_info g,
                                           UB_PRIVATE ub_grid_accessor* acc, ub_beam b, float t) {
-    return m.homogeneous ? ub_homogeneous_segment(m, t) : ub_grid_segment(g, acc, b, t);
+    return m.homogeneous ? ub_homogeneous_segment_cp(m, t, mCont) : ub_grid_segment(g, acc, b, t);
 }
 
 /* A photon beam's medium at t from its table in a global buffer (count pieces from
  * `pieces`; count 0: no table, walk), else as ub_beam_segment. */
-UB_INLINE ub_segment_eval ub_photon_beam_segment(ub_medium_info m, ub_grid_info g,
+UB_INLINE ub_segment_eval ub_photon_beam_segment(ub_medium_info m, float mCont, ub_grid_info g,
                                                  UB_PRIVATE ub_grid_accessor* acc, ub_beam b,
                                                  float t, UB_GLOBAL const ub_beam_piece* pieces,
                                                  ub_uint count) {
-    if (m.homogeneous || count == 0u) return ub_beam_segment(m, g, acc, b, t);
+    if (m.homogeneous || count == 0u) return ub_beam_segment(m, mCont, g, acc, b, t);
     float sFirst = 0.0f, sLast = 0.0f;
     const float tau = ub_beam_table_tau_g(pieces, count, t, &sFirst, &sLast);
     return ub_grey_segment(tau, sFirst, sLast, g.albedo[0], g.albedo[1], g.albedo[2]);
@@ -204,11 +205,11 @@ UB_INLINE ub_segment_eval ub_photon_beam_segment(ub_medium_info m, ub_grid_info 
 /* A query beam's medium at t, its table built in `table` (cap pieces) at the first call:
  * *state is UB_TABLE_UNBUILT before it, then the table's piece count, or UB_TABLE_OVERFLOW
  * when the beam has more than cap pieces (then every call walks from the start). */
-UB_INLINE ub_segment_eval ub_query_beam_segment(ub_medium_info m, ub_grid_info g,
+UB_INLINE ub_segment_eval ub_query_beam_segment(ub_medium_info m, float mCont, ub_grid_info g,
                                                 UB_PRIVATE ub_grid_accessor* acc, ub_beam b,
                                                 float t, UB_PRIVATE ub_beam_piece* table,
                                                 ub_uint cap, UB_PRIVATE ub_uint* state) {
-    if (m.homogeneous) return ub_homogeneous_segment(m, t);
+    if (m.homogeneous) return ub_homogeneous_segment_cp(m, t, mCont);
     if (*state == UB_TABLE_UNBUILT) {
         float sFirst = 0.0f, sLast = 0.0f;
         ub_uint n = 0u;

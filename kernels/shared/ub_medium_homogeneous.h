@@ -16,7 +16,9 @@ typedef struct {
     ub_uint homogeneous; /* 0: a grid (the kernels leave such media to the host) */
 } ub_medium_info;
 
-UB_INLINE ub_segment_eval ub_homogeneous_segment(ub_medium_info m, float t) {
+/* The medium over [0, t] of a homogeneous medium, its continuation probability given
+ * (ub_homogeneous_cont_prob, constant per medium: loops over pairs compute it once). */
+UB_INLINE ub_segment_eval ub_homogeneous_segment_cp(ub_medium_info m, float t, float contProb) {
     ub_segment_eval e;
     float stop = 0.0f, pass = 0.0f;
     for (int a = 0; a < 3; ++a) {
@@ -29,9 +31,17 @@ UB_INLINE ub_segment_eval ub_homogeneous_segment(ub_medium_info m, float t) {
     e.stopFwdL = stop * (1.0f / 3.0f);
     e.stopRevStartL = e.stopFwdL; /* the same extinction at both ends */
     e.passProb = pass * (1.0f / 3.0f);
-    e.contProb = ub_medium_cont_prob(m.sigmaS[0], m.sigmaS[1], m.sigmaS[2], m.sigmaT[0],
-                                     m.sigmaT[1], m.sigmaT[2]);
+    e.contProb = contProb;
     return e;
+}
+
+UB_INLINE float ub_homogeneous_cont_prob(ub_medium_info m) {
+    return ub_medium_cont_prob(m.sigmaS[0], m.sigmaS[1], m.sigmaS[2], m.sigmaT[0], m.sigmaT[1],
+                               m.sigmaT[2]);
+}
+
+UB_INLINE ub_segment_eval ub_homogeneous_segment(ub_medium_info m, float t) {
+    return ub_homogeneous_segment_cp(m, t, ub_homogeneous_cont_prob(m));
 }
 
 #endif /* UB_MEDIUM_HOMOGENEOUS_H */

@@ -20,6 +20,8 @@ void BeamMedium::reset(const Scene& scene, const ub_beam& b) {
     built_ = false;
     pieces_.clear();
     info_ = mediumInfo(*medium_);
+    homogeneous_ = medium_->type == MediumType::kHomogeneous;
+    contProb_ = ub_homogeneous_cont_prob(info_);
 }
 
 ub_grid_info gridInfo(const Medium& m, uint32_t gridOffset) {
@@ -70,10 +72,9 @@ void BeamMedium::build() {
     }
 }
 
-ub_segment_eval BeamMedium::eval(float t) const {
+ub_segment_eval BeamMedium::evalOther(float t) const {
     const Vec3 o(beam_->origin[0], beam_->origin[1], beam_->origin[2]);
     const Vec3 d(beam_->dir[0], beam_->dir[1], beam_->dir[2]);
-    if (medium_->type == MediumType::kHomogeneous) return ub_homogeneous_segment(info_, t);
     if (!tabulated_ || pieces_.empty()) {
         const MediumSegment s = evalMediumSegment(*medium_, o, d, t);
         ub_segment_eval e;
