@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -242,9 +243,11 @@ TEST(Bvh, ParallelBuildEqualsTheBuildOnOneThread) {
 }
 
 // bb1d's first test of a leaf (kernels/shared/ub_bvh.h): the host's SSE form equals the shared
-// one bit for bit, a line it rejects ub_beam_beam_near rejects too (the filter never drops a
-// pair), and ub_block_lanes masks exactly the block's lanes inside a leaf's range. Lines at
-// every angle (parallel ones included) and separations around the radius.
+// one bit for bit, a part it rejects ub_bb1d_pair's geometry (ub_beam_beam_near, then
+// ub_beam_part_holds) rejects too (the filter never drops a pair), and ub_block_lanes masks
+// exactly the block's lanes inside a leaf's range. Lines at every angle (parallel ones
+// included), separations around the radius, parts of beams of length 4 with ranges around the
+// closest points, last parts among them.
 TEST(Bvh, BeamLineFilterEqualsTheSharedOneAndDropsNoPair) {
     Rng rng(31, 4);
     int near = 0, pairs = 0;
@@ -252,13 +255,24 @@ TEST(Bvh, BeamLineFilterEqualsTheSharedOneAndDropsNoPair) {
         const Vec3 o = randomIn(rng, -2.0f, 2.0f);
         const Vec3 d = sampleUniformSphere(rng.uniform2());
         ub_beam_keys4 keys{};
+        ub_beam_part parts[4];
         ub_float3 oB[4], dB[4];
         for (int j = 0; j < 4; ++j) {
             Vec3 dj = sampleUniformSphere(rng.uniform2());
             if (k % 17 == j) dj = d;  // parallel
-            const Vec3 oj = o + d * (4.0f * rng.uniform()) + randomIn(rng, -0.3f, 0.3f);
-            keys.ox[j] = oj.x, keys.oy[j] = oj.y, keys.oz[j] = oj.z;
-            keys.dx[j] = dj.x, keys.dy[j] = dj.y, keys.dz[j] = dj.z;
+            // The beam's origin 0-2 units back along it, so the closest point falls in 0-4.
+            const Vec3 oj = o + d * (4.0f * rng.uniform()) + randomIn(rng, -0.3f, 0.3f) -
+                            dj * (2.0f * rng.uniform());
+            ub_beam_part& part = parts[j];
+            part = ub_beam_part{};
+            for (int a = 0; a < 3; ++a) {
+                part.origin[a] = oj[a];
+                part.dir[a] = dj[a];
+            }
+            part.length = 4.0f;
+            part.t0 = k % 5 == 0 ? 0.0f : 3.0f * rng.uniform();
+            part.t1 = k % 7 == 0 ? 4.0f : std::min(4.0f, part.t0 + 1.5f * rng.uniform());
+            ub_beam_keys4_set(&keys, j, part);
             oB[j] = ub_make_float3(oj.x, oj.y, oj.z);
             dB[j] = ub_make_float3(dj.x, dj.y, dj.z);
         }
@@ -269,12 +283,15 @@ TEST(Bvh, BeamLineFilterEqualsTheSharedOneAndDropsNoPair) {
         for (int j = 0; j < 4; ++j) {
             float tA = 0, tB = 0, sinTheta = 0;
             const bool pair =
-                ub_beam_beam_near(oo, dd, 4.0f, oB[j], dB[j], 4.0f, r2, &tA, &tB, &sinTheta);
+                ub_beam_beam_near(oo, dd, 4.0f, oB[j], dB[j], 4.0f, r2, &tA, &tB, &sinTheta) &&
+                ub_beam_part_holds(parts[j], tB, parts[j].length);
             pairs += pair;
             near += (mask >> j) & 1u;
             if (pair) ASSERT_TRUE((mask >> j) & 1u) << "case " << k << " lane " << j;
         }
     }
+    std::printf("[ bvh      ] beam filter: %d pairs, %d passed the filter of 200000 parts\n", pairs,
+                near);
     EXPECT_GT(pairs, 10000);
     EXPECT_GT(near, pairs);
     for (uint32_t first = 0; first < 12; ++first)
