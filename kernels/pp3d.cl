@@ -8,14 +8,15 @@
 #include "ub_pp3d.h"
 #include "ub_surf.h"
 
-/* Arguments: the lookup (photons, grid), then the tail every estimate kernel shares (queries,
- * their count, media, MIS constants, radius, normalisation, path lengths, results). */
+/* Arguments: the lookup (photons, grid with its keys), then the tail every estimate kernel shares
+ * (queries, their count, media, MIS constants, radius, normalisation, path lengths, results). */
 __kernel void ub_pp3d_estimate(__global const ub_photon_point* photons,
                                __global const uint* cellEnds, __global const uint* indices,
-                               ub_hash_grid grid, __global const ub_query_point* queries,
-                               uint queryCount, __global const ub_medium_info* media,
-                               ub_mis_constants mis, float radius, float normalization,
-                               uint minLength, uint maxLength, __global float* out) {
+                               __global const float* keys, ub_hash_grid grid,
+                               __global const ub_query_point* queries, uint queryCount,
+                               __global const ub_medium_info* media, ub_mis_constants mis,
+                               float radius, float normalization, uint minLength, uint maxLength,
+                               __global float* out) {
     uint i = get_global_id(0);
     if (i >= queryCount) return;
     ub_query_point q = queries[i];
@@ -28,13 +29,12 @@ __kernel void ub_pp3d_estimate(__global const ub_photon_point* photons,
         uint b = buckets[k];
         uint begin = b == 0 ? 0u : cellEnds[b - 1], end = cellEnds[b];
         for (uint j = begin; j < end; ++j) {
-            /* The distance first, from the position alone, as the host's HashGrid::query
-             * does: most candidates end there, and the 80-byte record straddles two cache
-             * lines (ub_pp3d_contribution tests it again). */
-            __global const ub_photon_point* pp = photons + indices[j];
-            if (!ub_hash_within(grid, ub_make_float3(pp->pos[0], pp->pos[1], pp->pos[2]), qp))
-                continue;
-            ub_photon_point ph = *pp;
+            /* The distance first, from the position in bucket order (HashGrid::keys), as the
+             * host's HashGrid::query does: most candidates end there, and the 80-byte record
+             * is read only for the others (ub_pp3d_contribution tests it again). */
+            float4 key = vload4(j, keys);
+            if (!ub_hash_within(grid, ub_make_float3(key.x, key.y, key.z), qp)) continue;
+            ub_photon_point ph = photons[indices[j]];
             ub_float3 c = ub_pp3d_contribution(mis, ph, q, g, radius * radius, normalization,
                                                minLength, maxLength);
             sx += c.x;

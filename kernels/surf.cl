@@ -6,12 +6,13 @@
 #include "ub_medium_homogeneous.h"
 #include "ub_surf.h"
 
-/* Arguments: the lookup (photons, grid, coating tables), then the tail every estimate kernel
- * shares (queries, their count, media (unused here), MIS constants, radius, normalisation,
+/* Arguments: the lookup (photons, grid with its keys, coating tables), then the tail every estimate
+ * kernel shares (queries, their count, media (unused here), MIS constants, radius, normalisation,
  * path lengths, results). */
 __kernel void ub_surf_estimate(__global const ub_light_vertex* photons,
                                __global const uint* cellEnds, __global const uint* indices,
-                               ub_hash_grid grid, __global const float* tables,
+                               __global const float* keys, ub_hash_grid grid,
+                               __global const float* tables,
                                __global const ub_surface_query* queries, uint queryCount,
                                __global const ub_medium_info* media, ub_mis_constants mis,
                                float radius, float normalization, uint minLength, uint maxLength,
@@ -33,9 +34,9 @@ __kernel void ub_surf_estimate(__global const ub_light_vertex* photons,
         uint b = buckets[k];
         uint begin = b == 0 ? 0u : cellEnds[b - 1], end = cellEnds[b];
         for (uint j = begin; j < end; ++j) {
+            float4 key = vload4(j, keys); /* the position, in bucket order (HashGrid::keys) */
+            if (!ub_hash_within(grid, ub_make_float3(key.x, key.y, key.z), qp)) continue;
             __global const ub_light_vertex* gp = photons + indices[j];
-            ub_float3 pos = ub_make_float3(gp->position[0], gp->position[1], gp->position[2]);
-            if (!ub_hash_within(grid, pos, qp)) continue;
             if (!loaded) {
                 q = *gq;
                 loaded = 1;

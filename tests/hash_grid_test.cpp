@@ -74,7 +74,8 @@ TEST(HashGrid, VectorOfStructsOverload) {
 }
 
 // The build hashes in parallel above 16,384 points (estimators/hash_grid.cpp): the grid is
-// the one a single thread builds, entry for entry, and its queries still equal brute force.
+// the one a single thread builds, entry for entry, its keys are the points' positions in
+// bucket order, and its queries still equal brute force.
 TEST(HashGrid, ParallelBuildEqualsTheBuildOnOneThread) {
     std::vector<Photon> pts(50000);
     Rng rng(91, 2);
@@ -85,6 +86,14 @@ TEST(HashGrid, ParallelBuildEqualsTheBuildOnOneThread) {
     single.execute([&] { one.build(&pts[0].pos, pts.size(), sizeof(Photon), 0.01f); });
     EXPECT_EQ(many.cellEnds(), one.cellEnds());
     EXPECT_EQ(many.indices(), one.indices());
+    EXPECT_EQ(many.keys(), one.keys());
+    ASSERT_EQ(many.keys().size(), 4 * pts.size());
+    for (size_t i = 0; i < pts.size(); ++i) {
+        const Vec3& p = pts[many.indices()[i]].pos;
+        ASSERT_EQ(many.keys()[4 * i], p.x) << i;
+        ASSERT_EQ(many.keys()[4 * i + 1], p.y) << i;
+        ASSERT_EQ(many.keys()[4 * i + 2], p.z) << i;
+    }
     for (int a = 0; a < 3; ++a) EXPECT_EQ(many.params().lo[a], one.params().lo[a]);
     checkAgainstBruteForce(pts, 0.01f, 0, 17);
 }

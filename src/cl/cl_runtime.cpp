@@ -623,7 +623,7 @@ void ClRuntime::estimateSurf(const std::vector<LightVertex>& photons, const Hash
     if (photons.empty()) return out->assign(queries.size(), Rgb(0.0f));
     runEstimate(surf_, "clEnqueueNDRangeKernel(ub_surf_estimate)",
                 {bufferArg(photons), bufferArg(grid.cellEnds()), bufferArg(grid.indices()),
-                 scalarArg(grid.params()), bufferArg(tables)},
+                 bufferArg(grid.keys()), scalarArg(grid.params()), bufferArg(tables)},
                 bufferArg(queries), queries.size(), a, out);
 }
 
@@ -643,7 +643,7 @@ void ClRuntime::estimatePP3D(const std::vector<ub_photon_point>& photons, const 
     if (photons.empty()) return out->assign(queries.size(), Rgb(0.0f));
     runEstimate(pp3d_, "clEnqueueNDRangeKernel(ub_pp3d_estimate)",
                 {bufferArg(photons), bufferArg(grid.cellEnds()), bufferArg(grid.indices()),
-                 scalarArg(grid.params())},
+                 bufferArg(grid.keys()), scalarArg(grid.params())},
                 bufferArg(queries), queries.size(), a, out);
 }
 

@@ -52,7 +52,18 @@ void HashGrid::build(const Vec3* positions, size_t count, size_t stride, float r
         sum += n;
     }
     for (size_t i = 0; i < count; ++i) indices_[cellEnds_[bucket[i]]++] = uint32_t(i);
-    // cellEnds_[b] now holds the end of bucket b.
+    // cellEnds_[b] now holds the end of bucket b. The positions in that order.
+    keys_.resize(4 * count);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kGrain),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t i = r.begin(); i < r.end(); ++i) {
+                              const Vec3& p = at(positions, stride, indices_[i]);
+                              keys_[4 * i] = p.x;
+                              keys_[4 * i + 1] = p.y;
+                              keys_[4 * i + 2] = p.z;
+                              keys_[4 * i + 3] = 0.0f;
+                          }
+                      });
 }
 
 }  // namespace ub
