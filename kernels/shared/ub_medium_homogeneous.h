@@ -40,8 +40,4 @@ UB_INLINE float ub_homogeneous_cont_prob(ub_medium_info m) {
                                m.sigmaT[2]);
 }
 
-UB_INLINE ub_segment_eval ub_homogeneous_segment(ub_medium_info m, float t) {
-    return ub_homogeneous_segment_cp(m, t, ub_homogeneous_cont_prob(m));
-}
-
 #endif /* UB_MEDIUM_HOMOGENEOUS_H */

@@ -20,7 +20,6 @@ void BeamMedium::reset(const Scene& scene, const ub_beam& b) {
     built_ = false;
     pieces_.clear();
     info_ = mediumInfo(*medium_);
-    homogeneous_ = medium_->type == MediumType::kHomogeneous;
     contProb_ = ub_homogeneous_cont_prob(info_);
 }
 

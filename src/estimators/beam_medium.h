@@ -35,7 +35,7 @@ class BeamMedium {
     /// Homogeneous media inline, with their continuation probability computed once: the
     /// closed form was 16% of bb1d's host pass on mirrorballs as a call (perf).
     ub_segment_eval eval(float t) const {
-        return homogeneous_ ? ub_homogeneous_segment_cp(info_, t, contProb_) : evalOther(t);
+        return info_.homogeneous ? ub_homogeneous_segment_cp(info_, t, contProb_) : evalOther(t);
     }
     size_t bytes() const { return pieces_.capacity() * sizeof(ub_beam_piece); }
     /// The table (empty: homogeneous or trilinear medium, or a beam of no length).
@@ -45,7 +45,7 @@ class BeamMedium {
     const Medium* medium_ = nullptr;
     const ub_beam* beam_ = nullptr;
     ub_segment_eval evalOther(float t) const;
-    bool tabulated_ = false, built_ = false, homogeneous_ = false;
+    bool tabulated_ = false, built_ = false;
     float contProb_ = 0.0f;  ///< homogeneous media: ub_homogeneous_cont_prob(info_)
     std::vector<ub_beam_piece> pieces_;
     ub_medium_info info_{};  ///< homogeneous media: the closed form of the kernels

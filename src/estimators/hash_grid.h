@@ -67,10 +67,6 @@ class HashGrid {
     const std::vector<uint32_t>& indices() const { return indices_; }
     /// 4 floats per entry of indices(): the point's position and 0, in bucket order.
     const std::vector<float>& keys() const { return keys_; }
-    size_t bytes() const {
-        return indices_.capacity() * sizeof(uint32_t) + cellEnds_.capacity() * sizeof(uint32_t) +
-               keys_.capacity() * sizeof(float);
-    }
 
   private:
     static const Vec3& at(const Vec3* base, size_t stride, size_t i) {
