@@ -21,14 +21,12 @@ __kernel void ub_pp3d_estimate(__global const ub_photon_point* photons,
     if (i >= queryCount) return;
     ub_query_point q = queries[i];
     float g = media[q.mediumId].g;
-    ub_uint buckets[8];
+    ub_uint begins[8], ends[8];
     ub_float3 qp = ub_f3_from(q.pos);
-    int nb = ub_hash_buckets(grid, qp, buckets);
+    int nr = ub_hash_ranges(grid, qp, cellEnds, begins, ends);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    for (int k = 0; k < nb; ++k) {
-        uint b = buckets[k];
-        uint begin = b == 0 ? 0u : cellEnds[b - 1], end = cellEnds[b];
-        for (uint j = begin; j < end; ++j) {
+    for (int k = 0; k < nr; ++k) {
+        for (uint j = begins[k]; j < ends[k]; ++j) {
             /* The distance first, from the position in bucket order (HashGrid::keys), as the
              * host's HashGrid::query does: most candidates end there, and the 80-byte record
              * is read only for the others (ub_pp3d_contribution tests it again). */

@@ -27,13 +27,11 @@ __kernel void ub_surf_estimate(__global const ub_light_vertex* photons,
     float r2 = radius * radius;
     ub_surface_query q;
     int loaded = 0;
-    ub_uint buckets[8];
-    int nb = ub_hash_buckets(grid, qp, buckets);
+    ub_uint begins[8], ends[8];
+    int nr = ub_hash_ranges(grid, qp, cellEnds, begins, ends);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    for (int k = 0; k < nb; ++k) {
-        uint b = buckets[k];
-        uint begin = b == 0 ? 0u : cellEnds[b - 1], end = cellEnds[b];
-        for (uint j = begin; j < end; ++j) {
+    for (int k = 0; k < nr; ++k) {
+        for (uint j = begins[k]; j < ends[k]; ++j) {
             float4 key = vload4(j, keys); /* the position, in bucket order (HashGrid::keys) */
             if (!ub_hash_within(grid, ub_make_float3(key.x, key.y, key.z), qp)) continue;
             __global const ub_light_vertex* gp = photons + indices[j];

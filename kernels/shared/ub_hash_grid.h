@@ -58,6 +58,26 @@ UB_INLINE int ub_hash_buckets(ub_hash_grid g, ub_float3 q, UB_PRIVATE ub_uint* b
     return nb;
 }
 
+/* The candidates of a query at q: the index ranges [begins[k], ends[k]) of the distinct
+ * buckets of its 2x2x2 block (ub_hash_buckets, in that order) that hold points; returns how
+ * many (<= 8). cellEnds: the end of each bucket in bucket order. Every bucket's bounds are
+ * read before any candidate, so that their cache misses overlap rather than each waiting for
+ * the previous bucket's candidates (surf kernel about 5% faster on cornell-fog). */
+UB_INLINE int ub_hash_ranges(ub_hash_grid g, ub_float3 q, UB_GLOBAL const ub_uint* cellEnds,
+                             UB_PRIVATE ub_uint* begins, UB_PRIVATE ub_uint* ends) {
+    ub_uint buckets[8];
+    int nb = ub_hash_buckets(g, q, buckets);
+    int n = 0;
+    for (int k = 0; k < nb; ++k) {
+        ub_uint b = buckets[k];
+        ub_uint begin = b == 0 ? 0u : cellEnds[b - 1], end = cellEnds[b];
+        begins[n] = begin;
+        ends[n] = end;
+        n += begin < end ? 1 : 0;
+    }
+    return n;
+}
+
 /* Whether point p lies within the grid's radius of q: the range test of a query, the host's
  * (HashGrid::query) and the kernels' before they read a candidate's record. */
 UB_INLINE int ub_hash_within(ub_hash_grid g, ub_float3 p, ub_float3 q) {

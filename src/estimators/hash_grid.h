@@ -87,13 +87,11 @@ class HashGrid {
 template <class Visit>
 void HashGrid::query(const Vec3& q, const Vec3* positions, size_t stride, Visit&& visit) const {
     if (indices_.empty()) return;
-    uint32_t buckets[8];
+    uint32_t begins[8], ends[8];
     const ub_float3 qf = ub_make_float3(q.x, q.y, q.z);
-    const int nb = ub_hash_buckets(params_, qf, buckets);
-    for (int j = 0; j < nb; ++j) {
-        uint32_t b = buckets[j];
-        uint32_t begin = b == 0 ? 0 : cellEnds_[b - 1], end = cellEnds_[b];
-        for (uint32_t i = begin; i < end; ++i) {
+    const int nr = ub_hash_ranges(params_, qf, cellEnds_.data(), begins, ends);
+    for (int j = 0; j < nr; ++j) {
+        for (uint32_t i = begins[j]; i < ends[j]; ++i) {
             const float* k = &keys_[4 * size_t(i)];
             if (ub_hash_within(params_, ub_make_float3(k[0], k[1], k[2]), qf)) visit(indices_[i]);
         }
