@@ -16,7 +16,7 @@
 /* count[c] == UB_BVH_NONE: no child c; count[c] == 0: child c is the inner node child[c];
  * else child c is a leaf holding prims[child[c] .. child[c] + count[c]). 128 bytes. */
 #define UB_BVH_NONE 0xFFFFFFFFu
-typedef struct {
+typedef struct UB_CACHE_ALIGNED {
     float loX[4], loY[4], loZ[4];
     float hiX[4], hiY[4], hiZ[4];
     ub_uint child[4];
@@ -46,7 +46,7 @@ typedef struct {
  * pair test's scalar one differently (seen on PoCL: without the margin the kernel lost pairs
  * at parts' ends, and its bunny bb1d image moved from 5.3e-7 to 1.3e-6 of the host twin's;
  * with it, back to 5.3e-7). 128 bytes. */
-typedef struct {
+typedef struct UB_CACHE_ALIGNED {
     float ox[4], oy[4], oz[4];
     float dx[4], dy[4], dz[4];
     float t0[4], t1[4];

@@ -56,6 +56,16 @@ typedef uint32_t ub_uint;
 #define ub_erfc(x) std::erfc(x)
 #endif
 
+/* A record aligned to a cache line (typedef struct UB_CACHE_ALIGNED {...} name;): a 128-byte
+ * BVH node or block of keys then spans two 64-byte lines, not three when it starts mid-line
+ * (malloc aligns to 16). Host vectors of such records allocate aligned (C++17); device buffers
+ * are the runtime's (CL_MEM_USE_HOST_PTR: the host vector's). Sizes and offsets do not change. */
+#ifdef __OPENCL_C_VERSION__
+#define UB_CACHE_ALIGNED __attribute__((aligned(64)))
+#else
+#define UB_CACHE_ALIGNED alignas(64)
+#endif
+
 #define UB_PI 3.14159265358979323846f
 #define UB_INV_PI 0.31830988618379067154f
 

@@ -44,7 +44,7 @@ typedef struct {
  * block j; the last block's missing lanes hold medium UB_NO_MEDIUM, which no query is in), as a
  * structure of arrays, so one load tests four candidates (ub_pb2d_near4). 64 bytes. */
 #define UB_NO_MEDIUM 0xFFFFFFFFu
-typedef struct {
+typedef struct UB_CACHE_ALIGNED {
     float px[4], py[4], pz[4];
     ub_uint mediumId[4];
 } ub_photon_keys4;
