@@ -242,6 +242,31 @@ TEST(Bvh, ParallelBuildEqualsTheBuildOnOneThread) {
     EXPECT_EQ(orderOne, orderMany);
 }
 
+// With leaves of a multiple of four, every leaf but the one holding the last items starts on
+// a block of four in leaf order and holds whole blocks (the walks test candidates four to a
+// block), for any count of boxes; leaves of other sizes are plain median splits.
+TEST(Bvh, LeavesOfAMultipleOfFourHoldWholeBlocks) {
+    Rng rng(22, 1);
+    for (int count : {12, 13, 1000, 20003}) {
+        const std::vector<Bounds3> boxes = beamBoxes(rng, count);
+        Bvh bvh;
+        bvh.build(boxes, 12);
+        size_t leaves = 0, items = 0;
+        for (const BvhNode& n : bvh.nodes())
+            for (int c = 0; c < 4; ++c) {
+                if (n.count[c] == UB_BVH_NONE || n.count[c] == 0) continue;
+                ++leaves;
+                items += n.count[c];
+                EXPECT_LE(n.count[c], 12u);
+                EXPECT_EQ(n.child[c] % 4, 0u) << count << " boxes";
+                if (n.child[c] + n.count[c] != uint32_t(count))
+                    EXPECT_EQ(n.count[c] % 4, 0u) << count << " boxes";
+            }
+        EXPECT_EQ(items, size_t(count));
+        EXPECT_GE(leaves, size_t(count + 11) / 12);
+    }
+}
+
 // bb1d's first test of a leaf (kernels/shared/ub_bvh.h): the host's SSE form equals the shared
 // one bit for bit, a part it rejects ub_bb1d_pair's geometry (ub_beam_beam_near, then
 // ub_beam_part_holds) rejects too (the filter never drops a pair), and ub_block_lanes masks

@@ -7,12 +7,14 @@
 // Built top-down as a binary tree: a node's primitives are split at the median of their box
 // centres along the axis of largest centre extent, down to leaves of at most leafSize
 // primitives (O(n log n) with nth_element; the leaf sizes are measured, docs/performance.md).
-// Median splits keep the tree balanced whatever the beam distribution. The binary tree is
-// then collapsed into four-wide nodes (kernels/shared/ub_bvh.h): each node takes its
-// binary children and opens the inner one with the largest box surface until it holds four,
-// so one node load tests four boxes. A walk here is bound by the latency of its node loads
-// (bb1d on mirrorballs: about 300 nodes per query beam for 4.5 pairs), and the wide nodes
-// halve the loads and the depth (measured, docs/performance.md).
+// Median splits keep the tree balanced whatever the beam distribution; with leaves of a
+// multiple of four the left half takes a multiple of four, so leaves hold whole blocks of
+// four candidates (ub_beam_keys4, ub_photon_keys4) and start on one in leaf order. The binary tree
+// is then collapsed into four-wide nodes (kernels/shared/ub_bvh.h): each node takes its binary
+// children and opens the inner one with the largest box surface until it holds four, so one node
+// load tests four boxes. A walk here is bound by the latency of its node loads (bb1d on
+// mirrorballs: about 300 nodes per query beam for 4.5 pairs), and the wide nodes halve the loads
+// and the depth (measured, docs/performance.md).
 //
 // Own code rather than Embree's user geometry: the nodes are a flat array of
 // fixed-size records, which the OpenCL backend uploads and traverses as they are
