@@ -18,14 +18,14 @@ typedef struct {
     float lo[3];       /* corner of the points' bounding box */
     float invCellSize; /* 1 / (2 r) */
     float radiusSqr;
-    ub_uint cellCount; /* buckets, >= 1 */
+    ub_uint cellCount; /* buckets, a power of two (HashGrid::build) */
     ub_uint pad0, pad1;
 } ub_hash_grid;
 
-/* Bucket of integer cell (x, y, z) (Teschner et al. 2003). */
+/* Bucket of integer cell (x, y, z) (Teschner et al. 2003), of a power-of-two count. */
 UB_INLINE ub_uint ub_hash_cell(ub_hash_grid g, int x, int y, int z) {
     ub_uint h = ((ub_uint)(x)*73856093u) ^ ((ub_uint)(y)*19349663u) ^ ((ub_uint)(z)*83492791u);
-    return h % g.cellCount;
+    return h & (g.cellCount - 1u);
 }
 
 /* Bucket of a point. */
@@ -58,15 +58,16 @@ UB_INLINE int ub_hash_buckets(ub_hash_grid g, ub_float3 q, UB_PRIVATE ub_uint* b
     return nb;
 }
 
-/* The candidates of a query at q: the index ranges [begins[k], ends[k]) of the distinct
- * buckets of its 2x2x2 block (ub_hash_buckets, in that order) that hold points; returns how
- * many (<= 8). cellEnds: the end of each bucket in bucket order. Every bucket's bounds are
- * read before any candidate, so that their cache misses overlap rather than each waiting for
- * the previous bucket's candidates (surf kernel about 5% faster on cornell-fog). */
-UB_INLINE int ub_hash_ranges(ub_hash_grid g, ub_float3 q, UB_GLOBAL const ub_uint* cellEnds,
-                             UB_PRIVATE ub_uint* begins, UB_PRIVATE ub_uint* ends) {
-    ub_uint buckets[8];
-    int nb = ub_hash_buckets(g, q, buckets);
+/* The index ranges [begins[k], ends[k]) of the buckets buckets[0 .. nb - 1] (from
+ * ub_hash_buckets) that hold points, in that order; returns how many (<= 8). cellEnds: the
+ * end of each bucket in bucket order. Every bucket's bounds are read before any candidate,
+ * so that their cache misses overlap rather than each waiting for the previous bucket's
+ * candidates (surf kernel about 5% faster on cornell-fog). The kernels call it apart from
+ * ub_hash_buckets, after a barrier, so that PoCL runs the bounds loads of a whole work-group
+ * back to back (kernels/surf.cl). */
+UB_INLINE int ub_hash_bucket_ranges(UB_PRIVATE const ub_uint* buckets, int nb,
+                                    UB_GLOBAL const ub_uint* cellEnds, UB_PRIVATE ub_uint* begins,
+                                    UB_PRIVATE ub_uint* ends) {
     int n = 0;
     for (int k = 0; k < nb; ++k) {
         ub_uint b = buckets[k];
@@ -76,6 +77,15 @@ UB_INLINE int ub_hash_ranges(ub_hash_grid g, ub_float3 q, UB_GLOBAL const ub_uin
         n += begin < end ? 1 : 0;
     }
     return n;
+}
+
+/* The candidates of a query at q: the ranges of the distinct buckets of its 2x2x2 block
+ * (ub_hash_buckets, then ub_hash_bucket_ranges); returns how many (<= 8). */
+UB_INLINE int ub_hash_ranges(ub_hash_grid g, ub_float3 q, UB_GLOBAL const ub_uint* cellEnds,
+                             UB_PRIVATE ub_uint* begins, UB_PRIVATE ub_uint* ends) {
+    ub_uint buckets[8];
+    int nb = ub_hash_buckets(g, q, buckets);
+    return ub_hash_bucket_ranges(buckets, nb, cellEnds, begins, ends);
 }
 
 /* Whether point p lies within the grid's radius of q: the range test of a query, the host's

@@ -13,6 +13,12 @@ void HashGrid::build(const Vec3* positions, size_t count, size_t stride, float r
                      size_t cellCount) {
     radius_ = radius;
     if (cellCount == 0) cellCount = count > 0 ? count : 1;
+    // A power of two, so that a cell's bucket is a mask rather than an integer division
+    // (ub_hash_cell): a query hashes eight cells, and the divisions were 3-6% of the surf and
+    // pp3d passes (perf, cornell-fog; docs/performance.md).
+    size_t buckets = 1;
+    while (buckets < cellCount) buckets <<= 1;
+    cellCount = buckets;
     cellEnds_.assign(cellCount, 0);
     indices_.resize(count);
     // The bounding corner and each point's bucket in parallel (min is exact in any order);

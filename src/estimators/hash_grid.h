@@ -25,7 +25,8 @@ class HashGrid {
   public:
     /// Builds the grid over positions[0..count) (the pointer is read during build only;
     /// `stride` is the distance in bytes between consecutive positions, so callers can
-    /// pass a member of an array of structs). cellCount 0 picks max(count, 1).
+    /// pass a member of an array of structs). cellCount 0 picks max(count, 1); either is
+    /// rounded up to a power of two.
     void build(const Vec3* positions, size_t count, size_t stride, float radius,
                size_t cellCount = 0);
     template <class T>
@@ -58,6 +59,23 @@ class HashGrid {
         if (items.empty()) return;
         query(q, reinterpret_cast<const Vec3*>(&(items[0].*member)[0]), sizeof(T), visit);
     }
+
+    /// Queries in blocks, in the phases the kernels run a work-group in (kernels/surf.cl):
+    /// blockRanges finds the buckets of every query of the block, then reads every bucket's
+    /// bounds, so that the bounds' cache misses of a block overlap where one query at a time
+    /// waited on its own; candidates(r, k, visit) then visits query k's points within the
+    /// radius (visit(index), each once, in the order query() visits them).
+    static constexpr size_t kBlock = 64;
+    struct BlockRanges {
+        ub_float3 q[kBlock];
+        int count[kBlock];
+        uint32_t begins[kBlock][8], ends[kBlock][8];
+    };
+    /// Queries k = 0 .. n - 1 (n <= kBlock) at posOf(k).
+    template <class PosOf>
+    void blockRanges(size_t n, PosOf&& posOf, BlockRanges* r) const;
+    template <class Visit>
+    void candidates(const BlockRanges& r, size_t k, Visit&& visit) const;
 
     float radius() const { return radius_; }
     size_t cellCount() const { return cellEnds_.size(); }
@@ -96,6 +114,30 @@ void HashGrid::query(const Vec3& q, const Vec3* positions, size_t stride, Visit&
             if (ub_hash_within(params_, ub_make_float3(k[0], k[1], k[2]), qf)) visit(indices_[i]);
         }
     }
+}
+
+template <class PosOf>
+void HashGrid::blockRanges(size_t n, PosOf&& posOf, BlockRanges* r) const {
+    uint32_t buckets[kBlock][8];
+    int nb[kBlock];
+    for (size_t k = 0; k < n; ++k) {
+        const Vec3 q = posOf(k);
+        r->q[k] = ub_make_float3(q.x, q.y, q.z);
+        nb[k] = indices_.empty() ? 0 : ub_hash_buckets(params_, r->q[k], buckets[k]);
+    }
+    for (size_t k = 0; k < n; ++k)
+        r->count[k] =
+            ub_hash_bucket_ranges(buckets[k], nb[k], cellEnds_.data(), r->begins[k], r->ends[k]);
+}
+
+template <class Visit>
+void HashGrid::candidates(const BlockRanges& r, size_t k, Visit&& visit) const {
+    for (int j = 0; j < r.count[k]; ++j)
+        for (uint32_t i = r.begins[k][j]; i < r.ends[k][j]; ++i) {
+            const float* p = &keys_[4 * size_t(i)];
+            if (ub_hash_within(params_, ub_make_float3(p[0], p[1], p[2]), r.q[k]))
+                visit(indices_[i]);
+        }
 }
 
 }  // namespace ub

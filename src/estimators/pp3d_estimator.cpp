@@ -21,20 +21,30 @@ void estimatePP3D(const VolumeEstimateInput& in, const HashGrid& grid, std::vect
     const float r = in.radius[UB_TECH_PP3D];
     // UPBP Table 1: K3 = 1 / ((4/3) pi r^3), over N_L light subpaths.
     const float normalization = ub_pp3d_normalization(in.lightPathCount, r);
-    forEachQuery(queries.size(), 64, out, pairs, [&](size_t i, size_t* found) {
-        const ub_query_point& q = queries[i];
-        const float g = in.scene->media[q.mediumId].g;
-        Rgb sum(0.0f);
-        grid.query(
-            Vec3(q.pos[0], q.pos[1], q.pos[2]), reinterpret_cast<const Vec3*>(photons[0].pos),
-            sizeof(ub_photon_point), [&](uint32_t j) {
-                ub_float3 c = ub_pp3d_contribution(in.mis, photons[j], q, g, r * r, normalization,
-                                                   ub_uint(in.minLength), ub_uint(in.maxLength));
-                sum += Rgb(c.x, c.y, c.z);
-                ++*found;
-            });
-        return sum;
-    });
+    forEachQueryBlock(
+        queries.size(), HashGrid::kBlock, out, pairs, [&](size_t begin, size_t end, size_t* found) {
+            HashGrid::BlockRanges ranges;
+            grid.blockRanges(
+                end - begin,
+                [&](size_t k) {
+                    const float* p = queries[begin + k].pos;
+                    return Vec3(p[0], p[1], p[2]);
+                },
+                &ranges);
+            for (size_t i = begin; i < end; ++i) {
+                const ub_query_point& q = queries[i];
+                const float g = in.scene->media[q.mediumId].g;
+                Rgb sum(0.0f);
+                grid.candidates(ranges, i - begin, [&](uint32_t j) {
+                    ub_float3 c =
+                        ub_pp3d_contribution(in.mis, photons[j], q, g, r * r, normalization,
+                                             ub_uint(in.minLength), ub_uint(in.maxLength));
+                    sum += Rgb(c.x, c.y, c.z);
+                    ++*found;
+                });
+                (*out)[i] = sum;
+            }
+        });
 }
 
 }  // namespace ub

@@ -113,20 +113,26 @@ void estimateSurface(const SurfaceMergeInput& in, const HashGrid& grid, std::vec
     *pairs = 0;
     if (photons.empty() || queries.empty()) return;
     const float radiusSqr = in.radius * in.radius;
-    forEachQuery(queries.size(), 64, out, pairs, [&](size_t i, size_t* found) {
-        const ub_surface_query& q = queries[i];
-        const float* coating =
-            in.tables->data() + size_t(q.bsdf.tableIndex) * UB_ROUGH_PLASTIC_TABLE_SIZE;
-        Rgb sum(0.0f);
-        grid.query(loadF3(q.pos), photons, &LightVertex::position, [&](uint32_t j) {
-            const ub_float3 c =
-                ub_surf_contribution(in.mis, &photons[j], &q, coating, radiusSqr,
-                                     ub_uint(in.minLength), ub_uint(in.maxLength), 0u);
-            sum += Rgb(c.x, c.y, c.z);
-            ++*found;
+    forEachQueryBlock(
+        queries.size(), HashGrid::kBlock, out, pairs, [&](size_t begin, size_t end, size_t* found) {
+            HashGrid::BlockRanges ranges;
+            grid.blockRanges(
+                end - begin, [&](size_t k) { return loadF3(queries[begin + k].pos); }, &ranges);
+            for (size_t i = begin; i < end; ++i) {
+                const ub_surface_query& q = queries[i];
+                const float* coating =
+                    in.tables->data() + size_t(q.bsdf.tableIndex) * UB_ROUGH_PLASTIC_TABLE_SIZE;
+                Rgb sum(0.0f);
+                grid.candidates(ranges, i - begin, [&](uint32_t j) {
+                    const ub_float3 c =
+                        ub_surf_contribution(in.mis, &photons[j], &q, coating, radiusSqr,
+                                             ub_uint(in.minLength), ub_uint(in.maxLength), 0u);
+                    sum += Rgb(c.x, c.y, c.z);
+                    ++*found;
+                });
+                (*out)[i] = sum * loadF3(q.throughput) * in.normalization;
+            }
         });
-        return sum * loadF3(q.throughput) * in.normalization;
-    });
 }
 
 void VertexCM::estimateSurfaceQueries(Image& out, Image* layer) {

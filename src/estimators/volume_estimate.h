@@ -108,6 +108,23 @@ void forEachQuery(size_t n, size_t grain, std::vector<Rgb>* out, size_t* pairs,
     *pairs = total;
 }
 
+/// forEachQuery for estimators that take their queries in blocks (HashGrid::queryBlock):
+/// estimate(begin, end, &found) writes (*out)[i] for i in [begin, end), blocks of at most
+/// `block` queries.
+template <class EstimateBlock>
+void forEachQueryBlock(size_t n, size_t block, std::vector<Rgb>* out, size_t* pairs,
+                       EstimateBlock&& estimate) {
+    std::atomic<size_t> total{0};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, (n + block - 1) / block),
+                      [&](const tbb::blocked_range<size_t>& range) {
+                          size_t found = 0;
+                          for (size_t b = range.begin(); b != range.end(); ++b)
+                              estimate(b * block, std::min(n, (b + 1) * block), &found);
+                          total += found;
+                      });
+    *pairs = total;
+}
+
 // The host twins, one per estimator (estimators/*_estimator.cpp): each adds its estimate of
 // query i to out[i].
 class HashGrid;
