@@ -28,6 +28,9 @@
 #ifndef UB_QUERY_PIECES
 #define UB_QUERY_PIECES 128
 #endif
+/* bb1d's candidates gathered before they are tested (ub_bb1d_flush); kPending of
+ * src/estimators/bb1d_estimator.cpp. */
+#define UB_BB1D_PENDING 32
 
 /* The walk of kernels/shared/ub_bvh.h, in the host twin's order (src/estimators/bvh.h): pop
  * a node; MASK (an expression of `n`, the node in global memory) gives the children that pass;
@@ -160,6 +163,47 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
     ub_store_f3(out, i, sx, sy, sz);
 }
 
+/* bb1d's candidates that passed the four-lane filter, pending[0 .. np - 1] in walk order, in
+ * two stages as the host twin handles them (src/estimators/bb1d_estimator.cpp): the pair test of
+ * each, whose part reads no longer wait on each other's cache misses, then the contributions of
+ * the pairs it accepted, in the same order (the sum is the walk order's). */
+static void ub_bb1d_flush(__global const ub_beam* beams, __global const ub_beam_part* parts,
+                          __global const ub_beam_piece* beamPieces, __global const uint* beamRanges,
+                          ub_medium_info m, float mCont, ub_grid_info gi, ub_grid_accessor* acc,
+                          const ub_beam* qb, ub_beam_piece* table, ub_uint* tableState,
+                          ub_mis_constants mis, float radius, float normalization, uint minLength,
+                          uint maxLength, const uint* pending, int np, float* sum) {
+    uint accepted[UB_BB1D_PENDING], beamOf[UB_BB1D_PENDING];
+    float tcs[UB_BB1D_PENDING], tls[UB_BB1D_PENDING], sins[UB_BB1D_PENDING];
+    for (int j = 0; j < np; ++j) beamOf[j] = parts[pending[j]].beam;
+    int nf = 0;
+    for (int j = 0; j < np; ++j) {
+        float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
+        if (!ub_bb1d_pair(*qb, parts[pending[j]], radius * radius, minLength, maxLength, &tc, &tl,
+                          &sinTheta))
+            continue;
+        accepted[nf] = beamOf[j];
+        tcs[nf] = tc;
+        tls[nf] = tl;
+        sins[nf] = sinTheta;
+        ++nf;
+    }
+    for (int j = 0; j < nf; ++j) {
+        uint beam = accepted[j];
+        ub_beam pb = beams[beam];
+        ub_segment_eval sl =
+            ub_photon_beam_segment(m, mCont, gi, acc, pb, tls[j],
+                                   beamPieces + beamRanges[2u * beam], beamRanges[2u * beam + 1u]);
+        ub_segment_eval sc = ub_query_beam_segment(m, mCont, gi, acc, *qb, tcs[j], table,
+                                                   UB_QUERY_PIECES, tableState);
+        ub_float3 c =
+            ub_bb1d_contribution(mis, pb, *qb, sl, sc, tls[j], tcs[j], sins[j], m.g, normalization);
+        sum[0] += c.x;
+        sum[1] += c.y;
+        sum[2] += c.z;
+    }
+}
+
 /* bb1d: query beams x photon beams (BVH over the diced beam parts). */
 __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_beam_part* parts,
                                __global const ub_beam_keys4* lines,
@@ -182,32 +226,27 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
     ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
     ub_beam_piece table[UB_QUERY_PIECES];
     ub_uint tableState = UB_TABLE_UNBUILT;
-    float sx = 0.0f, sy = 0.0f, sz = 0.0f;
+    float sum[3] = {0.0f, 0.0f, 0.0f};
+    uint pending[UB_BB1D_PENDING];
+    int np = 0;
     /* A leaf's candidates four at a time by their lines first, as the host twin does
-     * (src/estimators/bb1d_estimator.cpp). */
+     * (src/estimators/bb1d_estimator.cpp), gathered and handled UB_BB1D_PENDING at a time. */
     UB_BVH_LEAVES_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qb.length))
     for (uint b = leafFirst / 4u; b * 4u < leafEnd; ++b) {
         uint near = ub_beam_lines_near4_global(lines + b, o, d, radius * radius) &
                     ub_block_lanes(b, leafFirst, leafEnd);
         for (; near != 0u; near &= near - 1u) {
-            uint k = b * 4u + (31u - clz(near & (0u - near)));
-            ub_beam_part part = parts[k];
-            float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
-            if (!ub_bb1d_pair(qb, part, radius * radius, minLength, maxLength, &tc, &tl, &sinTheta))
-                continue;
-            ub_beam pb = beams[part.beam];
-            ub_segment_eval sl = ub_photon_beam_segment(m, mCont, gi, &acc, pb, tl,
-                                                        beamPieces + beamRanges[2u * part.beam],
-                                                        beamRanges[2u * part.beam + 1u]);
-            ub_segment_eval sc = ub_query_beam_segment(m, mCont, gi, &acc, qb, tc, table,
-                                                       UB_QUERY_PIECES, &tableState);
-            ub_float3 c =
-                ub_bb1d_contribution(mis, pb, qb, sl, sc, tl, tc, sinTheta, m.g, normalization);
-            sx += c.x;
-            sy += c.y;
-            sz += c.z;
+            pending[np++] = b * 4u + (31u - clz(near & (0u - near)));
+            if (np == UB_BB1D_PENDING) {
+                ub_bb1d_flush(beams, parts, beamPieces, beamRanges, m, mCont, gi, &acc, &qb, table,
+                              &tableState, mis, radius, normalization, minLength, maxLength,
+                              pending, np, sum);
+                np = 0;
+            }
         }
     }
     UB_BVH_LEAVES_END
-    ub_store_f3(out, i, sx, sy, sz);
+    ub_bb1d_flush(beams, parts, beamPieces, beamRanges, m, mCont, gi, &acc, &qb, table, &tableState,
+                  mis, radius, normalization, minLength, maxLength, pending, np, sum);
+    ub_store_f3(out, i, sum[0], sum[1], sum[2]);
 }

@@ -16,6 +16,12 @@
 
 namespace ub {
 
+namespace {
+/// Candidates gathered before a flush (see estimateBB1D): a query beam of mirrorballs finds
+/// 4.5 pairs on average, and a flush of a full buffer costs nothing more than several.
+constexpr int kPending = 32;
+}  // namespace
+
 void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
                   const std::vector<BeamPart>& parts, const std::vector<ub_beam_keys4>& lines,
                   const std::vector<BeamMedium>& photonMedia, std::vector<Rgb>* out,
@@ -25,27 +31,56 @@ void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
     if (beams.empty() || queries.empty()) return;
     const float r = in.radius[UB_TECH_BB1D];
     const float normalization = ub_bb1d_normalization(in.beamPathCount, r);
-    forEachQuery(queries.size(), 16, out, pairs, [&](size_t i, size_t* found) {
+    forEachQuery(queries.size(), 16, out, pairs, [&](size_t i, size_t* pairsFound) {
         const ub_beam& qb = queries[i];
         const float g = in.scene->media[qb.mediumId].g;
         const ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
         BeamMedium queryMedium;  // tabulated when the first pair is found
         queryMedium.reset(*in.scene, qb);
         Rgb sum(0.0f);
-        auto pair = [&](uint32_t k) {
-            const BeamPart& part = parts[k];
-            float tc = 0.0f, tl = 0.0f, sinTheta = 0.0f;
-            if (!ub_bb1d_pair(qb, part, r * r, ub_uint(in.minLength), ub_uint(in.maxLength), &tc,
-                              &tl, &sinTheta))
-                return;
-            const ub_beam& pb = beams[part.beam];
-            if (!queryMedium.built()) queryMedium.build();
-            const ub_segment_eval sl = photonMedia[part.beam].eval(tl);
-            const ub_segment_eval sc = queryMedium.eval(tc);
-            const ub_float3 c =
-                ub_bb1d_contribution(in.mis, pb, qb, sl, sc, tl, tc, sinTheta, g, normalization);
-            sum += Rgb(c.x, c.y, c.z);
-            ++*found;
+        // The candidates the four-lane filter passes are gathered in walk order and handled
+        // in three stages, so that the cache misses of several candidates overlap where each
+        // waited on its own: their parts are prefetched; the pair test reads each part, and
+        // prefetches the photon beam and its medium of each pair it accepts; then the pairs'
+        // contributions, in the order the walk found them (the sum is as before, bit for bit).
+        // The first read of a candidate's part was 18% of the pass (perf, mirrorballs).
+        struct Accepted {
+            uint32_t part;
+            float tc, tl, sinTheta;
+        };
+        uint32_t pending[kPending];
+        Accepted accepted[kPending];
+        int np = 0;
+        auto flush = [&] {
+            for (int k = 0; k < np; ++k) {
+                const char* p = reinterpret_cast<const char*>(&parts[pending[k]]);
+                __builtin_prefetch(p);
+                __builtin_prefetch(p + sizeof(BeamPart) - 1);  // a part may straddle two lines
+            }
+            int nf = 0;
+            for (int k = 0; k < np; ++k) {
+                const BeamPart& part = parts[pending[k]];
+                Accepted& f = accepted[nf];
+                if (!ub_bb1d_pair(qb, part, r * r, ub_uint(in.minLength), ub_uint(in.maxLength),
+                                  &f.tc, &f.tl, &f.sinTheta))
+                    continue;
+                f.part = pending[k];
+                __builtin_prefetch(&beams[part.beam]);
+                __builtin_prefetch(&photonMedia[part.beam]);
+                ++nf;
+            }
+            for (int k = 0; k < nf; ++k) {
+                const Accepted& f = accepted[k];
+                const uint32_t beam = parts[f.part].beam;
+                if (!queryMedium.built()) queryMedium.build();
+                const ub_segment_eval sl = photonMedia[beam].eval(f.tl);
+                const ub_segment_eval sc = queryMedium.eval(f.tc);
+                const ub_float3 c = ub_bb1d_contribution(in.mis, beams[beam], qb, sl, sc, f.tl,
+                                                         f.tc, f.sinTheta, g, normalization);
+                sum += Rgb(c.x, c.y, c.z);
+            }
+            *pairsFound += size_t(nf);
+            np = 0;
         };
         // A leaf's candidates four at a time by their lines and ranges (the pair test's first
         // two rejections and its range test), then the pair test for those left: most
@@ -57,9 +92,13 @@ void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
                 for (uint32_t b = first / 4; b * 4 < end; ++b) {
                     uint32_t near =
                         beamLinesNear4(lines[b], o, d, r * r) & ub_block_lanes(b, first, end);
-                    for (; near != 0; near &= near - 1) pair(b * 4 + uint32_t(__builtin_ctz(near)));
+                    for (; near != 0; near &= near - 1) {
+                        pending[np++] = b * 4 + uint32_t(__builtin_ctz(near));
+                        if (np == kPending) flush();
+                    }
                 }
             });
+        flush();
         return sum;
     });
 }
