@@ -31,6 +31,9 @@
 /* bb1d's candidates gathered before they are tested (ub_bb1d_flush); kPending of
  * src/estimators/bb1d_estimator.cpp. */
 #define UB_BB1D_PENDING 32
+/* pb2d's pairs gathered before they are evaluated (ub_pb2d_flush); kPending of
+ * src/estimators/pb2d_estimator.cpp. */
+#define UB_PB2D_PENDING 32
 
 /* The walk of kernels/shared/ub_bvh.h, in the host twin's order (src/estimators/bvh.h): pop
  * a node; MASK (an expression of `n`, the node in global memory) gives the children that pass;
@@ -80,6 +83,28 @@
     }                   \
     UB_BVH_LEAVES_END
 
+/* pb2d's pairs, pending[0 .. np - 1] at beam parameters t[0 .. np - 1] in walk order: the
+ * photons' path lengths first, whose loads then overlap their cache misses, then the pairs'
+ * contributions in the same order (the host twin prefetches the records). */
+static void ub_pb2d_flush(__global const ub_photon_point* photons, ub_medium_info m, float mCont,
+                          ub_grid_info gi, ub_grid_accessor* acc, const ub_beam* qb,
+                          ub_beam_piece* table, ub_uint* tableState, ub_mis_constants mis,
+                          float normalization, uint minLength, uint maxLength, const uint* pending,
+                          const float* t, int np, float* sum) {
+    uint lengths[UB_PB2D_PENDING];
+    for (int j = 0; j < np; ++j) lengths[j] = photons[pending[j]].pathLength;
+    for (int j = 0; j < np; ++j) {
+        if (!ub_pb2d_length_ok(lengths[j], *qb, minLength, maxLength)) continue;
+        ub_photon_point ph = photons[pending[j]];
+        ub_segment_eval s =
+            ub_query_beam_segment(m, mCont, gi, acc, *qb, t[j], table, UB_QUERY_PIECES, tableState);
+        ub_float3 c = ub_pb2d_contribution(mis, ph, *qb, s, t[j], m.g, normalization);
+        sum[0] += c.x;
+        sum[1] += c.y;
+        sum[2] += c.z;
+    }
+}
+
 /* pb2d: query beams x photon points (BVH over the photons' kernel spheres). */
 __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
                                __global const ub_photon_keys4* keys,
@@ -103,9 +128,13 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     const uint qMedium = qb.mediumId;
     ub_beam_piece table[UB_QUERY_PIECES];
     ub_uint tableState = UB_TABLE_UNBUILT;
-    float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     /* A leaf's photons four at a time by their keys, as the host twin does
-     * (src/estimators/pb2d_estimator.cpp). */
+     * (src/estimators/pb2d_estimator.cpp), the pairs gathered UB_PB2D_PENDING at a time and
+     * evaluated in walk order (ub_pb2d_flush). */
+    uint pending[UB_PB2D_PENDING];
+    float pendingT[UB_PB2D_PENDING];
+    float sum[3] = {0.0f, 0.0f, 0.0f};
+    int np = 0;
     UB_BVH_LEAVES_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qLength))
     for (uint b = leafFirst / 4u; b * 4u < leafEnd; ++b) {
         float t[4];
@@ -113,18 +142,19 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
                     ub_block_lanes(b, leafFirst, leafEnd);
         for (; near != 0u; near &= near - 1u) {
             uint lane = 31u - clz(near & (0u - near));
-            ub_photon_point ph = photons[b * 4u + lane];
-            if (!ub_pb2d_length_ok(ph.pathLength, qb, minLength, maxLength)) continue;
-            ub_segment_eval s = ub_query_beam_segment(m, mCont, gi, &acc, qb, t[lane], table,
-                                                      UB_QUERY_PIECES, &tableState);
-            ub_float3 c = ub_pb2d_contribution(mis, ph, qb, s, t[lane], m.g, normalization);
-            sx += c.x;
-            sy += c.y;
-            sz += c.z;
+            pending[np] = b * 4u + lane;
+            pendingT[np++] = t[lane];
+            if (np == UB_PB2D_PENDING) {
+                ub_pb2d_flush(photons, m, mCont, gi, &acc, &qb, table, &tableState, mis,
+                              normalization, minLength, maxLength, pending, pendingT, np, sum);
+                np = 0;
+            }
         }
     }
     UB_BVH_LEAVES_END
-    ub_store_f3(out, i, sx, sy, sz);
+    ub_pb2d_flush(photons, m, mCont, gi, &acc, &qb, table, &tableState, mis, normalization,
+                  minLength, maxLength, pending, pendingT, np, sum);
+    ub_store_f3(out, i, sum[0], sum[1], sum[2]);
 }
 
 /* bp2d: query points x photon beams (BVH over the diced beam parts). */
