@@ -51,6 +51,43 @@ TEST(HashGrid, RangeQueryEqualsBruteForce) {
             checkAgainstBruteForce(pts, r, cells, 11);
 }
 
+// The block queries of the estimate passes (HashGrid::blockRanges and candidates, as the surf
+// and pp3d kernels run a work-group) visit each query's points in the order query() does, for
+// a full block and a short last one; bucket counts are rounded up to powers of two (the bucket
+// is a mask, ub_hash_cell).
+TEST(HashGrid, BlockQueriesVisitWhatQueryVisitsInItsOrder) {
+    Rng rng(9, 2);
+    std::vector<Photon> pts(4000);
+    for (auto& p : pts) p.pos = Vec3(rng.uniform(), rng.uniform(), rng.uniform());
+    for (size_t cells : {size_t(0), size_t(7), size_t(1000)}) {
+        HashGrid grid;
+        grid.build(&pts[0].pos, pts.size(), sizeof(Photon), 0.05f, cells);
+        const size_t c = grid.cellCount();
+        EXPECT_EQ(c & (c - 1), 0u) << c << " buckets";
+        EXPECT_GE(c, cells == 0 ? pts.size() : cells);
+        std::vector<Vec3> queries(HashGrid::kBlock + 17);
+        for (size_t i = 0; i < queries.size(); ++i)
+            queries[i] = i % 3 == 0 ? pts[rng.nextU32() % pts.size()].pos
+                                    : Vec3(rng.uniform(), rng.uniform(), rng.uniform());
+        size_t visited = 0;
+        for (size_t begin = 0; begin < queries.size(); begin += HashGrid::kBlock) {
+            const size_t end = std::min(queries.size(), begin + HashGrid::kBlock);
+            HashGrid::BlockRanges ranges;
+            grid.blockRanges(
+                end - begin, [&](size_t k) { return queries[begin + k]; }, &ranges);
+            for (size_t i = begin; i < end; ++i) {
+                std::vector<uint32_t> inBlock, alone;
+                grid.candidates(ranges, i - begin, [&](uint32_t j) { inBlock.push_back(j); });
+                grid.query(queries[i], &pts[0].pos, sizeof(Photon),
+                           [&](uint32_t j) { alone.push_back(j); });
+                ASSERT_EQ(inBlock, alone) << "query " << i << ", " << c << " buckets";
+                visited += alone.size();
+            }
+        }
+        EXPECT_GT(visited, queries.size() / 3);  // the queries on points find at least those
+    }
+}
+
 TEST(HashGrid, EmptyGridFindsNothing) {
     HashGrid grid;
     std::vector<Photon> none;
