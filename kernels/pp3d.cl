@@ -17,17 +17,14 @@ __kernel void ub_pp3d_estimate(__global const ub_photon_point* photons,
                                __global const ub_medium_info* media, ub_mis_constants mis,
                                float radius, float normalization, uint minLength, uint maxLength,
                                __global float* out) {
-    /* Buckets, bounds, candidates: three phases split by barriers, as kernels/surf.cl does
-     * and for the same reason (cornell-fog, replayed: 0.0054-0.0065 -> 0.0049 s). */
+    /* The buckets and their bounds for the whole work-group first, as kernels/surf.cl does
+     * (cornell-fog, replayed: 0.0054-0.0065 -> 0.0049 s). */
     uint i = get_global_id(0);
     int live = i < queryCount;
     __global const ub_query_point* gq = queries + (live ? i : 0u);
     ub_float3 qp = ub_make_float3(gq->pos[0], gq->pos[1], gq->pos[2]);
-    ub_uint buckets[8], begins[8], ends[8];
-    int nb = live ? ub_hash_buckets(grid, qp, buckets) : 0;
-    barrier(CLK_LOCAL_MEM_FENCE);
-    int nr = ub_hash_bucket_ranges(buckets, nb, cellEnds, begins, ends);
-    barrier(CLK_LOCAL_MEM_FENCE);
+    ub_uint begins[8], ends[8];
+    int nr = ub_hash_ranges_group(grid, qp, live, cellEnds, begins, ends);
     if (!live) return;
     ub_query_point q = *gq;
     float g = media[q.mediumId].g;

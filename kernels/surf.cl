@@ -17,12 +17,9 @@ __kernel void ub_surf_estimate(__global const ub_light_vertex* photons,
                                __global const ub_medium_info* media, ub_mis_constants mis,
                                float radius, float normalization, uint minLength, uint maxLength,
                                __global float* out) {
-    /* Three phases split by barriers (no local memory is shared: the barriers only make PoCL
-     * run each phase for the whole work-group before the next): the buckets of every query,
-     * then their bounds, then the candidates. The bounds' loads of 64 queries then follow
-     * each other and their cache misses overlap, where one query at a time waited on its own
-     * (cornell-fog, replayed: 0.017-0.019 -> 0.014-0.017 s, docs/performance.md). A work-item
-     * past the end joins the barriers with no buckets. */
+    /* The buckets and their bounds for the whole work-group first (ub_hash_ranges_group, which
+     * every work-item joins), then the candidates (cornell-fog, replayed: 0.017-0.019 ->
+     * 0.014-0.017 s, docs/performance.md). */
     uint i = get_global_id(0);
     int live = i < queryCount;
     /* The query (240 bytes) and a photon (112 bytes) are copied to private memory only for a
@@ -33,11 +30,8 @@ __kernel void ub_surf_estimate(__global const ub_light_vertex* photons,
     float r2 = radius * radius;
     ub_surface_query q;
     int loaded = 0;
-    ub_uint buckets[8], begins[8], ends[8];
-    int nb = live ? ub_hash_buckets(grid, qp, buckets) : 0;
-    barrier(CLK_LOCAL_MEM_FENCE);
-    int nr = ub_hash_bucket_ranges(buckets, nb, cellEnds, begins, ends);
-    barrier(CLK_LOCAL_MEM_FENCE);
+    ub_uint begins[8], ends[8];
+    int nr = ub_hash_ranges_group(grid, qp, live, cellEnds, begins, ends);
     if (!live) return;
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     for (int k = 0; k < nr; ++k) {

@@ -62,9 +62,8 @@ UB_INLINE int ub_hash_buckets(ub_hash_grid g, ub_float3 q, UB_PRIVATE ub_uint* b
  * ub_hash_buckets) that hold points, in that order; returns how many (<= 8). cellEnds: the
  * end of each bucket in bucket order. Every bucket's bounds are read before any candidate,
  * so that their cache misses overlap rather than each waiting for the previous bucket's
- * candidates (surf kernel about 5% faster on cornell-fog). The kernels call it apart from
- * ub_hash_buckets, after a barrier, so that PoCL runs the bounds loads of a whole work-group
- * back to back (kernels/surf.cl). */
+ * candidates (surf kernel about 5% faster on cornell-fog). The kernels call it for a whole
+ * work-group at once (ub_hash_ranges_group). */
 UB_INLINE int ub_hash_bucket_ranges(UB_PRIVATE const ub_uint* buckets, int nb,
                                     UB_GLOBAL const ub_uint* cellEnds, UB_PRIVATE ub_uint* begins,
                                     UB_PRIVATE ub_uint* ends) {
@@ -87,6 +86,25 @@ UB_INLINE int ub_hash_ranges(ub_hash_grid g, ub_float3 q, UB_GLOBAL const ub_uin
     int nb = ub_hash_buckets(g, q, buckets);
     return ub_hash_bucket_ranges(buckets, nb, cellEnds, begins, ends);
 }
+
+#ifdef __OPENCL_C_VERSION__
+/* ub_hash_ranges for a work-group, every work-item of which must call it (`live` false for
+ * one past the queries: it gets no ranges): the buckets of every query, a barrier, the bounds
+ * of every bucket, a barrier. No local memory is shared; the barriers make PoCL run each phase
+ * for the whole work-group before the next, so the bounds' loads of 64 queries follow each
+ * other and their cache misses overlap, where one query at a time waited on its own
+ * (kernels/surf.cl; the host twins' HashGrid::blockRanges does the same over blocks). */
+UB_INLINE int ub_hash_ranges_group(ub_hash_grid g, ub_float3 q, int live,
+                                   UB_GLOBAL const ub_uint* cellEnds, UB_PRIVATE ub_uint* begins,
+                                   UB_PRIVATE ub_uint* ends) {
+    ub_uint buckets[8];
+    int nb = live ? ub_hash_buckets(g, q, buckets) : 0;
+    barrier(CLK_LOCAL_MEM_FENCE);
+    int nr = ub_hash_bucket_ranges(buckets, nb, cellEnds, begins, ends);
+    barrier(CLK_LOCAL_MEM_FENCE);
+    return nr;
+}
+#endif
 
 /* Whether point p lies within the grid's radius of q: the range test of a query, the host's
  * (HashGrid::query) and the kernels' before they read a candidate's record. */

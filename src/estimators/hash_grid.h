@@ -91,6 +91,12 @@ class HashGrid {
         return *reinterpret_cast<const Vec3*>(reinterpret_cast<const char*>(base) + i * stride);
     }
 
+    /// The points within the radius of q among the buckets' index ranges [begins[j], ends[j]),
+    /// j < n (query() and candidates()).
+    template <class Visit>
+    void visitRanges(const uint32_t* begins, const uint32_t* ends, int n, ub_float3 q,
+                     Visit&& visit) const;
+
     ub_hash_grid params_{};
     float radius_ = 0;
     std::vector<uint32_t> indices_;   ///< point indices sorted by bucket
@@ -107,13 +113,18 @@ void HashGrid::query(const Vec3& q, const Vec3* positions, size_t stride, Visit&
     if (indices_.empty()) return;
     uint32_t begins[8], ends[8];
     const ub_float3 qf = ub_make_float3(q.x, q.y, q.z);
-    const int nr = ub_hash_ranges(params_, qf, cellEnds_.data(), begins, ends);
-    for (int j = 0; j < nr; ++j) {
+    visitRanges(begins, ends, ub_hash_ranges(params_, qf, cellEnds_.data(), begins, ends), qf,
+                visit);
+}
+
+template <class Visit>
+void HashGrid::visitRanges(const uint32_t* begins, const uint32_t* ends, int n, ub_float3 q,
+                           Visit&& visit) const {
+    for (int j = 0; j < n; ++j)
         for (uint32_t i = begins[j]; i < ends[j]; ++i) {
-            const float* k = &keys_[4 * size_t(i)];
-            if (ub_hash_within(params_, ub_make_float3(k[0], k[1], k[2]), qf)) visit(indices_[i]);
+            const float* p = &keys_[4 * size_t(i)];
+            if (ub_hash_within(params_, ub_make_float3(p[0], p[1], p[2]), q)) visit(indices_[i]);
         }
-    }
 }
 
 template <class PosOf>
@@ -132,12 +143,7 @@ void HashGrid::blockRanges(size_t n, PosOf&& posOf, BlockRanges* r) const {
 
 template <class Visit>
 void HashGrid::candidates(const BlockRanges& r, size_t k, Visit&& visit) const {
-    for (int j = 0; j < r.count[k]; ++j)
-        for (uint32_t i = r.begins[k][j]; i < r.ends[k][j]; ++i) {
-            const float* p = &keys_[4 * size_t(i)];
-            if (ub_hash_within(params_, ub_make_float3(p[0], p[1], p[2]), r.q[k]))
-                visit(indices_[i]);
-        }
+    visitRanges(r.begins[k], r.ends[k], r.count[k], r.q[k], visit);
 }
 
 }  // namespace ub

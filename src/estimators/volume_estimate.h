@@ -91,26 +91,10 @@ bool prepareDeviceMedia(const Scene& scene, ClRuntime* cl, bool needGrids,
 void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Image, 4>* layers,
                     VolumeEstimateStats* stats = nullptr);
 
-/// Runs estimate(i, &found) for every query i in [0, n) in parallel (TBB, chunks of
-/// `grain`), writing its result to (*out)[i]; *pairs gets the sum of what the calls add to
-/// `found` (the kernel pairs they evaluated).
-template <class Estimate>
-void forEachQuery(size_t n, size_t grain, std::vector<Rgb>* out, size_t* pairs,
-                  Estimate&& estimate) {
-    std::atomic<size_t> total{0};
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain),
-                      [&](const tbb::blocked_range<size_t>& range) {
-                          size_t found = 0;
-                          for (size_t i = range.begin(); i != range.end(); ++i)
-                              (*out)[i] = estimate(i, &found);
-                          total += found;
-                      });
-    *pairs = total;
-}
-
-/// forEachQuery for estimators that take their queries in blocks (HashGrid::queryBlock):
-/// estimate(begin, end, &found) writes (*out)[i] for i in [begin, end), blocks of at most
-/// `block` queries.
+/// Runs estimate(begin, end, &found) over [0, n) in blocks of at most `block` queries, in
+/// parallel (TBB): it writes (*out)[i] for i in [begin, end), and *pairs gets the sum of what
+/// the calls add to `found` (the kernel pairs they evaluated). The hashed-grid estimators take
+/// their queries a block at a time (HashGrid::blockRanges).
 template <class EstimateBlock>
 void forEachQueryBlock(size_t n, size_t block, std::vector<Rgb>* out, size_t* pairs,
                        EstimateBlock&& estimate) {
@@ -123,6 +107,16 @@ void forEachQueryBlock(size_t n, size_t block, std::vector<Rgb>* out, size_t* pa
                           total += found;
                       });
     *pairs = total;
+}
+
+/// Runs estimate(i, &found) for every query i in [0, n) (forEachQueryBlock, blocks of
+/// `grain`), writing its result to (*out)[i].
+template <class Estimate>
+void forEachQuery(size_t n, size_t grain, std::vector<Rgb>* out, size_t* pairs,
+                  Estimate&& estimate) {
+    forEachQueryBlock(n, grain, out, pairs, [&](size_t begin, size_t end, size_t* found) {
+        for (size_t i = begin; i < end; ++i) (*out)[i] = estimate(i, found);
+    });
 }
 
 // The host twins, one per estimator (estimators/*_estimator.cpp): each adds its estimate of
