@@ -263,8 +263,16 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
      * (src/estimators/bb1d_estimator.cpp), gathered and handled UB_BB1D_PENDING at a time. */
     UB_BVH_LEAVES_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qb.length))
     for (uint b = leafFirst / 4u; b * 4u < leafEnd; ++b) {
-        uint near = ub_beam_lines_near4_global(lines + b, o, d, radius * radius) &
-                    ub_block_lanes(b, leafFirst, leafEnd);
+        /* two blocks at once where the leaf has both (ub_beam_lines_near8_global) */
+        uint near;
+        if ((b + 1u) * 4u < leafEnd) {
+            uint m8 = ub_beam_lines_near8_global(lines + b, o, d, radius * radius);
+            near = (m8 & ub_block_lanes(b, leafFirst, leafEnd)) |
+                   ((m8 >> 4) & ub_block_lanes(b + 1u, leafFirst, leafEnd)) << 4;
+        } else {
+            near = ub_beam_lines_near4_global(lines + b, o, d, radius * radius) &
+                   ub_block_lanes(b, leafFirst, leafEnd);
+        }
         for (; near != 0u; near &= near - 1u) {
             pending[np++] = b * 4u + (31u - clz(near & (0u - near)));
             if (np == UB_BB1D_PENDING) {
@@ -274,6 +282,7 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
                 np = 0;
             }
         }
+        if ((b + 1u) * 4u < leafEnd) ++b; /* the pair's second block is done */
     }
     UB_BVH_LEAVES_END
     ub_bb1d_flush(beams, parts, beamPieces, beamRanges, m, mCont, gi, &acc, &qb, table, &tableState,

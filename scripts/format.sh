@@ -4,7 +4,7 @@
 # --check prints the files that differ and exits 1 if there are any.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-mapfile -t files < <(git ls-files --cached --others --exclude-standard '*.cpp' '*.h' '*.cl')
+mapfile -t files < <(git ls-files --cached --others --exclude-standard '*.cpp' '*.h' '*.inc' '*.cl')
 if [ "${1:-}" = "--check" ]; then
   bad=()
   for f in "${files[@]}"; do

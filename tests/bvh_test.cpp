@@ -329,6 +329,44 @@ TEST(Bvh, BeamLineFilterEqualsTheSharedOneAndDropsNoPair) {
                 }
 }
 
+// bb1d's AVX walk tests two blocks of lines at once (src/estimators/bb1d_walk.inc): its mask is
+// the two blocks' SSE masks side by side, bit for bit, on random lines (parallel ones among
+// them), separations around the radius and ranges around the closest points, last parts (t1 =
+// infinity) included. A CPU without AVX never runs that walk; the test says so and stops.
+TEST(Bvh, BeamLineFilterEightWideEqualsTwoBlocks) {
+    if (!bb1dWideWalkAvailable())
+        GTEST_SKIP() << "no AVX on this CPU: bb1d walks four lines a time";
+    Rng rng(37, 5);
+    int set = 0;
+    for (int k = 0; k < 20000; ++k) {
+        const Vec3 o = randomIn(rng, -2.0f, 2.0f);
+        const Vec3 d = sampleUniformSphere(rng.uniform2());
+        ub_beam_keys4 keys[2] = {};
+        for (int j = 0; j < 8; ++j) {
+            Vec3 dj = sampleUniformSphere(rng.uniform2());
+            if (k % 13 == j) dj = d;  // parallel
+            const Vec3 oj = o + d * (4.0f * rng.uniform()) + randomIn(rng, -0.3f, 0.3f) -
+                            dj * (2.0f * rng.uniform());
+            ub_beam_part part{};
+            for (int a = 0; a < 3; ++a) {
+                part.origin[a] = oj[a];
+                part.dir[a] = dj[a];
+            }
+            part.length = 4.0f;
+            part.t0 = k % 5 == 0 ? 0.0f : 3.0f * rng.uniform();
+            part.t1 = k % 7 == 0 ? 4.0f : std::min(4.0f, part.t0 + 1.5f * rng.uniform());
+            ub_beam_keys4_set(&keys[j / 4], j % 4, part);
+        }
+        const ub_float3 oo = ub_make_float3(o.x, o.y, o.z), dd = ub_make_float3(d.x, d.y, d.z);
+        const float r2 = 0.01f;
+        const uint32_t two =
+            beamLinesNear4(keys[0], oo, dd, r2) | beamLinesNear4(keys[1], oo, dd, r2) << 4;
+        ASSERT_EQ(bb1dLinesNear8ForTests(keys, oo, dd, r2), two) << "case " << k;
+        set += __builtin_popcount(two);
+    }
+    EXPECT_GT(set, 10000);  // lanes that passed: the comparison saw both answers
+}
+
 // pb2d's test of a leaf's photons four at a time: the host's SSE form (pb2dNear4ForTests) gives
 // the shared ub_pb2d_near4's mask and beam parameters bit for bit, which are ub_pb2d_near's per
 // photon; photons around the radius and the beam's ends, in two media, with padded lanes.

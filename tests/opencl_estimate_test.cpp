@@ -342,6 +342,56 @@ TEST(OpenClEstimate, BeamKernelsInAGridMediumEqualTheirTwins) {
 
 // The program cache: the first runtime builds and caches, the second loads the entry; a
 // corrupt entry is rebuilt and replaced, never fatal.
+// bb1d's host twin walks the part lines eight at a time where the CPU has AVX, else four
+// (src/estimators/bb1d_walk.inc): both find the same candidates in the same order, so the
+// bb1d layer is the same bit for bit (the VDB smoke, one iteration). Here because the kernel
+// does the same in kernels/beams.cl, which the test above holds to this twin.
+TEST(OpenClEstimate, Bb1dWideWalkEqualsTheFourLaneOne) {
+    if (!bb1dWideWalkAvailable())
+        GTEST_SKIP() << "no AVX on this CPU: bb1d walks four lines a time";
+    auto scene = smoke32();
+    ASSERT_TRUE(scene);
+    RenderOptions opt = smokeOptions();
+    opt.algorithm = "upbp:bb1d";
+    VertexCM engine(*scene, opt);
+    Image img;
+    engine.renderIteration(1, img);
+    ASSERT_GT(engine.photonBeams().size(), 100u);
+    ASSERT_GT(engine.queryBeams().size(), 300u);
+    VolumeEstimateInput vin;
+    vin.scene = scene.get();
+    vin.radius[UB_TECH_BB1D] = engine.volumeRadiusAt(UB_TECH_BB1D, 1);
+    vin.mis = ub_mis_enable_volume(ub_mis_make_constants(0.01f, 1024.0f, 1, 1, UB_MIS_POWER), 0.0f,
+                                   0.0f, 0.0f, vin.radius[UB_TECH_BB1D], 256.0f, 1, 0);
+    vin.techniques.bb1d = true;
+    vin.lightPathCount = 1024.0f;
+    vin.beamPathCount = 256.0f;
+    vin.minLength = 0;
+    vin.maxLength = 6;
+    vin.photonPoints = &engine.photonPoints();
+    vin.photonBeams = &engine.photonBeams();
+    vin.queryPoints = &engine.queryPoints();
+    vin.queryBeams = &engine.queryBeams();
+    std::array<Image, 2> layers;
+    for (int pass = 0; pass < 2; ++pass) {
+        setBb1dWideWalkForTests(pass == 0);
+        EXPECT_EQ(bb1dWideWalk(), pass == 0);
+        Image image(32, 32);
+        std::array<Image, 4> perTechnique;
+        for (Image& l : perTechnique) l = Image(32, 32);
+        estimateVolume(vin, &image, &perTechnique);
+        layers[size_t(pass)] = perTechnique[UB_TECH_BB1D];
+    }
+    setBb1dWideWalkForTests(true);
+    double sum = 0;
+    for (size_t i = 0; i < layers[0].pixels.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            ASSERT_EQ(layers[0].pixels[i][c], layers[1].pixels[i][c]) << "pixel " << i;
+            sum += layers[0].pixels[i][c];
+        }
+    EXPECT_GT(sum, 0.0);
+}
+
 TEST(OpenClEstimate, ProgramCacheHitAndCorruptEntry) {
     const std::string dir =
         (std::filesystem::temp_directory_path() / ("unibeam-clcache-" + std::to_string(::getpid())))

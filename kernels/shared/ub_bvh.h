@@ -177,6 +177,31 @@ UB_INLINE ub_uint ub_beam_lines_near4_global(__global const ub_beam_keys4* k, ub
     return (ub_uint)((near.x & 1) | (near.y & 2) | (near.z & 4) | (near.w & 8));
 }
 
+/* Two consecutive blocks k[0], k[1] as float8 lanes, the same operations: bits 0-3 are block
+ * k[0]'s mask, bits 4-7 block k[1]'s. On PoCL's AVX2 CPU target a float8 is one register, so two
+ * blocks cost about what one did (the host's beamLinesNear8, src/estimators/bb1d_walk.inc). */
+UB_INLINE ub_uint ub_beam_lines_near8_global(__global const ub_beam_keys4* k, ub_float3 o,
+                                             ub_float3 d, float radiusSqr) {
+    float8 oBx = (float8)(vload4(0, k[0].ox), vload4(0, k[1].ox));
+    float8 oBy = (float8)(vload4(0, k[0].oy), vload4(0, k[1].oy));
+    float8 oBz = (float8)(vload4(0, k[0].oz), vload4(0, k[1].oz));
+    float8 dBx = (float8)(vload4(0, k[0].dx), vload4(0, k[1].dx));
+    float8 dBy = (float8)(vload4(0, k[0].dy), vload4(0, k[1].dy));
+    float8 dBz = (float8)(vload4(0, k[0].dz), vload4(0, k[1].dz));
+    float8 b = d.x * dBx + d.y * dBy + d.z * dBz;
+    float8 sin2 = 1.0f - b * b;
+    float8 wx = o.x - oBx, wy = o.y - oBy, wz = o.z - oBz;
+    float8 cx = d.y * dBz - d.z * dBy, cy = d.z * dBx - d.x * dBz, cz = d.x * dBy - d.y * dBx;
+    float8 sep = wx * cx + wy * cy + wz * cz;
+    float8 tB = ((dBx * wx + dBy * wy + dBz * wz) - b * (d.x * wx + d.y * wy + d.z * wz)) / sin2;
+    float8 t0 = (float8)(vload4(0, k[0].t0), vload4(0, k[1].t0));
+    float8 t1 = (float8)(vload4(0, k[0].t1), vload4(0, k[1].t1));
+    int8 held = !(tB < t0 || tB >= t1);
+    int8 near = (sin2 > 1e-7f) & !(sep * sep > radiusSqr * sin2) & held;
+    return (ub_uint)((near.s0 & 1) | (near.s1 & 2) | (near.s2 & 4) | (near.s3 & 8) |
+                     (near.s4 & 16) | (near.s5 & 32) | (near.s6 & 64) | (near.s7 & 128));
+}
+
 /* The kernels' ub_bvh_contains, the same way. */
 UB_INLINE ub_uint ub_bvh_contains_global(__global const ub_bvh_node* n, ub_float3 p) {
     int4 in = (vload4(0, n->loX) <= p.x) & (vload4(0, n->hiX) >= p.x) & (vload4(0, n->loY) <= p.y) &

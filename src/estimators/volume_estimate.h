@@ -143,5 +143,16 @@ void estimateBP2D(const VolumeEstimateInput& in, const Bvh& beamParts,
 void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
                   const std::vector<BeamPart>& parts, const std::vector<ub_beam_keys4>& lines,
                   const std::vector<BeamMedium>& photonMedia, std::vector<Rgb>* out, size_t* pairs);
+/// Whether estimateBB1D tests part lines eight at a time (the CPU has AVX; bb1d_walk.inc).
+bool bb1dWideWalk();
+/// Lets estimateBB1D use the AVX walk where the CPU has it (the default) or not: the two give
+/// the same sums bit for bit, which a test checks.
+void setBb1dWideWalkForTests(bool allowed);
+/// The AVX walk's test of blocks k[0] and k[1] (bits 0-3 and 4-7); throws where
+/// bb1dWideWalk() could never be true (no AVX).
+uint32_t bb1dLinesNear8ForTests(const ub_beam_keys4* k, const ub_float3& o, const ub_float3& d,
+                                float radiusSqr);
+/// Whether this CPU and build have the AVX walk (whatever setBb1dWideWalkForTests says).
+bool bb1dWideWalkAvailable();
 
 }  // namespace ub
