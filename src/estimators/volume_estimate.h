@@ -9,7 +9,7 @@
 //   pb2d  BVH over photon points as boxes of their kernel sphere, traversed by
 //         each query beam (estimators/bvh.h);
 //   bp2d, bb1d  one BVH over photon-beam pieces diced along their axis into at
-//         most 64 parts of length >= 4 r, each part's box enclosing its cylinder
+//         most 32 parts of length >= 32 r, each part's box enclosing its cylinder
 //         of radius max(r_bp2d, r_bb1d); traversed by query points and query
 //         beams. A beam meets a query in several parts' boxes; only the part whose
 //         parameter range holds the closest-approach parameter counts it, so each
