@@ -12,7 +12,9 @@
 /* No contraction of a * b + c into fma: the host twins compute without it (x86-64 baseline), and
  * the candidate tests (ub_pb2d_near4_global, ub_beam_lines_near4_global) then give the host's
  * answers at the radius, where one contracted rounding moved a pair in or out (mirrorballs pb2d:
- * image means 8e-5 apart, docs/performance.md). */
+ * image means 8e-5 apart, docs/performance.md). The runtime puts the pragma on the first line
+ * of the program (src/cl/cl_runtime.cpp), ahead of pp3d.cl, which defines the shared headers'
+ * functions first; it stays here for a program built from this file alone. */
 #pragma OPENCL FP_CONTRACT OFF
 #include "ub_bb1d.h"
 #include "ub_bp2d.h"

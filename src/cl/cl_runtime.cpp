@@ -263,7 +263,15 @@ ClRuntime::ClRuntime(int platform, int device, const std::string& cacheDir,
     check(err, "clCreateContext");
     queue_ = clCreateCommandQueue(context_, dev, 0, &err);
     check(err, "clCreateCommandQueue");
-    const std::string src = clProgramSource({"pp3d.cl", "beams.cl", "surf.cl"});
+    // One program of the three files. No contraction of a * b + c into fma anywhere in it: the
+    // host twins compute without (x86-64 baseline), and the candidate filters (ub_bvh.h,
+    // ub_pb2d.h) must give the pair tests' answers at the radius. The pragma is the program's
+    // first line because a shared header's functions take the state where they are first
+    // defined: beams.cl's own pragma came after pp3d.cl had defined ub_bvh.h's filters and
+    // ub_vec3.h's dot products contracted (PoCL's code had 99 fused multiply-adds in the bb1d
+    // kernel, its line filter's among them).
+    const std::string src =
+        "#pragma OPENCL FP_CONTRACT OFF\n" + clProgramSource({"pp3d.cl", "beams.cl", "surf.cl"});
     const std::string options =
         std::string("-cl-std=CL1.2") + (extraOptions.empty() ? "" : " " + extraOptions);
     // Program cache: key = source, options, device, driver.
