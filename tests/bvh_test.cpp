@@ -267,6 +267,26 @@ TEST(Bvh, LeavesOfAMultipleOfFourHoldWholeBlocks) {
     }
 }
 
+/// A part of a beam of length 4 whose line passes near the segment o + t d, t in [0, 4] (its
+/// origin 0-2 units back along it, so the closest point falls in 0-4), along d itself when
+/// `parallel`; its range around the closest point, from 0 when k % 5 == 0 and to the beam's
+/// end (a last part) when k % 7 == 0.
+ub_beam_part randomPartNear(Rng& rng, const Vec3& o, const Vec3& d, int k, bool parallel) {
+    Vec3 dj = sampleUniformSphere(rng.uniform2());
+    if (parallel) dj = d;
+    const Vec3 oj =
+        o + d * (4.0f * rng.uniform()) + randomIn(rng, -0.3f, 0.3f) - dj * (2.0f * rng.uniform());
+    ub_beam_part part{};
+    for (int a = 0; a < 3; ++a) {
+        part.origin[a] = oj[a];
+        part.dir[a] = dj[a];
+    }
+    part.length = 4.0f;
+    part.t0 = k % 5 == 0 ? 0.0f : 3.0f * rng.uniform();
+    part.t1 = k % 7 == 0 ? 4.0f : std::min(4.0f, part.t0 + 1.5f * rng.uniform());
+    return part;
+}
+
 // bb1d's first test of a leaf (kernels/shared/ub_bvh.h): the host's SSE form equals the shared
 // one bit for bit, a part it rejects ub_bb1d_pair's geometry (ub_beam_beam_near, then
 // ub_beam_part_holds) rejects too (the filter never drops a pair), and ub_block_lanes masks
@@ -283,23 +303,10 @@ TEST(Bvh, BeamLineFilterEqualsTheSharedOneAndDropsNoPair) {
         ub_beam_part parts[4];
         ub_float3 oB[4], dB[4];
         for (int j = 0; j < 4; ++j) {
-            Vec3 dj = sampleUniformSphere(rng.uniform2());
-            if (k % 17 == j) dj = d;  // parallel
-            // The beam's origin 0-2 units back along it, so the closest point falls in 0-4.
-            const Vec3 oj = o + d * (4.0f * rng.uniform()) + randomIn(rng, -0.3f, 0.3f) -
-                            dj * (2.0f * rng.uniform());
-            ub_beam_part& part = parts[j];
-            part = ub_beam_part{};
-            for (int a = 0; a < 3; ++a) {
-                part.origin[a] = oj[a];
-                part.dir[a] = dj[a];
-            }
-            part.length = 4.0f;
-            part.t0 = k % 5 == 0 ? 0.0f : 3.0f * rng.uniform();
-            part.t1 = k % 7 == 0 ? 4.0f : std::min(4.0f, part.t0 + 1.5f * rng.uniform());
+            const ub_beam_part& part = parts[j] = randomPartNear(rng, o, d, k, k % 17 == j);
             ub_beam_keys4_set(&keys, j, part);
-            oB[j] = ub_make_float3(oj.x, oj.y, oj.z);
-            dB[j] = ub_make_float3(dj.x, dj.y, dj.z);
+            oB[j] = ub_f3_from(part.origin);
+            dB[j] = ub_f3_from(part.dir);
         }
         const ub_float3 oo = ub_make_float3(o.x, o.y, o.z), dd = ub_make_float3(d.x, d.y, d.z);
         const float r2 = 0.01f;
@@ -332,31 +339,24 @@ TEST(Bvh, BeamLineFilterEqualsTheSharedOneAndDropsNoPair) {
 // bb1d's AVX walk tests two blocks of lines at once (src/estimators/bb1d_walk.inc): its mask is
 // the two blocks' SSE masks side by side, bit for bit, on random lines (parallel ones among
 // them), separations around the radius and ranges around the closest points, last parts (t1 =
-// infinity) included. A CPU without AVX never runs that walk; the test says so and stops.
+// infinity) included. A CPU without AVX never runs that walk: there the test checks that it is
+// never chosen and that asking for it is an error.
 TEST(Bvh, BeamLineFilterEightWideEqualsTwoBlocks) {
-    if (!bb1dWideWalkAvailable())
-        GTEST_SKIP() << "no AVX on this CPU: bb1d walks four lines a time";
+    if (!bb1dWideWalkAvailable()) {
+        EXPECT_FALSE(bb1dWideWalk());
+        const ub_beam_keys4 keys[2] = {};
+        const ub_float3 o = ub_make_float3(0.0f, 0.0f, 0.0f), d = ub_make_float3(1.0f, 0.0f, 0.0f);
+        EXPECT_THROW(bb1dLinesNear8ForTests(keys, o, d, 0.01f), std::logic_error);
+        return;
+    }
     Rng rng(37, 5);
     int set = 0;
     for (int k = 0; k < 20000; ++k) {
         const Vec3 o = randomIn(rng, -2.0f, 2.0f);
         const Vec3 d = sampleUniformSphere(rng.uniform2());
         ub_beam_keys4 keys[2] = {};
-        for (int j = 0; j < 8; ++j) {
-            Vec3 dj = sampleUniformSphere(rng.uniform2());
-            if (k % 13 == j) dj = d;  // parallel
-            const Vec3 oj = o + d * (4.0f * rng.uniform()) + randomIn(rng, -0.3f, 0.3f) -
-                            dj * (2.0f * rng.uniform());
-            ub_beam_part part{};
-            for (int a = 0; a < 3; ++a) {
-                part.origin[a] = oj[a];
-                part.dir[a] = dj[a];
-            }
-            part.length = 4.0f;
-            part.t0 = k % 5 == 0 ? 0.0f : 3.0f * rng.uniform();
-            part.t1 = k % 7 == 0 ? 4.0f : std::min(4.0f, part.t0 + 1.5f * rng.uniform());
-            ub_beam_keys4_set(&keys[j / 4], j % 4, part);
-        }
+        for (int j = 0; j < 8; ++j)
+            ub_beam_keys4_set(&keys[j / 4], j % 4, randomPartNear(rng, o, d, k, k % 13 == j));
         const ub_float3 oo = ub_make_float3(o.x, o.y, o.z), dd = ub_make_float3(d.x, d.y, d.z);
         const float r2 = 0.01f;
         const uint32_t two =

@@ -161,19 +161,32 @@ UB_INLINE ub_uint ub_bvh_meets_global(__global const ub_bvh_node* n, ub_float3 o
     return (ub_uint)((hit.x & 1) | (hit.y & 2) | (hit.z & 4) | (hit.w & 8));
 }
 
+/* The line filter of ub_beam_lines_near4 on T lanes (float4: one block; float8: two), its
+ * comparisons as IT; LOAD(field) gives the lanes of a field of ub_beam_keys4. Sets `near`. */
+#define UB_BEAM_LINES_NEAR(T, IT, LOAD, o, d, radiusSqr, near)                    \
+    {                                                                             \
+        T ubOx = LOAD(ox), ubOy = LOAD(oy), ubOz = LOAD(oz);                      \
+        T ubDx = LOAD(dx), ubDy = LOAD(dy), ubDz = LOAD(dz);                      \
+        T ubB = d.x * ubDx + d.y * ubDy + d.z * ubDz;                             \
+        T ubSin2 = 1.0f - ubB * ubB;                                              \
+        T ubWx = o.x - ubOx, ubWy = o.y - ubOy, ubWz = o.z - ubOz;                \
+        T ubCx = d.y * ubDz - d.z * ubDy, ubCy = d.z * ubDx - d.x * ubDz,         \
+          ubCz = d.x * ubDy - d.y * ubDx;                                         \
+        T ubSep = ubWx * ubCx + ubWy * ubCy + ubWz * ubCz;                        \
+        T ubTB = ((ubDx * ubWx + ubDy * ubWy + ubDz * ubWz) -                     \
+                  ubB * (d.x * ubWx + d.y * ubWy + d.z * ubWz)) /                 \
+                 ubSin2;                                                          \
+        IT ubHeld = !(ubTB < LOAD(t0) || ubTB >= LOAD(t1));                       \
+        near = (ubSin2 > 1e-7f) & !(ubSep * ubSep > radiusSqr * ubSin2) & ubHeld; \
+    }
+#define UB_KEYS_LOAD4(field) vload4(0, k->field)
+#define UB_KEYS_LOAD8(field) ((float8)(vload4(0, k[0].field), vload4(0, k[1].field)))
+
 /* The kernels' ub_beam_lines_near4: the four lines as float4 lanes, the same operations. */
 UB_INLINE ub_uint ub_beam_lines_near4_global(__global const ub_beam_keys4* k, ub_float3 o,
                                              ub_float3 d, float radiusSqr) {
-    float4 oBx = vload4(0, k->ox), oBy = vload4(0, k->oy), oBz = vload4(0, k->oz);
-    float4 dBx = vload4(0, k->dx), dBy = vload4(0, k->dy), dBz = vload4(0, k->dz);
-    float4 b = d.x * dBx + d.y * dBy + d.z * dBz;
-    float4 sin2 = 1.0f - b * b;
-    float4 wx = o.x - oBx, wy = o.y - oBy, wz = o.z - oBz;
-    float4 cx = d.y * dBz - d.z * dBy, cy = d.z * dBx - d.x * dBz, cz = d.x * dBy - d.y * dBx;
-    float4 sep = wx * cx + wy * cy + wz * cz;
-    float4 tB = ((dBx * wx + dBy * wy + dBz * wz) - b * (d.x * wx + d.y * wy + d.z * wz)) / sin2;
-    int4 held = !(tB < vload4(0, k->t0) || tB >= vload4(0, k->t1));
-    int4 near = (sin2 > 1e-7f) & !(sep * sep > radiusSqr * sin2) & held;
+    int4 near;
+    UB_BEAM_LINES_NEAR(float4, int4, UB_KEYS_LOAD4, o, d, radiusSqr, near)
     return (ub_uint)((near.x & 1) | (near.y & 2) | (near.z & 4) | (near.w & 8));
 }
 
@@ -182,22 +195,8 @@ UB_INLINE ub_uint ub_beam_lines_near4_global(__global const ub_beam_keys4* k, ub
  * blocks cost about what one did (the host's beamLinesNear8, src/estimators/bb1d_walk.inc). */
 UB_INLINE ub_uint ub_beam_lines_near8_global(__global const ub_beam_keys4* k, ub_float3 o,
                                              ub_float3 d, float radiusSqr) {
-    float8 oBx = (float8)(vload4(0, k[0].ox), vload4(0, k[1].ox));
-    float8 oBy = (float8)(vload4(0, k[0].oy), vload4(0, k[1].oy));
-    float8 oBz = (float8)(vload4(0, k[0].oz), vload4(0, k[1].oz));
-    float8 dBx = (float8)(vload4(0, k[0].dx), vload4(0, k[1].dx));
-    float8 dBy = (float8)(vload4(0, k[0].dy), vload4(0, k[1].dy));
-    float8 dBz = (float8)(vload4(0, k[0].dz), vload4(0, k[1].dz));
-    float8 b = d.x * dBx + d.y * dBy + d.z * dBz;
-    float8 sin2 = 1.0f - b * b;
-    float8 wx = o.x - oBx, wy = o.y - oBy, wz = o.z - oBz;
-    float8 cx = d.y * dBz - d.z * dBy, cy = d.z * dBx - d.x * dBz, cz = d.x * dBy - d.y * dBx;
-    float8 sep = wx * cx + wy * cy + wz * cz;
-    float8 tB = ((dBx * wx + dBy * wy + dBz * wz) - b * (d.x * wx + d.y * wy + d.z * wz)) / sin2;
-    float8 t0 = (float8)(vload4(0, k[0].t0), vload4(0, k[1].t0));
-    float8 t1 = (float8)(vload4(0, k[0].t1), vload4(0, k[1].t1));
-    int8 held = !(tB < t0 || tB >= t1);
-    int8 near = (sin2 > 1e-7f) & !(sep * sep > radiusSqr * sin2) & held;
+    int8 near;
+    UB_BEAM_LINES_NEAR(float8, int8, UB_KEYS_LOAD8, o, d, radiusSqr, near)
     return (ub_uint)((near.s0 & 1) | (near.s1 & 2) | (near.s2 & 4) | (near.s3 & 8) |
                      (near.s4 & 16) | (near.s5 & 32) | (near.s6 & 64) | (near.s7 & 128));
 }
