@@ -50,23 +50,21 @@
  * one macro taking the block: a block with commas needs a variadic macro, which OpenCL C 1.2 does
  * not have (NVIDIA's compiler rejects it: "variadic macros not supported in OpenCL", seen on an
  * H200, docs/opencl.md). */
-#define UB_BVH_LEAVES_BEGIN(nodes, MASK)                                                       \
-    {                                                                                          \
-        uint ubStack[UB_BVH_STACK];                                                            \
-        int ubTop = 0;                                                                         \
-        ubStack[ubTop++] = 0u;                                                                 \
-        while (ubTop > 0) {                                                                    \
-            __global const ub_bvh_node* n = nodes + ubStack[--ubTop];                          \
-            uint ubMask = (MASK);                                                              \
-            if (ubMask == 0u) continue;                                                        \
-            int4 ubLeafV = vload4(0, n->count) != (uint4)(0u);                                 \
-            uint ubLeaf =                                                                      \
-                (uint)((ubLeafV.x & 1) | (ubLeafV.y & 2) | (ubLeafV.z & 4) | (ubLeafV.w & 8)); \
-            uint ubInner = ubMask & ~ubLeaf;                                                   \
-            ubLeaf &= ubMask;                                                                  \
-            while (ubLeaf) {                                                                   \
-                uint ubC = 31u - clz(ubLeaf & (0u - ubLeaf));                                  \
-                ubLeaf &= ubLeaf - 1u;                                                         \
+#define UB_BVH_LEAVES_BEGIN(nodes, MASK)                                     \
+    {                                                                        \
+        uint ubStack[UB_BVH_STACK];                                          \
+        int ubTop = 0;                                                       \
+        ubStack[ubTop++] = 0u;                                               \
+        while (ubTop > 0) {                                                  \
+            __global const ub_bvh_node* n = nodes + ubStack[--ubTop];        \
+            uint ubMask = (MASK);                                            \
+            if (ubMask == 0u) continue;                                      \
+            uint ubLeaf = ub_lane_mask4(vload4(0, n->count) != (uint4)(0u)); \
+            uint ubInner = ubMask & ~ubLeaf;                                 \
+            ubLeaf &= ubMask;                                                \
+            while (ubLeaf) {                                                 \
+                uint ubC = 31u - clz(ubLeaf & (0u - ubLeaf));                \
+                ubLeaf &= ubLeaf - 1u;                                       \
                 uint leafFirst = n->child[ubC], leafEnd = leafFirst + n->count[ubC];
 #define UB_BVH_LEAVES_END                 \
     }                                     \
@@ -86,14 +84,16 @@
     UB_BVH_LEAVES_END
 
 /* pb2d's pairs, pending[0 .. np - 1] at beam parameters t[0 .. np - 1] in walk order: the
- * photons' path lengths first, whose loads then overlap their cache misses, then the pairs'
- * contributions in the same order (the host twin prefetches the records). */
+ * photons' records prefetched (UB_PREFETCH: PoCL's CPU devices; a hint or nothing elsewhere) and
+ * their path lengths read, whose loads then overlap their cache misses, then the pairs'
+ * contributions in the same order, as the host twin does. */
 static void ub_pb2d_flush(__global const ub_photon_point* photons, ub_medium_info m, float mCont,
                           ub_grid_info gi, ub_grid_accessor* acc, const ub_beam* qb,
                           ub_beam_piece* table, ub_uint* tableState, ub_mis_constants mis,
                           float normalization, uint minLength, uint maxLength, const uint* pending,
                           const float* t, int np, float* sum) {
     uint lengths[UB_PB2D_PENDING];
+    for (int j = 0; j < np; ++j) UB_PREFETCH(photons + pending[j]);
     for (int j = 0; j < np; ++j) lengths[j] = photons[pending[j]].pathLength;
     for (int j = 0; j < np; ++j) {
         if (!ub_pb2d_length_ok(lengths[j], *qb, minLength, maxLength)) continue;
@@ -196,8 +196,9 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
 }
 
 /* bb1d's candidates that passed the four-lane filter, pending[0 .. np - 1] in walk order, in
- * two stages as the host twin handles them (src/estimators/bb1d_estimator.cpp): the pair test of
- * each, whose part reads no longer wait on each other's cache misses, then the contributions of
+ * two stages as the host twin handles them (src/estimators/bb1d_estimator.cpp): their parts
+ * prefetched (UB_PREFETCH), the pair test of each, whose part reads no longer wait on each other's
+ * cache misses, prefetching the photon beam of each pair it accepts, then the contributions of
  * the pairs it accepted, in the same order (the sum is the walk order's). */
 static void ub_bb1d_flush(__global const ub_beam* beams, __global const ub_beam_part* parts,
                           __global const ub_beam_piece* beamPieces, __global const uint* beamRanges,
@@ -207,6 +208,11 @@ static void ub_bb1d_flush(__global const ub_beam* beams, __global const ub_beam_
                           uint maxLength, const uint* pending, int np, float* sum) {
     uint accepted[UB_BB1D_PENDING], beamOf[UB_BB1D_PENDING];
     float tcs[UB_BB1D_PENDING], tls[UB_BB1D_PENDING], sins[UB_BB1D_PENDING];
+    for (int j = 0; j < np; ++j) {
+        __global const char* part = (__global const char*)(parts + pending[j]);
+        UB_PREFETCH(part);
+        UB_PREFETCH(part + sizeof(ub_beam_part) - 1); /* a part may straddle two lines */
+    }
     for (int j = 0; j < np; ++j) beamOf[j] = parts[pending[j]].beam;
     int nf = 0;
     for (int j = 0; j < np; ++j) {
@@ -215,6 +221,7 @@ static void ub_bb1d_flush(__global const ub_beam* beams, __global const ub_beam_
                           &sinTheta))
             continue;
         accepted[nf] = beamOf[j];
+        UB_PREFETCH(beams + beamOf[j]);
         tcs[nf] = tc;
         tls[nf] = tl;
         sins[nf] = sinTheta;

@@ -132,3 +132,59 @@ TEST(OpenClHeaders, KernelSourcesUseNoVariadicMacros) {
     }
     EXPECT_GE(files, 20);
 }
+
+// ub_lane_mask4 / ub_lane_mask8 (kernels/shared/ub_defs.h) give bit j for a true lane j: every
+// pattern of four and of eight lanes, in the movmskps form PoCL's x86 devices take and in the
+// portable form (UB_PORTABLE_LANE_MASK) other devices take.
+TEST(OpenClHeaders, LaneMasksGiveOneBitPerTrueLane) {
+    ClDevice dev = findDevice();
+    ASSERT_TRUE(dev.error.empty()) << dev.error;
+    cl_int err = CL_SUCCESS;
+    cl_context ctx = clCreateContext(nullptr, 1, &dev.device, nullptr, nullptr, &err);
+    ASSERT_EQ(err, CL_SUCCESS) << "clCreateContext failed on " << dev.description;
+    cl_command_queue queue = clCreateCommandQueue(ctx, dev.device, 0, &err);
+    ASSERT_EQ(err, CL_SUCCESS);
+    const std::string src = R"(#include "ub_defs.h"
+__kernel void ub_lane_masks(__global uint* out) {
+    uint i = get_global_id(0);
+    int8 v = (int8)(0) - (int8)((int)(i & 1u), (int)(i >> 1 & 1u), (int)(i >> 2 & 1u),
+                                (int)(i >> 3 & 1u), (int)(i >> 4 & 1u), (int)(i >> 5 & 1u),
+                                (int)(i >> 6 & 1u), (int)(i >> 7 & 1u));
+    out[2u * i] = ub_lane_mask8(v);
+    out[2u * i + 1u] = ub_lane_mask4(v.lo);
+})";
+    for (const char* variant : {"", " -DUB_PORTABLE_LANE_MASK"}) {
+        SCOPED_TRACE(std::string("options:") + variant);
+        const char* s = src.c_str();
+        size_t len = src.size();
+        cl_program prog = clCreateProgramWithSource(ctx, 1, &s, &len, &err);
+        ASSERT_EQ(err, CL_SUCCESS);
+        const std::string options =
+            "-cl-std=CL1.2 -I" + std::string(UNIBEAM_SOURCE_DIR) + "/kernels/shared" + variant;
+        ASSERT_EQ(clBuildProgram(prog, 1, &dev.device, options.c_str(), nullptr, nullptr),
+                  CL_SUCCESS);
+        cl_kernel kernel = clCreateKernel(prog, "ub_lane_masks", &err);
+        ASSERT_EQ(err, CL_SUCCESS);
+        std::vector<cl_uint> out(512, 0xdeadbeefu);
+        cl_mem buf =
+            clCreateBuffer(ctx, CL_MEM_WRITE_ONLY, out.size() * sizeof(cl_uint), nullptr, &err);
+        ASSERT_EQ(err, CL_SUCCESS);
+        ASSERT_EQ(clSetKernelArg(kernel, 0, sizeof(buf), &buf), CL_SUCCESS);
+        const size_t global = 256;
+        ASSERT_EQ(clEnqueueNDRangeKernel(queue, kernel, 1, nullptr, &global, nullptr, 0, nullptr,
+                                         nullptr),
+                  CL_SUCCESS);
+        ASSERT_EQ(clEnqueueReadBuffer(queue, buf, CL_TRUE, 0, out.size() * sizeof(cl_uint),
+                                      out.data(), 0, nullptr, nullptr),
+                  CL_SUCCESS);
+        for (cl_uint i = 0; i < 256; ++i) {
+            EXPECT_EQ(out[2 * i], i) << "eight lanes, pattern " << i;
+            EXPECT_EQ(out[2 * i + 1], i & 15u) << "four lanes, pattern " << i;
+        }
+        clReleaseMemObject(buf);
+        clReleaseKernel(kernel);
+        clReleaseProgram(prog);
+    }
+    clReleaseCommandQueue(queue);
+    clReleaseContext(ctx);
+}

@@ -158,7 +158,7 @@ UB_INLINE ub_uint ub_bvh_meets_global(__global const ub_bvh_node* n, ub_float3 o
     UB_BVH_SLAB(float4, vload4(0, n->loY), vload4(0, n->hiY), o.y, invD.y, t0, t1)
     UB_BVH_SLAB(float4, vload4(0, n->loZ), vload4(0, n->hiZ), o.z, invD.z, t0, t1)
     int4 hit = (t0 <= t1) & (vload4(0, n->count) != (uint4)(UB_BVH_NONE));
-    return (ub_uint)((hit.x & 1) | (hit.y & 2) | (hit.z & 4) | (hit.w & 8));
+    return ub_lane_mask4(hit);
 }
 
 /* The line filter of ub_beam_lines_near4 on T lanes (float4: one block; float8: two), its
@@ -187,7 +187,7 @@ UB_INLINE ub_uint ub_beam_lines_near4_global(__global const ub_beam_keys4* k, ub
                                              ub_float3 d, float radiusSqr) {
     int4 near;
     UB_BEAM_LINES_NEAR(float4, int4, UB_KEYS_LOAD4, o, d, radiusSqr, near)
-    return (ub_uint)((near.x & 1) | (near.y & 2) | (near.z & 4) | (near.w & 8));
+    return ub_lane_mask4(near);
 }
 
 /* Two consecutive blocks k[0], k[1] as float8 lanes, the same operations: bits 0-3 are block
@@ -197,8 +197,7 @@ UB_INLINE ub_uint ub_beam_lines_near8_global(__global const ub_beam_keys4* k, ub
                                              ub_float3 d, float radiusSqr) {
     int8 near;
     UB_BEAM_LINES_NEAR(float8, int8, UB_KEYS_LOAD8, o, d, radiusSqr, near)
-    return (ub_uint)((near.s0 & 1) | (near.s1 & 2) | (near.s2 & 4) | (near.s3 & 8) |
-                     (near.s4 & 16) | (near.s5 & 32) | (near.s6 & 64) | (near.s7 & 128));
+    return ub_lane_mask8(near);
 }
 
 /* The kernels' ub_bvh_contains, the same way. */
@@ -206,7 +205,7 @@ UB_INLINE ub_uint ub_bvh_contains_global(__global const ub_bvh_node* n, ub_float
     int4 in = (vload4(0, n->loX) <= p.x) & (vload4(0, n->hiX) >= p.x) & (vload4(0, n->loY) <= p.y) &
               (vload4(0, n->hiY) >= p.y) & (vload4(0, n->loZ) <= p.z) & (vload4(0, n->hiZ) >= p.z) &
               (vload4(0, n->count) != (uint4)(UB_BVH_NONE));
-    return (ub_uint)((in.x & 1) | (in.y & 2) | (in.z & 4) | (in.w & 8));
+    return ub_lane_mask4(in);
 }
 #endif
 

@@ -66,6 +66,45 @@ typedef uint32_t ub_uint;
 #define UB_CACHE_ALIGNED alignas(64)
 #endif
 
+/* A hint to start loading the cache line of address p. The host twins use the compiler's
+ * builtin. In OpenCL C, `prefetch()` does nothing on PoCL, so on a clang-built x86-64 or
+ * AArch64 device compiler (PoCL's CPU devices) the kernels take the clang builtin, which
+ * becomes the CPU's prefetch instruction; other device compilers get no hint. */
+#if !defined(__OPENCL_C_VERSION__) || \
+    (defined(__clang__) && (defined(__x86_64__) || defined(__aarch64__)))
+#define UB_PREFETCH(p) __builtin_prefetch(p)
+#else
+#define UB_PREFETCH(p) ((void)0)
+#endif
+
+#ifdef __OPENCL_C_VERSION__
+/* Bit j set where lane j of a vector comparison (-1 true, 0 false) is true. On clang's x86
+ * targets (PoCL's CPU devices) one movmskps: LLVM 15 compiles the portable form, four ands and
+ * three ors of the lanes, to nine extracts and ors, a tenth of PoCL's code for bb1d's walk
+ * (docs/performance.md, session 34). The result is the same either way (UB_PORTABLE_LANE_MASK
+ * forces the portable form; tests/opencl_headers_test.cpp runs both). */
+#if defined(__clang__) && defined(__SSE__) && !defined(UB_PORTABLE_LANE_MASK)
+typedef float ub_v4sf __attribute__((vector_size(16)));
+UB_INLINE ub_uint ub_lane_mask4(int4 v) {
+    return (ub_uint)__builtin_ia32_movmskps((ub_v4sf)as_float4(v));
+}
+#else
+UB_INLINE ub_uint ub_lane_mask4(int4 v) {
+    return (ub_uint)((v.x & 1) | (v.y & 2) | (v.z & 4) | (v.w & 8));
+}
+#endif
+#if defined(__clang__) && defined(__AVX__) && !defined(UB_PORTABLE_LANE_MASK)
+typedef float ub_v8sf __attribute__((vector_size(32)));
+UB_INLINE ub_uint ub_lane_mask8(int8 v) {
+    return (ub_uint)__builtin_ia32_movmskps256((ub_v8sf)as_float8(v));
+}
+#else
+UB_INLINE ub_uint ub_lane_mask8(int8 v) {
+    return ub_lane_mask4(v.lo) | ub_lane_mask4(v.hi) << 4;
+}
+#endif
+#endif
+
 #define UB_PI 3.14159265358979323846f
 #define UB_INV_PI 0.31830988618379067154f
 

@@ -67,7 +67,7 @@ UB_INLINE ub_uint ub_pb2d_near4_global(__global const ub_photon_keys4* k, ub_flo
     int4 near = (tp >= 0.0f) & (tp <= length) & (d2 <= radiusSqr) &
                 (vload4(0, k->mediumId) == (uint4)(mediumId));
     vstore4(tp, 0, t);
-    return (ub_uint)((near.x & 1) | (near.y & 2) | (near.z & 4) | (near.w & 8));
+    return ub_lane_mask4(near);
 }
 #endif
 
