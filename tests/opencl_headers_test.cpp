@@ -188,3 +188,74 @@ __kernel void ub_lane_masks(__global uint* out) {
     clReleaseCommandQueue(queue);
     clReleaseContext(ctx);
 }
+
+// ub_hash_buckets8, the kernels' form of ub_hash_buckets (kernels/shared/ub_hash_grid.h), gives
+// the same buckets in the same order. Bucket counts of 1 to 64 make two cells of a block share a
+// bucket often, so the duplicate test is exercised, and 2^20 rarely.
+TEST(OpenClHeaders, HashBuckets8EqualsHashBuckets) {
+    ClDevice dev = findDevice();
+    ASSERT_TRUE(dev.error.empty()) << dev.error;
+    cl_int err = CL_SUCCESS;
+    cl_context ctx = clCreateContext(nullptr, 1, &dev.device, nullptr, nullptr, &err);
+    ASSERT_EQ(err, CL_SUCCESS) << "clCreateContext failed on " << dev.description;
+    cl_command_queue queue = clCreateCommandQueue(ctx, dev.device, 0, &err);
+    ASSERT_EQ(err, CL_SUCCESS);
+    // Work-item i: a point on a lattice of 1/7 cells around the origin, buckets 2^(i % 7),
+    // or 2^20 for i % 7 == 6. out[18 i ...]: both counts, then both bucket lists.
+    const std::string src = R"(#include "ub_hash_grid.h"
+__kernel void ub_hash_pair(__global uint* out) {
+    uint i = get_global_id(0);
+    ub_hash_grid g;
+    g.lo[0] = -1.0f; g.lo[1] = -2.0f; g.lo[2] = -3.0f;
+    g.invCellSize = 0.5f;
+    g.radiusSqr = 1.0f;
+    g.cellCount = i % 7u == 6u ? (1u << 20) : (1u << (i % 7u));
+    g.pad0 = g.pad1 = 0u;
+    ub_float3 q = ub_make_float3((float)(i % 23u) / 7.0f - 1.5f, (float)(i / 23u % 19u) / 7.0f,
+                                 (float)(i / 437u) / 7.0f - 3.0f);
+    uint a[8], b[8];
+    for (int k = 0; k < 8; ++k) a[k] = b[k] = 0xffffffffu;
+    int na = ub_hash_buckets(g, q, a), nb = ub_hash_buckets8(g, q, b);
+    out[18u * i] = (uint)na;
+    out[18u * i + 1u] = (uint)nb;
+    for (int k = 0; k < 8; ++k) {
+        out[18u * i + 2u + k] = k < na ? a[k] : 0xffffffffu;
+        out[18u * i + 10u + k] = k < nb ? b[k] : 0xffffffffu;
+    }
+})";
+    const char* s = src.c_str();
+    size_t len = src.size();
+    cl_program prog = clCreateProgramWithSource(ctx, 1, &s, &len, &err);
+    ASSERT_EQ(err, CL_SUCCESS);
+    const std::string options =
+        "-cl-std=CL1.2 -I" + std::string(UNIBEAM_SOURCE_DIR) + "/kernels/shared";
+    ASSERT_EQ(clBuildProgram(prog, 1, &dev.device, options.c_str(), nullptr, nullptr), CL_SUCCESS);
+    cl_kernel kernel = clCreateKernel(prog, "ub_hash_pair", &err);
+    ASSERT_EQ(err, CL_SUCCESS);
+    const size_t n = 23 * 19 * 12;
+    std::vector<cl_uint> out(18 * n, 0);
+    cl_mem buf =
+        clCreateBuffer(ctx, CL_MEM_WRITE_ONLY, out.size() * sizeof(cl_uint), nullptr, &err);
+    ASSERT_EQ(err, CL_SUCCESS);
+    ASSERT_EQ(clSetKernelArg(kernel, 0, sizeof(buf), &buf), CL_SUCCESS);
+    ASSERT_EQ(clEnqueueNDRangeKernel(queue, kernel, 1, nullptr, &n, nullptr, 0, nullptr, nullptr),
+              CL_SUCCESS);
+    ASSERT_EQ(clEnqueueReadBuffer(queue, buf, CL_TRUE, 0, out.size() * sizeof(cl_uint), out.data(),
+                                  0, nullptr, nullptr),
+              CL_SUCCESS);
+    int withDuplicates = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const cl_uint* r = &out[18 * i];
+        ASSERT_EQ(r[0], r[1]) << "point " << i;
+        for (int k = 0; k < 8; ++k)
+            ASSERT_EQ(r[2 + k], r[10 + k]) << "point " << i << " bucket " << k;
+        withDuplicates += r[0] < 8 ? 1 : 0;
+    }
+    EXPECT_GT(withDuplicates, int(n / 2));  // the duplicate test ran
+    EXPECT_LT(withDuplicates, int(n));      // and so did the case without duplicates
+    clReleaseMemObject(buf);
+    clReleaseKernel(kernel);
+    clReleaseProgram(prog);
+    clReleaseCommandQueue(queue);
+    clReleaseContext(ctx);
+}

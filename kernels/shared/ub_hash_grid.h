@@ -37,9 +37,9 @@ UB_INLINE ub_uint ub_hash_point(ub_hash_grid g, ub_float3 p) {
 
 /* The distinct buckets of the 2x2x2 block of cells nearest to q (two cells may hash to the
  * same bucket: each is visited once); returns how many (<= 8). */
-UB_INLINE int ub_hash_buckets(ub_hash_grid g, ub_float3 q, UB_PRIVATE ub_uint* buckets) {
+/* The lowest cell of the 2x2x2 block of cells nearest to q. */
+UB_INLINE void ub_hash_block_base(ub_hash_grid g, ub_float3 q, UB_PRIVATE int* base) {
     float d[3];
-    int base[3];
     d[0] = (q.x - g.lo[0]) * g.invCellSize;
     d[1] = (q.y - g.lo[1]) * g.invCellSize;
     d[2] = (q.z - g.lo[2]) * g.invCellSize;
@@ -47,6 +47,11 @@ UB_INLINE int ub_hash_buckets(ub_hash_grid g, ub_float3 q, UB_PRIVATE ub_uint* b
         float f = ub_floor(d[a]);
         base[a] = (int)f - (d[a] - f < 0.5f ? 1 : 0);
     }
+}
+
+UB_INLINE int ub_hash_buckets(ub_hash_grid g, ub_float3 q, UB_PRIVATE ub_uint* buckets) {
+    int base[3];
+    ub_hash_block_base(g, q, base);
     int nb = 0;
     for (int k = 0; k < 8; ++k) {
         ub_uint b =
@@ -88,6 +93,29 @@ UB_INLINE int ub_hash_ranges(ub_hash_grid g, ub_float3 q, UB_GLOBAL const ub_uin
 }
 
 #ifdef __OPENCL_C_VERSION__
+/* ub_hash_buckets with the eight hashes as one uint8 and each bucket's test against the earlier
+ * ones as one comparison and lane mask, without branches: the same buckets in the same order.
+ * PoCL ran ub_hash_buckets' loop of up to 28 scalar comparisons, with its data-dependent trip
+ * counts, at about a tenth of the surf kernel's time (docs/performance.md, session 34). */
+UB_INLINE int ub_hash_buckets8(ub_hash_grid g, ub_float3 q, UB_PRIVATE ub_uint* buckets) {
+    int base[3];
+    ub_hash_block_base(g, q, base);
+    /* ub_hash_cell of cell k = base + (k & 1, k >> 1 & 1, k >> 2), lane k */
+    uint8 x = (uint8)((uint)base[0]) + (uint8)(0u, 1u, 0u, 1u, 0u, 1u, 0u, 1u);
+    uint8 y = (uint8)((uint)base[1]) + (uint8)(0u, 0u, 1u, 1u, 0u, 0u, 1u, 1u);
+    uint8 z = (uint8)((uint)base[2]) + (uint8)(0u, 0u, 0u, 0u, 1u, 1u, 1u, 1u);
+    uint8 h = ((x * 73856093u) ^ (y * 19349663u) ^ (z * 83492791u)) & (uint8)(g.cellCount - 1u);
+    ub_uint hs[8];
+    vstore8(h, 0, hs);
+    int nb = 0;
+    for (int k = 0; k < 8; ++k) {
+        ub_uint seen = ub_lane_mask8(h == (uint8)(hs[k])) & ((1u << k) - 1u);
+        buckets[nb] = hs[k];
+        nb += seen == 0u ? 1 : 0;
+    }
+    return nb;
+}
+
 /* ub_hash_ranges for a work-group, every work-item of which must call it (`live` false for
  * one past the queries: it gets no ranges): the buckets of every query, a barrier, the bounds
  * of every bucket, a barrier. No local memory is shared; the barriers make PoCL run each phase
@@ -98,7 +126,7 @@ UB_INLINE int ub_hash_ranges_group(ub_hash_grid g, ub_float3 q, int live,
                                    UB_GLOBAL const ub_uint* cellEnds, UB_PRIVATE ub_uint* begins,
                                    UB_PRIVATE ub_uint* ends) {
     ub_uint buckets[8];
-    int nb = live ? ub_hash_buckets(g, q, buckets) : 0;
+    int nb = live ? ub_hash_buckets8(g, q, buckets) : 0;
     barrier(CLK_LOCAL_MEM_FENCE);
     int nr = ub_hash_bucket_ranges(buckets, nb, cellEnds, begins, ends);
     barrier(CLK_LOCAL_MEM_FENCE);
