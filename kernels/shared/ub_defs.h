@@ -30,7 +30,12 @@ typedef uint ub_uint;
 #define ub_atan2(y, x) atan2(y, x)
 #define ub_acos(x) acos(x)
 #define ub_log(x) log(x)
+/* PoCL's floor() is a software routine with three branches; clang's builtin is one roundss. */
+#ifdef __clang__
+#define ub_floor(x) __builtin_floorf(x)
+#else
 #define ub_floor(x) floor(x)
+#endif
 #define ub_erf(x) erf(x)
 #define ub_erfc(x) erfc(x)
 #else
