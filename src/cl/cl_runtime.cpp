@@ -552,13 +552,21 @@ void ClRuntime::runEstimate(cl_kernel kernel, const char* name, const std::vecto
                           : clEnqueueNDRangeKernel(queue_, kernel, 1, nullptr, &global, &local, 0,
                                                    nullptr, nullptr);
                 if (err == CL_SUCCESS && inPlace) {
+                    // The map is enqueued without waiting: where the device maps the results in
+                    // place (PoCL), map, unmap and kernel are waited for once, by clFinish. A
+                    // blocking map and then clFinish waited twice on the device's threads, a
+                    // few percent of the millisecond passes (docs/performance.md, session 34).
                     step = "clEnqueueMapBuffer(results)";
-                    void* p = clEnqueueMapBuffer(queue_, res, CL_TRUE, CL_MAP_READ, 0,
+                    void* p = clEnqueueMapBuffer(queue_, res, CL_FALSE, CL_MAP_READ, 0,
                                                  n * 3 * sizeof(float), 0, nullptr, nullptr, &err);
-                    if (err == CL_SUCCESS) {
-                        // A device that could not use the pointer in place maps a copy.
-                        if (p != &(*out)[begin])
+                    if (err == CL_SUCCESS && p != &(*out)[begin]) {
+                        // A device that could not use the pointer in place maps a copy, which
+                        // may be read once the map is done.
+                        err = clFinish(queue_);
+                        if (err == CL_SUCCESS)
                             std::memcpy(&(*out)[begin], p, n * 3 * sizeof(float));
+                    }
+                    if (err == CL_SUCCESS) {
                         step = "clEnqueueUnmapMemObject(results)";
                         err = clEnqueueUnmapMemObject(queue_, res, p, 0, nullptr, nullptr);
                         if (err == CL_SUCCESS) err = clFinish(queue_);
