@@ -85,8 +85,8 @@ typedef uint32_t ub_uint;
 #ifdef __OPENCL_C_VERSION__
 /* Bit j set where lane j of a vector comparison (-1 true, 0 false) is true. On clang's x86
  * targets (PoCL's CPU devices) one movmskps: LLVM 15 compiles the portable form, four ands and
- * three ors of the lanes, to nine extracts and ors, a tenth of PoCL's code for bb1d's walk
- * (docs/performance.md, session 34). The result is the same either way (UB_PORTABLE_LANE_MASK
+ * three ors of the lanes, to nine extracts and ors, about 5% of the bb1d kernel's samples
+ * (perf; docs/performance.md, session 34). The result is the same either way (UB_PORTABLE_LANE_MASK
  * forces the portable form; tests/opencl_headers_test.cpp runs both). */
 #if defined(__clang__) && defined(__SSE__) && !defined(UB_PORTABLE_LANE_MASK)
 typedef float ub_v4sf __attribute__((vector_size(16)));
