@@ -30,8 +30,10 @@ typedef uint ub_uint;
 #define ub_atan2(y, x) atan2(y, x)
 #define ub_acos(x) acos(x)
 #define ub_log(x) log(x)
-/* PoCL's floor() is a software routine with three branches; clang's builtin is one roundss. */
-#ifdef __clang__
+/* PoCL's floor() is a software routine with three branches; clang's builtin is one roundss.
+ * Only for clang's x86-64 targets (PoCL's CPU devices): a GPU's floor() is its own instruction
+ * already, and its driver's compiler need not know the builtin. */
+#if defined(__clang__) && defined(__x86_64__)
 #define ub_floor(x) __builtin_floorf(x)
 #else
 #define ub_floor(x) floor(x)
