@@ -133,10 +133,11 @@ TEST(OpenClHeaders, KernelSourcesUseNoVariadicMacros) {
     EXPECT_GE(files, 20);
 }
 
-// ub_lane_mask4 / ub_lane_mask8 (kernels/shared/ub_defs.h) give bit j for a true lane j: every
-// pattern of four and of eight lanes, in the movmskps form PoCL's x86 devices take and in the
-// portable form (UB_PORTABLE_LANE_MASK) other devices take.
-TEST(OpenClHeaders, LaneMasksGiveOneBitPerTrueLane) {
+// Builds `src` as OpenCL C 1.2 on findDevice()'s device, with kernels/shared on the include path
+// and `options` added, runs kernel `name` over `global` work-items with one argument, a buffer of
+// out->size() uints, and reads the buffer back into *out. Any OpenCL error fails the test.
+static void runUintKernel(const std::string& src, const char* name, const std::string& options,
+                          size_t global, std::vector<cl_uint>* out) {
     ClDevice dev = findDevice();
     ASSERT_TRUE(dev.error.empty()) << dev.error;
     cl_int err = CL_SUCCESS;
@@ -144,6 +145,37 @@ TEST(OpenClHeaders, LaneMasksGiveOneBitPerTrueLane) {
     ASSERT_EQ(err, CL_SUCCESS) << "clCreateContext failed on " << dev.description;
     cl_command_queue queue = clCreateCommandQueue(ctx, dev.device, 0, &err);
     ASSERT_EQ(err, CL_SUCCESS);
+    const char* s = src.c_str();
+    size_t len = src.size();
+    cl_program prog = clCreateProgramWithSource(ctx, 1, &s, &len, &err);
+    ASSERT_EQ(err, CL_SUCCESS);
+    const std::string all =
+        "-cl-std=CL1.2 -I" + std::string(UNIBEAM_SOURCE_DIR) + "/kernels/shared" + options;
+    ASSERT_EQ(clBuildProgram(prog, 1, &dev.device, all.c_str(), nullptr, nullptr), CL_SUCCESS)
+        << "options: " << all;
+    cl_kernel kernel = clCreateKernel(prog, name, &err);
+    ASSERT_EQ(err, CL_SUCCESS);
+    cl_mem buf =
+        clCreateBuffer(ctx, CL_MEM_WRITE_ONLY, out->size() * sizeof(cl_uint), nullptr, &err);
+    ASSERT_EQ(err, CL_SUCCESS);
+    ASSERT_EQ(clSetKernelArg(kernel, 0, sizeof(buf), &buf), CL_SUCCESS);
+    ASSERT_EQ(
+        clEnqueueNDRangeKernel(queue, kernel, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
+        CL_SUCCESS);
+    ASSERT_EQ(clEnqueueReadBuffer(queue, buf, CL_TRUE, 0, out->size() * sizeof(cl_uint),
+                                  out->data(), 0, nullptr, nullptr),
+              CL_SUCCESS);
+    clReleaseMemObject(buf);
+    clReleaseKernel(kernel);
+    clReleaseProgram(prog);
+    clReleaseCommandQueue(queue);
+    clReleaseContext(ctx);
+}
+
+// ub_lane_mask4 / ub_lane_mask8 (kernels/shared/ub_defs.h) give bit j for a true lane j: every
+// pattern of four and of eight lanes, in the movmskps form PoCL's x86 devices take and in the
+// portable form (UB_PORTABLE_LANE_MASK) other devices take.
+TEST(OpenClHeaders, LaneMasksGiveOneBitPerTrueLane) {
     const std::string src = R"(#include "ub_defs.h"
 __kernel void ub_lane_masks(__global uint* out) {
     uint i = get_global_id(0);
@@ -155,51 +187,19 @@ __kernel void ub_lane_masks(__global uint* out) {
 })";
     for (const char* variant : {"", " -DUB_PORTABLE_LANE_MASK"}) {
         SCOPED_TRACE(std::string("options:") + variant);
-        const char* s = src.c_str();
-        size_t len = src.size();
-        cl_program prog = clCreateProgramWithSource(ctx, 1, &s, &len, &err);
-        ASSERT_EQ(err, CL_SUCCESS);
-        const std::string options =
-            "-cl-std=CL1.2 -I" + std::string(UNIBEAM_SOURCE_DIR) + "/kernels/shared" + variant;
-        ASSERT_EQ(clBuildProgram(prog, 1, &dev.device, options.c_str(), nullptr, nullptr),
-                  CL_SUCCESS);
-        cl_kernel kernel = clCreateKernel(prog, "ub_lane_masks", &err);
-        ASSERT_EQ(err, CL_SUCCESS);
         std::vector<cl_uint> out(512, 0xdeadbeefu);
-        cl_mem buf =
-            clCreateBuffer(ctx, CL_MEM_WRITE_ONLY, out.size() * sizeof(cl_uint), nullptr, &err);
-        ASSERT_EQ(err, CL_SUCCESS);
-        ASSERT_EQ(clSetKernelArg(kernel, 0, sizeof(buf), &buf), CL_SUCCESS);
-        const size_t global = 256;
-        ASSERT_EQ(clEnqueueNDRangeKernel(queue, kernel, 1, nullptr, &global, nullptr, 0, nullptr,
-                                         nullptr),
-                  CL_SUCCESS);
-        ASSERT_EQ(clEnqueueReadBuffer(queue, buf, CL_TRUE, 0, out.size() * sizeof(cl_uint),
-                                      out.data(), 0, nullptr, nullptr),
-                  CL_SUCCESS);
+        ASSERT_NO_FATAL_FAILURE(runUintKernel(src, "ub_lane_masks", variant, 256, &out));
         for (cl_uint i = 0; i < 256; ++i) {
             EXPECT_EQ(out[2 * i], i) << "eight lanes, pattern " << i;
             EXPECT_EQ(out[2 * i + 1], i & 15u) << "four lanes, pattern " << i;
         }
-        clReleaseMemObject(buf);
-        clReleaseKernel(kernel);
-        clReleaseProgram(prog);
     }
-    clReleaseCommandQueue(queue);
-    clReleaseContext(ctx);
 }
 
 // ub_hash_buckets8, the kernels' form of ub_hash_buckets (kernels/shared/ub_hash_grid.h), gives
 // the same buckets in the same order. Bucket counts of 1 to 64 make two cells of a block share a
 // bucket often, so the duplicate test is exercised, and 2^20 rarely.
 TEST(OpenClHeaders, HashBuckets8EqualsHashBuckets) {
-    ClDevice dev = findDevice();
-    ASSERT_TRUE(dev.error.empty()) << dev.error;
-    cl_int err = CL_SUCCESS;
-    cl_context ctx = clCreateContext(nullptr, 1, &dev.device, nullptr, nullptr, &err);
-    ASSERT_EQ(err, CL_SUCCESS) << "clCreateContext failed on " << dev.description;
-    cl_command_queue queue = clCreateCommandQueue(ctx, dev.device, 0, &err);
-    ASSERT_EQ(err, CL_SUCCESS);
     // Work-item i: a point on a lattice of 1/7 cells around the origin, buckets 2^(i % 7),
     // or 2^20 for i % 7 == 6. out[18 i ...]: both counts, then both bucket lists.
     const std::string src = R"(#include "ub_hash_grid.h"
@@ -223,26 +223,9 @@ __kernel void ub_hash_pair(__global uint* out) {
         out[18u * i + 10u + k] = k < nb ? b[k] : 0xffffffffu;
     }
 })";
-    const char* s = src.c_str();
-    size_t len = src.size();
-    cl_program prog = clCreateProgramWithSource(ctx, 1, &s, &len, &err);
-    ASSERT_EQ(err, CL_SUCCESS);
-    const std::string options =
-        "-cl-std=CL1.2 -I" + std::string(UNIBEAM_SOURCE_DIR) + "/kernels/shared";
-    ASSERT_EQ(clBuildProgram(prog, 1, &dev.device, options.c_str(), nullptr, nullptr), CL_SUCCESS);
-    cl_kernel kernel = clCreateKernel(prog, "ub_hash_pair", &err);
-    ASSERT_EQ(err, CL_SUCCESS);
     const size_t n = 23 * 19 * 12;
     std::vector<cl_uint> out(18 * n, 0);
-    cl_mem buf =
-        clCreateBuffer(ctx, CL_MEM_WRITE_ONLY, out.size() * sizeof(cl_uint), nullptr, &err);
-    ASSERT_EQ(err, CL_SUCCESS);
-    ASSERT_EQ(clSetKernelArg(kernel, 0, sizeof(buf), &buf), CL_SUCCESS);
-    ASSERT_EQ(clEnqueueNDRangeKernel(queue, kernel, 1, nullptr, &n, nullptr, 0, nullptr, nullptr),
-              CL_SUCCESS);
-    ASSERT_EQ(clEnqueueReadBuffer(queue, buf, CL_TRUE, 0, out.size() * sizeof(cl_uint), out.data(),
-                                  0, nullptr, nullptr),
-              CL_SUCCESS);
+    ASSERT_NO_FATAL_FAILURE(runUintKernel(src, "ub_hash_pair", "", n, &out));
     int withDuplicates = 0;
     for (size_t i = 0; i < n; ++i) {
         const cl_uint* r = &out[18 * i];
@@ -253,9 +236,4 @@ __kernel void ub_hash_pair(__global uint* out) {
     }
     EXPECT_GT(withDuplicates, int(n / 2));  // the duplicate test ran
     EXPECT_LT(withDuplicates, int(n));      // and so did the case without duplicates
-    clReleaseMemObject(buf);
-    clReleaseKernel(kernel);
-    clReleaseProgram(prog);
-    clReleaseCommandQueue(queue);
-    clReleaseContext(ctx);
 }
