@@ -21,8 +21,12 @@ typedef struct {
 UB_INLINE ub_segment_eval ub_homogeneous_segment_cp(ub_medium_info m, float t, float contProb) {
     ub_segment_eval e;
     float stop = 0.0f, pass = 0.0f;
+    /* A grey medium (equal sigma_t) needs one exponential: the same argument gives the same
+     * value, so the result is that of three calls, bit for bit. */
+    const float T0 = ub_exp(-m.sigmaT[0] * t);
+    const int grey = m.sigmaT[1] == m.sigmaT[0] && m.sigmaT[2] == m.sigmaT[0];
     for (int a = 0; a < 3; ++a) {
-        float T = ub_exp(-m.sigmaT[a] * t);
+        float T = (a == 0 || grey) ? T0 : ub_exp(-m.sigmaT[a] * t);
         e.transmittance[a] = T;
         e.sigmaS[a] = m.sigmaS[a];
         stop += m.sigmaT[a] * T;

@@ -578,15 +578,16 @@ bool VertexCM::stackTowards(const PathVertex& v, const SubPath& state, const Vec
 bool VertexCM::sampleScattering(Rng& rng, const VertexScatter& scatter, const PathVertex& v,
                                 SubPath& state, bool onlyNull) const {
     Vec3 dirGen;
-    float dirPdfW = 0.0f, cosThetaOut = 0.0f;
+    float dirPdfW = 0.0f, cosThetaOut = 0.0f, sampledRevPdfW = 0.0f;
     uint32_t event = kEventNone;
-    Rgb f = scatter.sample(rng.uniform3(), &dirGen, &dirPdfW, &cosThetaOut, &event);
+    Rgb f =
+        scatter.sample(rng.uniform3(), &dirGen, &dirPdfW, &cosThetaOut, &event, &sampledRevPdfW);
     if (isBlack(f) || !(dirPdfW > 0.0f)) return false;
     const bool nullEvent = nullNotCounted_ && scatter.isNullEvent(event);
     if (onlyNull && !nullEvent) return false;
     const bool specular = (event & kEventSpecular) != 0;
-    // For a delta lobe the reverse pdf equals the forward one; otherwise evaluate it.
-    float revPdfW = specular ? dirPdfW : scatter.pdf(dirGen, /*reverse=*/true);
+    // For a delta lobe the reverse pdf equals the forward one; otherwise sample() computed it.
+    float revPdfW = specular ? dirPdfW : sampledRevPdfW;
 
     // Russian roulette (SmallVCM): continue with probability q; q is part of both pdfs.
     const float contProb = scatter.continuationProb();

@@ -87,12 +87,16 @@ class VertexScatter {
         if (reversePdfW) *reversePdfW = p;
         return Rgb(p);
     }
-    /// Samples dirGen; as Bsdf::sample (value * cos / pdf is the throughput factor).
+    /// Samples dirGen; as Bsdf::sample (value * cos / pdf is the throughput factor, and
+    /// *reversePdfW is pdf(*dirGen, true) for a non-delta event).
     Rgb sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
-               uint32_t* sampledEvent) const {
-        if (!inMedium_) return bsdf_.sample(rnd, dirGen, pdfW, cosThetaGen, sampledEvent);
+               uint32_t* sampledEvent, float* reversePdfW) const {
+        if (!inMedium_)
+            return bsdf_.sample(rnd, dirGen, pdfW, cosThetaGen, sampledEvent, reversePdfW);
         ub_float3 w = ub_hg_sample(f3(dirFix_), g_, rnd.x, rnd.y, pdfW);
         *dirGen = normalize(Vec3(w.x, w.y, w.z));
+        // pdf(*dirGen, true) recomputes the pdf from the normalised direction; so does this.
+        *reversePdfW = ub_hg_pdf(f3(dirFix_), f3(*dirGen), g_);
         *cosThetaGen = 1.0f;
         *sampledEvent = kEventDiffuse;  // any non-specular event
         return Rgb(*pdfW);

@@ -388,12 +388,13 @@ float Bsdf::pdf(const Vec3& dirGen, bool reverse) const {
 }
 
 Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
-                 uint32_t* sampledEvent) const {
+                 uint32_t* sampledEvent, float* reversePdfW) const {
     *pdfW = 0.0f;
+    if (reversePdfW) *reversePdfW = 0.0f;
     if (cosThetaGen) *cosThetaGen = 0.0f;
     if (sampledEvent) *sampledEvent = kEventNone;
     if (!valid_ || black_) return Rgb(0.0f);
-    if (blend_) return sampleBlend(rnd, dirGen, pdfW, cosThetaGen, sampledEvent);
+    if (blend_) return sampleBlend(rnd, dirGen, pdfW, cosThetaGen, sampledEvent, reversePdfW);
     if (isDelta_) return sampleDelta(rnd, dirGen, pdfW, cosThetaGen, sampledEvent);
 
     const Vec3& fix = localDirFix_;
@@ -500,6 +501,7 @@ Rgb Bsdf::sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
     if (!(pd > 0.0f)) return Rgb(0.0f);
     *dirGen = world;
     *pdfW = pd;
+    if (reversePdfW) *reversePdfW = pr;
     if (cosThetaGen) *cosThetaGen = cosGen;
     if (sampledEvent) *sampledEvent = event;
     return f;
@@ -535,7 +537,7 @@ Rgb Bsdf::mirrorReflectance() const {
 }
 
 Rgb Bsdf::sampleBlend(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
-                      uint32_t* sampledEvent) const {
+                      uint32_t* sampledEvent, float* reversePdfW) const {
     // Part a with probability 1 - w, b with w; rnd.z rescaled to [0, 1) for the part.
     const float wa = 1.0f - blendWeight_, wb = blendWeight_;
     const int i = (rnd.z < wa || !(wb > 0.0f)) ? 0 : 1;
@@ -557,11 +559,12 @@ Rgb Bsdf::sampleBlend(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThet
         return fPart * select;
     }
     // A non-delta direction: the mixture's value and pdf there (as evaluate()).
-    float pd = 0.0f, cosMix = 0.0f;
-    const Rgb f = evaluate(dir, &cosMix, &pd, nullptr);
+    float pd = 0.0f, pr = 0.0f, cosMix = 0.0f;
+    const Rgb f = evaluate(dir, &cosMix, &pd, &pr);
     if (!(pd > 0.0f)) return Rgb(0.0f);
     *dirGen = dir;
     *pdfW = pd;
+    if (reversePdfW) *reversePdfW = pr;
     if (cosThetaGen) *cosThetaGen = cosMix;
     if (sampledEvent) *sampledEvent = event;
     return f;

@@ -113,8 +113,12 @@ class Bsdf {
     /// pdf including lobe selection. For a delta lobe *pdfW is the discrete lobe probability
     /// and the returned value is the lobe weight / |cos|, so f_s * cosThetaGen / pdfW is the
     /// throughput factor in every case. Returns black and *pdfW = 0 if sampling failed.
+    /// For a non-delta event, *reversePdfW (if given) is pdf(*dirGen, true), computed by the
+    /// same evaluation that gave *pdfW (the bidirectional engine's MIS needs both, and used
+    /// to evaluate the BSDF a second time for it). For a delta event it is 0:
+    /// the reverse pdf of a delta lobe is the forward one, which the caller knows.
     Rgb sample(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
-               uint32_t* sampledEvent) const;
+               uint32_t* sampledEvent, float* reversePdfW = nullptr) const;
     /// Pdf of dirGen given dirFix (reverse=false) or of dirFix given dirGen (reverse=true),
     /// for the non-delta lobes.
     float pdf(const Vec3& dirGen, bool reverse = false) const;
@@ -167,7 +171,7 @@ class Bsdf {
     /// Coating transmittance of a (rough) plastic for |cos| = cosTheta.
     float plasticTransmittance(float cosTheta) const;
     Rgb sampleBlend(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
-                    uint32_t* sampledEvent) const;
+                    uint32_t* sampledEvent, float* reversePdfW) const;
     Rgb sampleDelta(const Vec3& rnd, Vec3* dirGen, float* pdfW, float* cosThetaGen,
                     uint32_t* sampledEvent) const;
     /// Mirror: the conductor Fresnel reflectance at dirFix's angle (1 without

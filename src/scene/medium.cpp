@@ -23,7 +23,11 @@ void checkG(float g) {
 }
 
 Rgb expNeg(const Rgb& tau) {
-    return {std::exp(-tau.x), std::exp(-tau.y), std::exp(-tau.z)};
+    // Grey optical depth (grey media, every grid medium with a grey albedo): one exponential,
+    // the same value as three.
+    const float x = std::exp(-tau.x);
+    if (tau.y == tau.x && tau.z == tau.x) return Rgb(x);
+    return {x, std::exp(-tau.y), std::exp(-tau.z)};
 }
 
 /// Leaf nodes of the default NanoVDB float tree are 8^3 voxels; a voxel whose block has no
