@@ -262,14 +262,17 @@ TEST(Bsdf, SampleMatchesEvaluateAndPdf) {
         int ok = 0;
         for (int i = 0; i < 1000; ++i) {
             Vec3 dir;
-            float pdfW, cosGen;
+            float pdfW, cosGen, revSampled = -1.0f;
             uint32_t event;
-            Rgb f = bsdf.sample(rng.uniform3(), &dir, &pdfW, &cosGen, &event);
+            Rgb f = bsdf.sample(rng.uniform3(), &dir, &pdfW, &cosGen, &event, &revSampled);
             if (pdfW == 0) {
                 ASSERT_TRUE(isBlack(f)) << c.label();
+                ASSERT_EQ(revSampled, 0.0f) << c.label();
                 continue;
             }
             ++ok;
+            // The reverse pdf sample() returns is pdf(dir, true) exactly (the same evaluation).
+            ASSERT_EQ(revSampled, bsdf.pdf(dir, true)) << c.label();
             float cosEval, pdfEval, revEval;
             Rgb fEval = bsdf.evaluate(dir, &cosEval, &pdfEval, &revEval);
             ASSERT_TRUE(nearRel(f, fEval)) << c.label() << " " << str(f) << " vs " << str(fEval);
