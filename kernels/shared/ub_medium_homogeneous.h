@@ -16,17 +16,25 @@ typedef struct {
     ub_uint homogeneous; /* 0: a grid (the kernels leave such media to the host) */
 } ub_medium_info;
 
+/* exp(-tau) per channel. Grey optical depths (grey media, grids with a grey albedo) take one
+ * exponential: the same argument gives the same value, so the result is that of three calls,
+ * bit for bit. The tracing passes' transmittances (src/scene/medium*.cpp) use it too. */
+UB_INLINE void ub_exp_neg3(float tau0, float tau1, float tau2, float* out) {
+    out[0] = ub_exp(-tau0);
+    const int grey = tau1 == tau0 && tau2 == tau0;
+    out[1] = grey ? out[0] : ub_exp(-tau1);
+    out[2] = grey ? out[0] : ub_exp(-tau2);
+}
+
 /* The medium over [0, t] of a homogeneous medium, its continuation probability given
  * (ub_homogeneous_cont_prob, constant per medium: loops over pairs compute it once). */
 UB_INLINE ub_segment_eval ub_homogeneous_segment_cp(ub_medium_info m, float t, float contProb) {
     ub_segment_eval e;
     float stop = 0.0f, pass = 0.0f;
-    /* A grey medium (equal sigma_t) needs one exponential: the same argument gives the same
-     * value, so the result is that of three calls, bit for bit. */
-    const float T0 = ub_exp(-m.sigmaT[0] * t);
-    const int grey = m.sigmaT[1] == m.sigmaT[0] && m.sigmaT[2] == m.sigmaT[0];
+    float Ts[3];
+    ub_exp_neg3(m.sigmaT[0] * t, m.sigmaT[1] * t, m.sigmaT[2] * t, Ts);
     for (int a = 0; a < 3; ++a) {
-        float T = (a == 0 || grey) ? T0 : ub_exp(-m.sigmaT[a] * t);
+        float T = Ts[a];
         e.transmittance[a] = T;
         e.sigmaS[a] = m.sigmaS[a];
         stop += m.sigmaT[a] * T;

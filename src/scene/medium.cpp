@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "kernels/shared/ub_medium_homogeneous.h"
 #include "scene/albedo_grid.h"
 #include "scene/medium_trilinear.h"
 
@@ -23,11 +24,9 @@ void checkG(float g) {
 }
 
 Rgb expNeg(const Rgb& tau) {
-    // Grey optical depth (grey media, every grid medium with a grey albedo): one exponential,
-    // the same value as three.
-    const float x = std::exp(-tau.x);
-    if (tau.y == tau.x && tau.z == tau.x) return Rgb(x);
-    return {x, std::exp(-tau.y), std::exp(-tau.z)};
+    float t[3];
+    ub_exp_neg3(tau.x, tau.y, tau.z, t);
+    return {t[0], t[1], t[2]};
 }
 
 /// Leaf nodes of the default NanoVDB float tree are 8^3 voxels; a voxel whose block has no

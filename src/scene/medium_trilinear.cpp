@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "kernels/shared/ub_medium_homogeneous.h"
+
 namespace ub {
 
 namespace {
@@ -140,7 +142,9 @@ void forEachCubic(const Medium& m, const Vec3& origin, const Vec3& dir, float tM
 }
 
 Rgb expNeg(const Rgb& tau) {
-    return {std::exp(-tau.x), std::exp(-tau.y), std::exp(-tau.z)};
+    float t[3];
+    ub_exp_neg3(tau.x, tau.y, tau.z, t);
+    return {t[0], t[1], t[2]};
 }
 
 /// Solves F(s) = target for s in [0, L], F(s) = scale * integral of c over [0, s]
