@@ -83,6 +83,30 @@
     }                   \
     UB_BVH_LEAVES_END
 
+/* A query's medium, read when its first candidates are evaluated rather than when its
+ * work-item starts: most queries of a pass find no pair (the candle's bp2d: 644 pairs for 28,573
+ * query points), and the medium record, the 112-byte grid record and the continuation
+ * probability cost a walk that finds nothing about as much as its node tests (docs/performance.md,
+ * session 36). The host twins read a query's medium lazily too (BeamMedium). */
+typedef struct {
+    ub_medium_info m;
+    ub_grid_info gi;
+    ub_grid_accessor acc;
+    float mCont;
+    int ready;
+} ub_query_medium;
+
+static void ub_query_medium_load(ub_query_medium* qm, __global const ub_medium_info* media,
+                                 __global const ub_grid_info* grids, __global const uchar* gridData,
+                                 uint mediumId) {
+    if (qm->ready) return;
+    qm->m = media[mediumId];
+    qm->mCont = ub_homogeneous_cont_prob(qm->m);
+    qm->gi = grids[mediumId];
+    if (!qm->m.homogeneous) ub_grid_accessor_init(&qm->acc, gridData, qm->gi);
+    qm->ready = 1;
+}
+
 /* pb2d's pairs, pending[0 .. np - 1] at beam parameters t[0 .. np - 1] in walk order: the
  * photons' records prefetched (UB_PREFETCH: PoCL's CPU devices; a hint or nothing elsewhere) and
  * their path lengths read, whose loads then overlap their cache misses, then the pairs'
@@ -119,11 +143,8 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     uint i = get_global_id(0);
     if (i >= queryCount) return;
     ub_beam qb = queries[i];
-    ub_medium_info m = media[qb.mediumId];
-    const float mCont = ub_homogeneous_cont_prob(m);
-    ub_grid_info gi = grids[qb.mediumId];
-    ub_grid_accessor acc;
-    if (!m.homogeneous) ub_grid_accessor_init(&acc, gridData, gi);
+    ub_query_medium qm;
+    qm.ready = 0;
     ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
     ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
     const float qLength = qb.length, r2 = radius * radius;
@@ -139,23 +160,36 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     int np = 0;
     UB_BVH_LEAVES_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qLength))
     for (uint b = leafFirst / 4u; b * 4u < leafEnd; ++b) {
-        float t[4];
-        uint near = ub_pb2d_near4_global(keys + b, o, d, qLength, qMedium, r2, t) &
-                    ub_block_lanes(b, leafFirst, leafEnd);
+        /* two blocks at once where the leaf has both (ub_pb2d_near8_global) */
+        float t[8];
+        uint near;
+        if ((b + 1u) * 4u < leafEnd) {
+            uint m8 = ub_pb2d_near8_global(keys + b, o, d, qLength, qMedium, r2, t);
+            near = (m8 & ub_block_lanes(b, leafFirst, leafEnd)) |
+                   ((m8 >> 4) & ub_block_lanes(b + 1u, leafFirst, leafEnd)) << 4;
+        } else {
+            near = ub_pb2d_near4_global(keys + b, o, d, qLength, qMedium, r2, t) &
+                   ub_block_lanes(b, leafFirst, leafEnd);
+        }
         for (; near != 0u; near &= near - 1u) {
             uint lane = 31u - clz(near & (0u - near));
             pending[np] = b * 4u + lane;
             pendingT[np++] = t[lane];
             if (np == UB_PB2D_PENDING) {
-                ub_pb2d_flush(photons, m, mCont, gi, &acc, &qb, table, &tableState, mis,
+                ub_query_medium_load(&qm, media, grids, gridData, qMedium);
+                ub_pb2d_flush(photons, qm.m, qm.mCont, qm.gi, &qm.acc, &qb, table, &tableState, mis,
                               normalization, minLength, maxLength, pending, pendingT, np, sum);
                 np = 0;
             }
         }
+        if ((b + 1u) * 4u < leafEnd) ++b; /* the pair's second block is done */
     }
     UB_BVH_LEAVES_END
-    ub_pb2d_flush(photons, m, mCont, gi, &acc, &qb, table, &tableState, mis, normalization,
-                  minLength, maxLength, pending, pendingT, np, sum);
+    if (np > 0) {
+        ub_query_medium_load(&qm, media, grids, gridData, qMedium);
+        ub_pb2d_flush(photons, qm.m, qm.mCont, qm.gi, &qm.acc, &qb, table, &tableState, mis,
+                      normalization, minLength, maxLength, pending, pendingT, np, sum);
+    }
     ub_store_f3(out, i, sum[0], sum[1], sum[2]);
 }
 
@@ -171,22 +205,20 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
     uint i = get_global_id(0);
     if (i >= queryCount) return;
     ub_query_point q = queries[i];
-    ub_medium_info m = media[q.mediumId];
-    const float mCont = ub_homogeneous_cont_prob(m);
-    ub_grid_info gi = grids[q.mediumId];
-    ub_grid_accessor acc;
-    if (!m.homogeneous) ub_grid_accessor_init(&acc, gridData, gi);
+    ub_query_medium qm;
+    qm.ready = 0;
     ub_float3 p = ub_f3_from(q.pos);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     UB_BVH_WALK_BEGIN(nodes, ub_bvh_contains_global(n, p)) {
         ub_beam_part part = parts[k];
         float t = 0.0f;
         if (!ub_bp2d_pair(q, part, radius * radius, minLength, maxLength, &t)) continue;
+        ub_query_medium_load(&qm, media, grids, gridData, q.mediumId);
         ub_beam pb = beams[part.beam];
-        ub_segment_eval s = ub_photon_beam_segment(m, mCont, gi, &acc, pb, t,
+        ub_segment_eval s = ub_photon_beam_segment(qm.m, qm.mCont, qm.gi, &qm.acc, pb, t,
                                                    beamPieces + beamRanges[2u * part.beam],
                                                    beamRanges[2u * part.beam + 1u]);
-        ub_float3 c = ub_bp2d_contribution(mis, pb, q, s, t, m.g, normalization);
+        ub_float3 c = ub_bp2d_contribution(mis, pb, q, s, t, qm.m.g, normalization);
         sx += c.x;
         sy += c.y;
         sz += c.z;
@@ -256,11 +288,8 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
     uint i = get_global_id(0);
     if (i >= queryCount) return;
     ub_beam qb = queries[i];
-    ub_medium_info m = media[qb.mediumId];
-    const float mCont = ub_homogeneous_cont_prob(m);
-    ub_grid_info gi = grids[qb.mediumId];
-    ub_grid_accessor acc;
-    if (!m.homogeneous) ub_grid_accessor_init(&acc, gridData, gi);
+    ub_query_medium qm;
+    qm.ready = 0;
     ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
     ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
     ub_beam_piece table[UB_QUERY_PIECES];
@@ -285,16 +314,21 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
         for (; near != 0u; near &= near - 1u) {
             pending[np++] = b * 4u + (31u - clz(near & (0u - near)));
             if (np == UB_BB1D_PENDING) {
-                ub_bb1d_flush(beams, parts, beamPieces, beamRanges, m, mCont, gi, &acc, &qb, table,
-                              &tableState, mis, radius, normalization, minLength, maxLength,
-                              pending, np, sum);
+                ub_query_medium_load(&qm, media, grids, gridData, qb.mediumId);
+                ub_bb1d_flush(beams, parts, beamPieces, beamRanges, qm.m, qm.mCont, qm.gi, &qm.acc,
+                              &qb, table, &tableState, mis, radius, normalization, minLength,
+                              maxLength, pending, np, sum);
                 np = 0;
             }
         }
         if ((b + 1u) * 4u < leafEnd) ++b; /* the pair's second block is done */
     }
     UB_BVH_LEAVES_END
-    ub_bb1d_flush(beams, parts, beamPieces, beamRanges, m, mCont, gi, &acc, &qb, table, &tableState,
-                  mis, radius, normalization, minLength, maxLength, pending, np, sum);
+    if (np > 0) {
+        ub_query_medium_load(&qm, media, grids, gridData, qb.mediumId);
+        ub_bb1d_flush(beams, parts, beamPieces, beamRanges, qm.m, qm.mCont, qm.gi, &qm.acc, &qb,
+                      table, &tableState, mis, radius, normalization, minLength, maxLength, pending,
+                      np, sum);
+    }
     ub_store_f3(out, i, sum[0], sum[1], sum[2]);
 }

@@ -237,3 +237,58 @@ __kernel void ub_hash_pair(__global uint* out) {
     EXPECT_GT(withDuplicates, int(n / 2));  // the duplicate test ran
     EXPECT_LT(withDuplicates, int(n));      // and so did the case without duplicates
 }
+
+// ub_pb2d_near8_global (kernels/shared/ub_pb2d.h), the pb2d kernel's test of two blocks of
+// photon keys at once, gives block k[0]'s mask in bits 0-3 and block k[1]'s in bits 4-7, and the
+// same beam parameters, bit for bit, as ub_pb2d_near4_global on each block. The photons lie
+// around a beam at distances on both sides of the radius, some before its origin or past its
+// end, some in another medium.
+TEST(OpenClHeaders, Pb2dNear8EqualsTwoBlocksOfFour) {
+    // Work-item i writes its two blocks into out[64 i ...] (32 words), then the masks (3 words)
+    // and both sets of parameters (16 words) after them.
+    const std::string src = R"(#include "ub_pb2d.h"
+__kernel void ub_pb2d_pair8(__global uint* out) {
+    uint i = get_global_id(0);
+    __global uint* o = out + 64u * i;
+    __global ub_photon_keys4* k = (__global ub_photon_keys4*)o;
+    uint s = i * 2654435761u + 12345u;
+    ub_float3 origin = ub_make_float3(0.1f * (float)(i % 7u), -0.2f, 0.3f);
+    ub_float3 dir = ub_f3_normalize(ub_make_float3(1.0f, 0.5f * (float)(i % 3u) - 0.5f, 0.25f));
+    for (int j = 0; j < 8; ++j) {
+        s = s * 1664525u + 1013904223u;
+        float along = (float)(s >> 8) * (1.0f / 16777216.0f) * 1.4f - 0.2f; /* -0.2 .. 1.2 */
+        s = s * 1664525u + 1013904223u;
+        float off = (float)(s >> 8) * (1.0f / 16777216.0f) * 0.2f;         /* 0 .. 0.2 */
+        ub_float3 side = ub_f3_normalize(ub_f3_cross(dir, ub_make_float3(0.0f, 0.0f, 1.0f)));
+        ub_float3 p = ub_f3_add(ub_f3_add(origin, ub_f3_scale(dir, along)), ub_f3_scale(side, off));
+        k[j / 4].px[j % 4] = p.x;
+        k[j / 4].py[j % 4] = p.y;
+        k[j / 4].pz[j % 4] = p.z;
+        k[j / 4].mediumId[j % 4] = (s >> 28) == 0u ? 2u : 1u;
+    }
+    float t8[8], t4[8];
+    uint m8 = ub_pb2d_near8_global(k, origin, dir, 1.0f, 1u, 0.01f, t8);
+    uint a = ub_pb2d_near4_global(k, origin, dir, 1.0f, 1u, 0.01f, t4);
+    uint b = ub_pb2d_near4_global(k + 1, origin, dir, 1.0f, 1u, 0.01f, t4 + 4);
+    o[32] = m8;
+    o[33] = a;
+    o[34] = b;
+    for (int j = 0; j < 8; ++j) {
+        o[35 + j] = as_uint(t8[j]);
+        o[43 + j] = as_uint(t4[j]);
+    }
+})";
+    const size_t n = 4096;
+    std::vector<cl_uint> out(64 * n, 0);
+    ASSERT_NO_FATAL_FAILURE(runUintKernel(src, "ub_pb2d_pair8", "", n, &out));
+    int near = 0, far = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const cl_uint* r = &out[64 * i + 32];
+        ASSERT_EQ(r[0], r[1] | r[2] << 4) << "work-item " << i;
+        for (int j = 0; j < 8; ++j) ASSERT_EQ(r[3 + j], r[11 + j]) << "work-item " << i;
+        near += __builtin_popcount(r[0]);
+        far += 8 - __builtin_popcount(r[0]);
+    }
+    EXPECT_GT(near, int(n));  // both outcomes occur often
+    EXPECT_GT(far, int(n));
+}

@@ -69,6 +69,23 @@ UB_INLINE ub_uint ub_pb2d_near4_global(__global const ub_photon_keys4* k, ub_flo
     vstore4(tp, 0, t);
     return ub_lane_mask4(near);
 }
+/* Two consecutive blocks k[0], k[1] as float8 lanes, the same operations per lane: bits 0-3
+ * are block k[0]'s mask and t[0..3] its parameters, bits 4-7 and t[4..7] block k[1]'s. On
+ * PoCL's AVX2 CPU target a float8 is one register (as ub_beam_lines_near8_global). */
+UB_INLINE ub_uint ub_pb2d_near8_global(__global const ub_photon_keys4* k, ub_float3 o, ub_float3 d,
+                                       float length, ub_uint mediumId, float radiusSqr,
+                                       UB_PRIVATE float* t) {
+    float8 opx = (float8)(vload4(0, k[0].px), vload4(0, k[1].px)) - o.x;
+    float8 opy = (float8)(vload4(0, k[0].py), vload4(0, k[1].py)) - o.y;
+    float8 opz = (float8)(vload4(0, k[0].pz), vload4(0, k[1].pz)) - o.z;
+    float8 tp = opx * d.x + opy * d.y + opz * d.z;
+    float8 qx = opx - d.x * tp, qy = opy - d.y * tp, qz = opz - d.z * tp;
+    float8 d2 = qx * qx + qy * qy + qz * qz;
+    int8 near = (tp >= 0.0f) & (tp <= length) & (d2 <= radiusSqr) &
+                ((uint8)(vload4(0, k[0].mediumId), vload4(0, k[1].mediumId)) == (uint8)(mediumId));
+    vstore8(tp, 0, t);
+    return ub_lane_mask8(near);
+}
 #endif
 
 UB_INLINE int ub_pb2d_length_ok(ub_uint photonLength, ub_beam qb, ub_uint minLength,
