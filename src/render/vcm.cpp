@@ -143,6 +143,7 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
                                                    std::to_string(options.alpha));
     }
     nullNotCounted_ = scene.settings.depthCounting == DepthCounting::kNonNullVertices;
+    for (const Medium& m : scene.media) mediaEmit_ = mediaEmit_ || m.hasEmission();
     const bool volumetric =
         options.algorithm == "vlt" || options.algorithm == "vbpt" || algorithm_ == Algorithm::Upbp;
     useMedia_ = volumetric && scene.hasMedia();

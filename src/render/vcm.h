@@ -259,6 +259,7 @@ class VertexCM : public Integrator {
     std::string backendNote_;
     /// DepthCounting::kNonNullVertices: null-lobe vertices do not count towards the length.
     bool nullNotCounted_ = false;
+    bool mediaEmit_ = false;  ///< some medium emits (sigma_a Le): camera medium vertices count
     std::vector<MediumStack> lightStacks_;  ///< media where each light's subpaths start
     float baseRadius_ = 0;
     float lightPickProb_ = 0;

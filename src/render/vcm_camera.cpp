@@ -50,6 +50,15 @@ Rgb VertexCM::traceCameraPath(int x, int y, int iteration, CameraRecords* record
     Rgb color(0.0f);
     LightScatterCache lightScatters;  // of the light subpath this one connects to
     for (;; ++state.pathLength) {
+        // Without vertex connection (merging-only sets: upbp without bpt, bpm), a vertex at the
+        // length limit adds nothing unless the subpath so far is purely specular (it may hit an
+        // emitter, SmallVCM's rule in lightHitRadiance) or a medium emits: it merges with no
+        // light vertex (each adds a segment), records no query and connects to nothing. Its
+        // segment is not traced, and the image is unchanged bit for bit (each pixel draws its
+        // own random numbers). SmallUPBP traces it (docs/performance.md, session 36).
+        if (state.pathLength >= maxLength && !useVC_ && !state.specularPath && !mediaEmit_ &&
+            !nullNotCounted_ && !lightTraceOnly_)
+            break;
         PathVertex v;
         bool escaped = false;
         const Rgb throughputBefore = state.throughput;
