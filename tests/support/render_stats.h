@@ -83,6 +83,24 @@ inline BlockStats renderBlockStats(Integrator& integrator, int iterations, int b
     return s;
 }
 
+/// Image mean and its standard error per channel over `iterations` iterations
+/// (renderBlockStats), and 5 standard errors of the difference of two such means.
+struct ImageMeans {
+    double mean[3] = {0, 0, 0}, stdErr[3] = {0, 0, 0};
+    double fiveSigmaTo(const ImageMeans& o, int c) const {
+        return 5.0 * std::sqrt(stdErr[c] * stdErr[c] + o.stdErr[c] * o.stdErr[c]);
+    }
+};
+inline ImageMeans renderImageMeans(Integrator& integrator, int iterations, int blockSize) {
+    const BlockStats s = renderBlockStats(integrator, iterations, blockSize);
+    ImageMeans m;
+    for (int c = 0; c < 3; ++c) {
+        m.mean[c] = s.imageMean(c);
+        m.stdErr[c] = s.imageStdErr(c);
+    }
+    return m;
+}
+
 /// Two-sided normal p-value of |z|.
 inline double twoSidedP(double z) {
     return std::erfc(std::fabs(z) / std::sqrt(2.0));
