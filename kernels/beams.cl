@@ -111,20 +111,19 @@ static void ub_query_medium_load(ub_query_medium* qm, __global const ub_medium_i
  * photons' records prefetched (UB_PREFETCH: PoCL's CPU devices; a hint or nothing elsewhere) and
  * their path lengths read, whose loads then overlap their cache misses, then the pairs'
  * contributions in the same order, as the host twin does. */
-static void ub_pb2d_flush(__global const ub_photon_point* photons, ub_medium_info m, float mCont,
-                          ub_grid_info gi, ub_grid_accessor* acc, const ub_beam* qb,
-                          ub_beam_piece* table, ub_uint* tableState, ub_mis_constants mis,
-                          float normalization, uint minLength, uint maxLength, const uint* pending,
-                          const float* t, int np, float* sum) {
+static void ub_pb2d_flush(__global const ub_photon_point* photons, ub_query_medium* qm,
+                          const ub_beam* qb, ub_beam_piece* table, ub_uint* tableState,
+                          ub_mis_constants mis, float normalization, uint minLength, uint maxLength,
+                          const uint* pending, const float* t, int np, float* sum) {
     uint lengths[UB_PB2D_PENDING];
     for (int j = 0; j < np; ++j) UB_PREFETCH(photons + pending[j]);
     for (int j = 0; j < np; ++j) lengths[j] = photons[pending[j]].pathLength;
     for (int j = 0; j < np; ++j) {
         if (!ub_pb2d_length_ok(lengths[j], *qb, minLength, maxLength)) continue;
         ub_photon_point ph = photons[pending[j]];
-        ub_segment_eval s =
-            ub_query_beam_segment(m, mCont, gi, acc, *qb, t[j], table, UB_QUERY_PIECES, tableState);
-        ub_float3 c = ub_pb2d_contribution(mis, ph, *qb, s, t[j], m.g, normalization);
+        ub_segment_eval s = ub_query_beam_segment(qm->m, qm->mCont, qm->gi, &qm->acc, *qb, t[j],
+                                                  table, UB_QUERY_PIECES, tableState);
+        ub_float3 c = ub_pb2d_contribution(mis, ph, *qb, s, t[j], qm->m.g, normalization);
         sum[0] += c.x;
         sum[1] += c.y;
         sum[2] += c.z;
@@ -177,8 +176,8 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
             pendingT[np++] = t[lane];
             if (np == UB_PB2D_PENDING) {
                 ub_query_medium_load(&qm, media, grids, gridData, qMedium);
-                ub_pb2d_flush(photons, qm.m, qm.mCont, qm.gi, &qm.acc, &qb, table, &tableState, mis,
-                              normalization, minLength, maxLength, pending, pendingT, np, sum);
+                ub_pb2d_flush(photons, &qm, &qb, table, &tableState, mis, normalization, minLength,
+                              maxLength, pending, pendingT, np, sum);
                 np = 0;
             }
         }
@@ -187,8 +186,8 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     UB_BVH_LEAVES_END
     if (np > 0) {
         ub_query_medium_load(&qm, media, grids, gridData, qMedium);
-        ub_pb2d_flush(photons, qm.m, qm.mCont, qm.gi, &qm.acc, &qb, table, &tableState, mis,
-                      normalization, minLength, maxLength, pending, pendingT, np, sum);
+        ub_pb2d_flush(photons, &qm, &qb, table, &tableState, mis, normalization, minLength,
+                      maxLength, pending, pendingT, np, sum);
     }
     ub_store_f3(out, i, sum[0], sum[1], sum[2]);
 }
@@ -234,10 +233,10 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
  * the pairs it accepted, in the same order (the sum is the walk order's). */
 static void ub_bb1d_flush(__global const ub_beam* beams, __global const ub_beam_part* parts,
                           __global const ub_beam_piece* beamPieces, __global const uint* beamRanges,
-                          ub_medium_info m, float mCont, ub_grid_info gi, ub_grid_accessor* acc,
-                          const ub_beam* qb, ub_beam_piece* table, ub_uint* tableState,
-                          ub_mis_constants mis, float radius, float normalization, uint minLength,
-                          uint maxLength, const uint* pending, int np, float* sum) {
+                          ub_query_medium* qm, const ub_beam* qb, ub_beam_piece* table,
+                          ub_uint* tableState, ub_mis_constants mis, float radius,
+                          float normalization, uint minLength, uint maxLength, const uint* pending,
+                          int np, float* sum) {
     uint accepted[UB_BB1D_PENDING], beamOf[UB_BB1D_PENDING];
     float tcs[UB_BB1D_PENDING], tls[UB_BB1D_PENDING], sins[UB_BB1D_PENDING];
     for (int j = 0; j < np; ++j) {
@@ -263,12 +262,12 @@ static void ub_bb1d_flush(__global const ub_beam* beams, __global const ub_beam_
         uint beam = accepted[j];
         ub_beam pb = beams[beam];
         ub_segment_eval sl =
-            ub_photon_beam_segment(m, mCont, gi, acc, pb, tls[j],
+            ub_photon_beam_segment(qm->m, qm->mCont, qm->gi, &qm->acc, pb, tls[j],
                                    beamPieces + beamRanges[2u * beam], beamRanges[2u * beam + 1u]);
-        ub_segment_eval sc = ub_query_beam_segment(m, mCont, gi, acc, *qb, tcs[j], table,
-                                                   UB_QUERY_PIECES, tableState);
-        ub_float3 c =
-            ub_bb1d_contribution(mis, pb, *qb, sl, sc, tls[j], tcs[j], sins[j], m.g, normalization);
+        ub_segment_eval sc = ub_query_beam_segment(qm->m, qm->mCont, qm->gi, &qm->acc, *qb, tcs[j],
+                                                   table, UB_QUERY_PIECES, tableState);
+        ub_float3 c = ub_bb1d_contribution(mis, pb, *qb, sl, sc, tls[j], tcs[j], sins[j], qm->m.g,
+                                           normalization);
         sum[0] += c.x;
         sum[1] += c.y;
         sum[2] += c.z;
@@ -315,9 +314,8 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
             pending[np++] = b * 4u + (31u - clz(near & (0u - near)));
             if (np == UB_BB1D_PENDING) {
                 ub_query_medium_load(&qm, media, grids, gridData, qb.mediumId);
-                ub_bb1d_flush(beams, parts, beamPieces, beamRanges, qm.m, qm.mCont, qm.gi, &qm.acc,
-                              &qb, table, &tableState, mis, radius, normalization, minLength,
-                              maxLength, pending, np, sum);
+                ub_bb1d_flush(beams, parts, beamPieces, beamRanges, &qm, &qb, table, &tableState,
+                              mis, radius, normalization, minLength, maxLength, pending, np, sum);
                 np = 0;
             }
         }
@@ -326,9 +324,8 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
     UB_BVH_LEAVES_END
     if (np > 0) {
         ub_query_medium_load(&qm, media, grids, gridData, qb.mediumId);
-        ub_bb1d_flush(beams, parts, beamPieces, beamRanges, qm.m, qm.mCont, qm.gi, &qm.acc, &qb,
-                      table, &tableState, mis, radius, normalization, minLength, maxLength, pending,
-                      np, sum);
+        ub_bb1d_flush(beams, parts, beamPieces, beamRanges, &qm, &qb, table, &tableState, mis,
+                      radius, normalization, minLength, maxLength, pending, np, sum);
     }
     ub_store_f3(out, i, sum[0], sum[1], sum[2]);
 }

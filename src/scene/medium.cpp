@@ -23,12 +23,6 @@ void checkG(float g) {
         throw std::invalid_argument("medium: HG g must lie in (-1, 1), got " + std::to_string(g));
 }
 
-Rgb expNeg(const Rgb& tau) {
-    float t[3];
-    ub_exp_neg3(tau.x, tau.y, tau.z, t);
-    return {t[0], t[1], t[2]};
-}
-
 /// Leaf nodes of the default NanoVDB float tree are 8^3 voxels; a voxel whose block has no
 /// leaf has the value of the enclosing tile (or the background) over the whole block.
 constexpr int kLeafDim = 8;
@@ -400,6 +394,12 @@ FreeFlightSample sampleFreeFlight(const Medium& m, const Vec3& origin, const Vec
         s.weight =
             s.scattered ? seg.transmittance * seg.sigmaS1 / s.pdf : seg.transmittance / s.pdf;
     return s;
+}
+
+Rgb expNeg(const Rgb& tau) {
+    float t[3];
+    ub_exp_neg3(tau.x, tau.y, tau.z, t);
+    return {t[0], t[1], t[2]};
 }
 
 }  // namespace ub

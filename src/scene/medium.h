@@ -180,6 +180,9 @@ struct MediumSegment {
 
 /// Evaluates the segment by regular tracking (exact for the piecewise-constant grid).
 MediumSegment evalMediumSegment(const Medium& m, const Vec3& origin, const Vec3& dir, float length);
+/// exp(-tau) per channel, one exponential for a grey depth (ub_exp_neg3,
+/// kernels/shared/ub_medium_homogeneous.h): the transmittance of every medium kind.
+Rgb expNeg(const Rgb& tau);
 /// The pieces of constant extinction of a grid medium along [0, length] of a ray, in order
 /// (regular tracking, the walk evalMediumSegment makes): visit(ta, tb, sigmaT) per piece.
 /// Returns false, visiting nothing, for media that are not piecewise constant along rays

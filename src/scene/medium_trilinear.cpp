@@ -6,8 +6,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "kernels/shared/ub_medium_homogeneous.h"
-
 namespace ub {
 
 namespace {
@@ -139,12 +137,6 @@ void forEachCubic(const Medium& m, const Vec3& origin, const Vec3& dir, float tM
         t = tNext;
     }
     if (tExit < tMax) visit(tExit, double(tMax), zero);
-}
-
-Rgb expNeg(const Rgb& tau) {
-    float t[3];
-    ub_exp_neg3(tau.x, tau.y, tau.z, t);
-    return {t[0], t[1], t[2]};
 }
 
 /// Solves F(s) = target for s in [0, L], F(s) = scale * integral of c over [0, s]
