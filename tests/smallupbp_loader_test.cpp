@@ -543,6 +543,38 @@ TEST(SmallUpbpBoundary, CavityStaysWithItsShell) {
     EXPECT_NEAR(signedVolume(s.pieces[0]), 27.0 - 1.0, 1e-4);
 }
 
+// SmallUPBP's Lambert and Phong lobes reflect on the front of the shading normal only: a
+// diffuse or Phong floor seen and lit from its back renders black, as in SmallUPBP, and the
+// same floor turned over is lit. (Before, unibeam's SmallUPBP surfaces were two-sided: the
+// back of the candle's `wire` object reflected light that SmallUPBP absorbs there.)
+TEST(SmallUpbpLoader, DiffuseAndPhongAreBlackFromTheBack) {
+    const char* materials[] = {"newmtl floor\nKd 0.5 0.5 0.5\n",
+                               "newmtl floor\nKd 0.2 0.2 0.2\nKs 0.5 0.5 0.5\nNs 10\n"};
+    for (const char* mtl : materials) {
+        for (bool front : {true, false}) {
+            SCOPED_TRACE(std::string(mtl) + (front ? " front" : " back"));
+            TinyScene t(front ? "front" : "back");
+            t.mtl = mtl;
+            // One quad at z = 0, its winding's normal +z (front) or -z (back), seen from z = 3
+            // and lit by a point light at z = 2.
+            t.obj = std::string("mtllib t.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n") +
+                    "usemtl floor\n" + (front ? "f 1 2 3 4\n" : "f 1 4 3 2\n");
+            t.aux =
+                "TM_ROW0 1 0 0\nTM_ROW1 0 1 0\nTM_ROW2 0 0 1\nTM_ROW3 0 0 3\nCAMERA_FOV 0.9\n"
+                "light_point 0 0 2 5 5 5\n";
+            t.write();
+            auto s = loadScene(t.objPath());
+            ASSERT_EQ(s->materials.size(), 1u);
+            EXPECT_FALSE(s->materials[0].twoSided);
+            const float mean = renderFinite(*s, 2);
+            if (front)
+                EXPECT_GT(mean, 0.01f);
+            else
+                EXPECT_EQ(mean, 0.0f);
+        }
+    }
+}
+
 // A diffuse or Phong colour above 1 creates energy: SmallUPBP renders it as written, so it
 // loads, with a warning at its line.
 TEST(SmallUpbpLoader, ReflectanceAboveOneIsAWarning) {

@@ -103,6 +103,10 @@ Material mapMaterial(const UpbpMaterial& u, const std::string& mtlFile, Context&
         m.type = MaterialType::Diffuse;
         m.diffuse = u.diffuse;
     }
+    // SmallUPBP's Lambert and Phong lobes reflect on the front of the shading normal only
+    // (its BSDF samples and evaluates nothing where the fixed direction is behind it), so
+    // these surfaces are black from the back, as the same lobes of MultiLobe are.
+    m.twoSided = false;
     return m;
 }
 
