@@ -111,7 +111,7 @@ bool isDielectric(MaterialType t) {
 /// Materials whose normals are never flipped to dirFix's side (the normal tells inside).
 bool keepsNormalSide(const Material& m) {
     return isDielectric(m.type) || m.type == MaterialType::ThinDielectric ||
-           (m.type == MaterialType::MultiLobe && m.refract) ||
+           (m.type == MaterialType::MultiLobe && (m.refract || !m.twoSided)) ||
            (m.type == MaterialType::Principled && !m.twoSided);
 }
 

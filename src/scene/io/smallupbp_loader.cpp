@@ -75,10 +75,12 @@ Material mapMaterial(const UpbpMaterial& u, const std::string& mtlFile, Context&
         m.exponent = u.shininess > 0.0f ? u.shininess : 1.0f;
         m.specular = u.mirror;
         m.refract = u.ior >= 0.0f;
-        if (m.refract) {
-            m.ior = u.ior;
-            m.twoSided = false;  // the normal tells inside from outside
-        }
+        if (m.refract) m.ior = u.ior;
+        // Not flipped to the viewer's side (scene/bsdf.cpp keepsNormalSide): with refraction
+        // the normal tells inside from outside; without, SmallUPBP's Lambert and Phong lobes
+        // are black behind the shading normal while its mirror reflects on both sides, which
+        // the unflipped lobes do (ub_bsdf_eval_phong, Bsdf::sampleDelta).
+        m.twoSided = false;
         // The lobes add: with refraction the transmitted part alone may carry albedo 1.
         const Rgb sum = u.diffuse + phong + (m.refract ? Rgb(0.0f) : u.mirror);
         const float most = maxComponent(sum) + (m.refract ? 1.0f : 0.0f);
