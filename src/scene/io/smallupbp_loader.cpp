@@ -10,7 +10,8 @@
 //    when ior >= 0, smooth refraction weighted by 1 - F. A material with refraction, or
 //    with a mirror and a diffuse/Phong lobe, becomes a MultiLobe material (every lobe, as
 //    SmallUPBP samples them); a mirror alone a Mirror, Kd with Ks (Ns > 0) a Phong, else a
-//    Diffuse material (the same BSDFs).
+//    Diffuse material (the same BSDFs). Sides as SmallUPBP's: the Lambert and Phong lobes
+//    reflect in front of the shading normal only (none is two-sided), the mirror on both sides.
 //  * Media: homogeneous; SmallUPBP's emission is the source term per unit length,
 //    unibeam's is sigma_a * Le, so Le = emission / absorption.
 //  * Shapes: one per material (SmallUPBP groups faces by material and identifies a
