@@ -543,10 +543,10 @@ TEST(SmallUpbpBoundary, CavityStaysWithItsShell) {
     EXPECT_NEAR(signedVolume(s.pieces[0]), 27.0 - 1.0, 1e-4);
 }
 
-// SmallUPBP's Lambert and Phong lobes reflect on the front of the shading normal only: a
-// diffuse or Phong floor seen and lit from its back renders black, as in SmallUPBP, and the
-// same floor turned over is lit. (Before, unibeam's SmallUPBP surfaces were two-sided: the
-// back of the candle's `wire` object reflected light that SmallUPBP absorbs there.)
+// SmallUPBP evaluates its Lambert and Phong lobes to zero behind the shading normal: a
+// diffuse or Phong floor seen and lit from its back renders black, and the same floor turned
+// over is lit. (Before, unibeam's SmallUPBP surfaces were two-sided: the inside of the candle's
+// room, the back of its `wire` box, reflected light that SmallUPBP's BSDF gives zero there.)
 TEST(SmallUpbpLoader, DiffuseAndPhongAreBlackFromTheBack) {
     const char* materials[] = {"newmtl floor\nKd 0.5 0.5 0.5\n",
                                "newmtl floor\nKd 0.2 0.2 0.2\nKs 0.5 0.5 0.5\nNs 10\n"};

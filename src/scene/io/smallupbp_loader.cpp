@@ -106,9 +106,11 @@ Material mapMaterial(const UpbpMaterial& u, const std::string& mtlFile, Context&
         m.type = MaterialType::Diffuse;
         m.diffuse = u.diffuse;
     }
-    // SmallUPBP's Lambert and Phong lobes reflect on the front of the shading normal only
-    // (its BSDF samples and evaluates nothing where the fixed direction is behind it), so
-    // these surfaces are black from the back, as the same lobes of MultiLobe are.
+    // SmallUPBP's BSDF evaluates its Lambert and Phong lobes to zero where the fixed
+    // direction is behind the shading normal, so these surfaces are black from the back, as
+    // the same lobes of MultiLobe are. (Its Phong sampler alone does sample there, which
+    // makes its sampling and its evaluation disagree; unibeam keeps them consistent,
+    // docs/smallupbp.md.)
     m.twoSided = false;
     return m;
 }
