@@ -33,6 +33,10 @@ std::string allMessages(const std::vector<Diagnostic>& d) {
     return s;
 }
 
+/// The .aux camera of the scratch scenes: at z = 3, looking down the -z axis.
+const char* const kCameraAbove =
+    "TM_ROW0 1 0 0\nTM_ROW1 0 1 0\nTM_ROW2 0 0 1\nTM_ROW3 0 0 3\nCAMERA_FOV 0.9\n";
+
 /// A scratch folder with a small valid scene t.obj / t.mtl / t.obj.aux that tests edit.
 class TinyScene {
   public:
@@ -48,14 +52,13 @@ class TinyScene {
             "mtllib t.mtl\n"
             "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
             "v -0.2 -0.2 0.1\nv 0.2 -0.2 0.1\nv 0 0.2 0.1\nv 0 0 0.5\n"
-            "v 0.3 -0.2 1\nv 0.7 -0.2 1\nv 0.7 0.2 1\nv 0.3 0.2 1\n"
+            "v -0.3 -0.3 1\nv 0.3 -0.3 1\nv 0.3 0.3 1\nv -0.3 0.3 1\n"
             "usemtl white\nf 1 2 3 4\n"
             "usemtl glass\nf 5 7 6\nf 5 6 8\nf 6 7 8\nf 7 5 8\n"
             "usemtl lamp\nf 9 12 11 10\n";
-        aux =
-            "TM_ROW0 1 0 0\nTM_ROW1 0 1 0\nTM_ROW2 0 0 1\nTM_ROW3 0 0 3\nCAMERA_FOV 0.9\n"
-            "medium inside\nabsorption 0.1 0.1 0.1\nscattering 0.5 0.5 0.5\ng 0.3\n"
-            "material glass\nior 1.5\nmirror 1 1 1\nmediumId inside\npriority 2\n";
+        aux = std::string(kCameraAbove) +
+              "medium inside\nabsorption 0.1 0.1 0.1\nscattering 0.5 0.5 0.5\ng 0.3\n"
+              "material glass\nior 1.5\nmirror 1 1 1\nmediumId inside\npriority 2\n";
     }
     ~TinyScene() { fs::remove_all(dir_); }
 
@@ -559,9 +562,7 @@ TEST(SmallUpbpLoader, DiffuseAndPhongAreBlackFromTheBack) {
             // and lit by a point light at z = 2.
             t.obj = std::string("mtllib t.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n") +
                     "usemtl floor\n" + (front ? "f 1 2 3 4\n" : "f 1 4 3 2\n");
-            t.aux =
-                "TM_ROW0 1 0 0\nTM_ROW1 0 1 0\nTM_ROW2 0 0 1\nTM_ROW3 0 0 3\nCAMERA_FOV 0.9\n"
-                "light_point 0 0 2 5 5 5\n";
+            t.aux = std::string(kCameraAbove) + "light_point 0 0 2 5 5 5\n";
             t.write();
             auto s = loadScene(t.objPath());
             ASSERT_EQ(s->materials.size(), 1u);
@@ -588,9 +589,8 @@ TEST(SmallUpbpLoader, MirrorLobeReflectsFromTheBackWhereLambertIsBlack) {
         // The floor's winding normal points down, away from the camera at z = 3, under a
         // constant sky of radiance 1 (about half of the image is the floor).
         t.obj = "mtllib t.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nusemtl floor\nf 1 4 3 2\n";
-        t.aux =
-            "TM_ROW0 1 0 0\nTM_ROW1 0 1 0\nTM_ROW2 0 0 1\nTM_ROW3 0 0 3\nCAMERA_FOV 0.9\n"
-            "material floor\nmirror 1 1 1\nlight_background_constant 1 1 1\n";
+        t.aux = std::string(kCameraAbove) +
+                "material floor\nmirror 1 1 1\nlight_background_constant 1 1 1\n";
         t.write();
         auto s = loadScene(t.objPath());
         EXPECT_EQ(s->materials[0].type,

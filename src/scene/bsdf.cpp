@@ -108,7 +108,9 @@ bool isDielectric(MaterialType t) {
     return t == MaterialType::Dielectric || t == MaterialType::RoughDielectric;
 }
 
-/// Materials whose normals are never flipped to dirFix's side (the normal tells inside).
+/// Materials whose normals are never flipped to dirFix's side: the normal tells inside from
+/// outside, or (a one-sided MultiLobe, SmallUPBP's) the lobes themselves decide what reflects
+/// behind it (Lambert and Phong nothing, the mirror as in front).
 bool keepsNormalSide(const Material& m) {
     return isDielectric(m.type) || m.type == MaterialType::ThinDielectric ||
            (m.type == MaterialType::MultiLobe && (m.refract || !m.twoSided)) ||

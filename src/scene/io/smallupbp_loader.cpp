@@ -65,6 +65,14 @@ struct Context {
 Material mapMaterial(const UpbpMaterial& u, const std::string& mtlFile, Context& ctx) {
     Material m;
     m.name = u.name;
+    // One-sided, as SmallUPBP's BSDF: it evaluates its Lambert and Phong lobes to zero where
+    // the fixed direction is behind the shading normal. A MultiLobe keeps its normal's side
+    // (scene/bsdf.cpp keepsNormalSide): with refraction the normal tells inside from outside,
+    // and behind it the Lambert and Phong lobes are black while the mirror reflects. Only a
+    // plain Mirror is two-sided. (SmallUPBP's Phong sampler alone does sample behind the
+    // normal, so its sampling and its evaluation disagree; unibeam keeps them consistent,
+    // docs/smallupbp.md.)
+    m.twoSided = false;
     const Rgb phong = u.shininess > 0.0f ? u.specular : Rgb(0.0f);
     const bool hasDiffuse = !isBlack(u.diffuse), hasPhong = !isBlack(phong);
     const bool hasMirror = !isBlack(u.mirror);
@@ -77,11 +85,6 @@ Material mapMaterial(const UpbpMaterial& u, const std::string& mtlFile, Context&
         m.specular = u.mirror;
         m.refract = u.ior >= 0.0f;
         if (m.refract) m.ior = u.ior;
-        // Not flipped to the viewer's side (scene/bsdf.cpp keepsNormalSide): with refraction
-        // the normal tells inside from outside; without, SmallUPBP's Lambert and Phong lobes
-        // are black behind the shading normal while its mirror reflects on both sides, which
-        // the unflipped lobes do (ub_bsdf_eval_phong, Bsdf::sampleDelta).
-        m.twoSided = false;
         // The lobes add: with refraction the transmitted part alone may carry albedo 1.
         const Rgb sum = u.diffuse + phong + (m.refract ? Rgb(0.0f) : u.mirror);
         const float most = maxComponent(sum) + (m.refract ? 1.0f : 0.0f);
@@ -95,6 +98,7 @@ Material mapMaterial(const UpbpMaterial& u, const std::string& mtlFile, Context&
     if (hasMirror) {
         m.type = MaterialType::Mirror;
         m.specular = u.mirror;
+        m.twoSided = true;  // SmallUPBP's mirror reflects on both sides
         return m;
     }
     if (hasPhong) {
@@ -106,12 +110,6 @@ Material mapMaterial(const UpbpMaterial& u, const std::string& mtlFile, Context&
         m.type = MaterialType::Diffuse;
         m.diffuse = u.diffuse;
     }
-    // SmallUPBP's BSDF evaluates its Lambert and Phong lobes to zero where the fixed
-    // direction is behind the shading normal, so these surfaces are black from the back, as
-    // the same lobes of MultiLobe are. (Its Phong sampler alone does sample there, which
-    // makes its sampling and its evaluation disagree; unibeam keeps them consistent,
-    // docs/smallupbp.md.)
-    m.twoSided = false;
     return m;
 }
 
