@@ -107,6 +107,18 @@ static void ub_query_medium_load(ub_query_medium* qm, __global const ub_medium_i
     qm->ready = 1;
 }
 
+/* Photon beam `beam`'s medium at t: in a homogeneous medium the closed form, without reading
+ * the beam's table range (beams in homogeneous media have no table, and the range is a load per
+ * pair: bb1d's kernel 1-2% faster on the bunny and mirrorballs, docs/performance.md, session
+ * 38); otherwise from its table (ub_photon_beam_segment). */
+static ub_segment_eval ub_photon_beam_medium(ub_query_medium* qm, ub_beam pb, float t,
+                                             __global const ub_beam_piece* beamPieces,
+                                             __global const uint* beamRanges, uint beam) {
+    if (qm->m.homogeneous) return ub_homogeneous_segment_cp(qm->m, t, qm->mCont);
+    return ub_photon_beam_segment(qm->m, qm->mCont, qm->gi, &qm->acc, pb, t,
+                                  beamPieces + beamRanges[2u * beam], beamRanges[2u * beam + 1u]);
+}
+
 /* pb2d's pairs, pending[0 .. np - 1] at beam parameters t[0 .. np - 1] in walk order: the
  * photons' records prefetched (UB_PREFETCH: PoCL's CPU devices; a hint or nothing elsewhere) and
  * their path lengths read, whose loads then overlap their cache misses, then the pairs'
@@ -214,9 +226,7 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
         if (!ub_bp2d_pair(q, part, radius * radius, minLength, maxLength, &t)) continue;
         ub_query_medium_load(&qm, media, grids, gridData, q.mediumId);
         ub_beam pb = beams[part.beam];
-        ub_segment_eval s = ub_photon_beam_segment(qm.m, qm.mCont, qm.gi, &qm.acc, pb, t,
-                                                   beamPieces + beamRanges[2u * part.beam],
-                                                   beamRanges[2u * part.beam + 1u]);
+        ub_segment_eval s = ub_photon_beam_medium(&qm, pb, t, beamPieces, beamRanges, part.beam);
         ub_float3 c = ub_bp2d_contribution(mis, pb, q, s, t, qm.m.g, normalization);
         sx += c.x;
         sy += c.y;
@@ -261,9 +271,7 @@ static void ub_bb1d_flush(__global const ub_beam* beams, __global const ub_beam_
     for (int j = 0; j < nf; ++j) {
         uint beam = accepted[j];
         ub_beam pb = beams[beam];
-        ub_segment_eval sl =
-            ub_photon_beam_segment(qm->m, qm->mCont, qm->gi, &qm->acc, pb, tls[j],
-                                   beamPieces + beamRanges[2u * beam], beamRanges[2u * beam + 1u]);
+        ub_segment_eval sl = ub_photon_beam_medium(qm, pb, tls[j], beamPieces, beamRanges, beam);
         ub_segment_eval sc = ub_query_beam_segment(qm->m, qm->mCont, qm->gi, &qm->acc, *qb, tcs[j],
                                                    table, UB_QUERY_PIECES, tableState);
         ub_float3 c = ub_bb1d_contribution(mis, pb, *qb, sl, sc, tls[j], tcs[j], sins[j], qm->m.g,
