@@ -9,11 +9,15 @@
 #include <CL/cl.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <regex>
 #include <string>
 #include <vector>
+
+#include "kernels/shared/ub_defs.h"
 
 namespace {
 
@@ -151,8 +155,13 @@ static void runUintKernel(const std::string& src, const char* name, const std::s
     ASSERT_EQ(err, CL_SUCCESS);
     const std::string all =
         "-cl-std=CL1.2 -I" + std::string(UNIBEAM_SOURCE_DIR) + "/kernels/shared" + options;
-    ASSERT_EQ(clBuildProgram(prog, 1, &dev.device, all.c_str(), nullptr, nullptr), CL_SUCCESS)
-        << "options: " << all;
+    if (clBuildProgram(prog, 1, &dev.device, all.c_str(), nullptr, nullptr) != CL_SUCCESS) {
+        size_t logSize = 0;
+        clGetProgramBuildInfo(prog, dev.device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &logSize);
+        std::string log(logSize, '\0');
+        clGetProgramBuildInfo(prog, dev.device, CL_PROGRAM_BUILD_LOG, logSize, log.data(), nullptr);
+        FAIL() << "build failed, options: " << all << "\n" << log;
+    }
     cl_kernel kernel = clCreateKernel(prog, name, &err);
     ASSERT_EQ(err, CL_SUCCESS);
     cl_mem buf =
@@ -291,4 +300,88 @@ __kernel void ub_pb2d_pair8(__global uint* out) {
     }
     EXPECT_GT(near, int(n));  // both outcomes occur often
     EXPECT_GT(far, int(n));
+}
+
+namespace {
+
+// Bits of the float x_i of ub_exp_poly's test points: i < n/2 from -0 down to -104, the rest from
+// +0 up to 89, evenly spaced in their bit patterns (so in ulps), the same integer arithmetic on
+// the host and in the kernel below.
+constexpr cl_uint kExpNeg = 0x80000000u, kExpNegEnd = 0xc2d00000u;  // -0, -104
+constexpr cl_uint kExpPosEnd = 0x42b20000u;                         // 89
+cl_uint expTestBits(cl_uint i, cl_uint n) {
+    const cl_uint half = n / 2u;
+    return i < half ? kExpNeg + i * ((kExpNegEnd - kExpNeg) / half)
+                    : (i - half) * (kExpPosEnd / half);
+}
+
+// |got - exact| in ulps of the float nearest the exact value (for denormal results, the
+// denormal spacing).
+double ulpError(float got, double exact) {
+    const float nearest = float(exact);
+    double ulp = double(std::nextafter(nearest, INFINITY)) - double(nearest);
+    if (!(ulp > 0.0)) ulp = double(std::nextafter(nearest, -INFINITY)) - double(nearest);
+    return std::fabs(double(got) - exact) / std::fabs(ulp);
+}
+
+}  // namespace
+
+// ub_exp_poly (kernels/shared/ub_defs.h), the kernels' exp on PoCL's CPU devices, is within one
+// ulp of exp over the range where exp is neither 0 nor inf, gives exp's values at the ends and
+// for the special inputs, and a kernel computes the same bits as the host.
+TEST(OpenClHeaders, ExpPolyIsWithinOneUlpAndTheSameOnTheDevice) {
+    // Host: one float in 61 where exp is a normal float, -87.34 to 88.72 (about 34 million),
+    // against exp in double. (unibeam flushes denormals to zero, src/scene/scene.cpp, so below
+    // -87.34 both exp and ub_exp_poly give 0 in this process.)
+    double worst = 0.0;
+    float worstAt = 0.0f;
+    auto check = [&](cl_uint u) {
+        float x;
+        std::memcpy(&x, &u, sizeof x);
+        const double e = ulpError(ub_exp_poly(x), std::exp(double(x)));
+        if (e > worst) {
+            worst = e;
+            worstAt = x;
+        }
+    };
+    for (cl_uint u = kExpNeg; u <= 0xc2aeac4fu; u += 61u) check(u);  // down to -87.34
+    for (cl_uint u = 0u; u <= 0x42b17217u; u += 61u) check(u);       // up to 88.72: below FLT_MAX
+    EXPECT_LE(worst, 1.0) << "at x = " << worstAt;
+    EXPECT_GT(worst, 0.5) << "the sweep did not reach a rounding error";  // it ran
+    EXPECT_EQ(ub_exp_poly(0.0f), 1.0f);
+    EXPECT_EQ(ub_exp_poly(-0.0f), 1.0f);
+    EXPECT_EQ(ub_exp_poly(-INFINITY), 0.0f);
+    EXPECT_EQ(ub_exp_poly(-110.0f), 0.0f);
+    EXPECT_EQ(ub_exp_poly(89.0f), INFINITY);
+    EXPECT_EQ(ub_exp_poly(INFINITY), INFINITY);
+    EXPECT_TRUE(std::isnan(ub_exp_poly(NAN)));
+
+    // Device: the same source, the program's floating-point mode (no contraction).
+    const std::string src = R"(#pragma OPENCL FP_CONTRACT OFF
+#include "ub_defs.h"
+__kernel void ub_exp_bits(__global uint* out) {
+    uint i = get_global_id(0), n = get_global_size(0), h = n / 2u;
+    uint u = i < h ? 0x80000000u + i * ((0xc2d00000u - 0x80000000u) / h) : (i - h) * (0x42b20000u / h);
+    out[i] = as_uint(ub_exp_poly(as_float(u)));
+})";
+    const cl_uint n = 1u << 20;
+    std::vector<cl_uint> out(n, 0u);
+    ASSERT_NO_FATAL_FAILURE(runUintKernel(src, "ub_exp_bits", "", n, &out));
+    // Compared where exp is a normal float: below, this process flushes denormal results to
+    // zero and PoCL's kernels (which set their own floating-point mode) need not.
+    int differ = 0, compared = 0;
+    for (cl_uint i = 0; i < n; ++i) {
+        const cl_uint u = expTestBits(i, n);
+        float x;
+        std::memcpy(&x, &u, sizeof x);
+        if (x < -87.33654f) continue;
+        ++compared;
+        const float host = ub_exp_poly(x);
+        cl_uint hostBits;
+        std::memcpy(&hostBits, &host, sizeof hostBits);
+        if (out[i] != hostBits && ++differ <= 5)
+            ADD_FAILURE() << "x = " << x << ": device bits " << out[i] << ", host " << hostBits;
+    }
+    EXPECT_EQ(differ, 0);
+    EXPECT_GT(compared, int(n / 2) + int(n / 3));
 }

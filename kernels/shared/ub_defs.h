@@ -20,7 +20,14 @@
 #define UB_PRIVATE __private
 typedef uint ub_uint;
 #define ub_sqrt(x) sqrt(x)
+/* PoCL's exp() is a slow routine on its CPU devices (about 40% of the bb1d kernel's pair
+ * evaluation, perf with -g; docs/performance.md, session 38): there the kernels take
+ * ub_exp_poly (below, within one ulp), and other device compilers (a GPU's) their own exp. */
+#if defined(__clang__) && defined(__x86_64__) && !defined(UB_LIBRARY_EXP)
+#define ub_exp(x) ub_exp_poly(x)
+#else
 #define ub_exp(x) exp(x)
+#endif
 #define ub_pow(x, y) pow(x, y)
 #define ub_fabs(x) fabs(x)
 #define ub_fmin(x, y) fmin(x, y)
@@ -38,11 +45,13 @@ typedef uint ub_uint;
 #else
 #define ub_floor(x) floor(x)
 #endif
+#define ub_rint(x) rint(x)
 #define ub_erf(x) erf(x)
 #define ub_erfc(x) erfc(x)
 #else
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #define UB_INLINE static inline
 #define UB_GLOBAL
 #define UB_PRIVATE
@@ -59,6 +68,7 @@ typedef uint32_t ub_uint;
 #define ub_acos(x) std::acos(x)
 #define ub_log(x) std::log(x)
 #define ub_floor(x) std::floor(x)
+#define ub_rint(x) std::rint(x)
 #define ub_erf(x) std::erf(x)
 #define ub_erfc(x) std::erfc(x)
 #endif
@@ -120,6 +130,45 @@ UB_INLINE float ub_clampf(float x, float lo, float hi) {
 }
 UB_INLINE float ub_sqr(float x) {
     return x * x;
+}
+
+/* The float whose bits are u. */
+UB_INLINE float ub_float_from_bits(ub_uint u) {
+#ifdef __OPENCL_C_VERSION__
+    return as_float(u);
+#else
+    float f;
+    std::memcpy(&f, &u, sizeof f);
+    return f;
+#endif
+}
+
+/* exp(x) in float arithmetic, within one ulp of the exact value over the whole range (0.99 ulp
+ * at most, measured on every seventh float by tests/opencl_headers_test.cpp, which also checks
+ * that a PoCL kernel gives the same bits), for the kernels on PoCL's CPU devices (ub_exp).
+ * Cody and Waite's reduction: k = round(x / ln 2), r = x - k ln 2 with ln 2 in two parts, the
+ * first with nine trailing zero bits so that k * ln2Hi is exact (|k| <= 150); then
+ * exp(r) = 1 + r + r^2 P(r) on |r| <= ln 2 / 2, P the degree-5 minimax polynomial of the Cephes
+ * library's expf (S. L. Moshier); 2^k as two powers of two, so that k = 128 overflows to inf
+ * and k down to -150 gives denormals, as exp() does. Below -104 the result is 0, above 89 inf;
+ * NaN stays NaN. (In PoCL's bb1d kernel this form is as fast as one without those ends; rounding
+ * by adding and subtracting 1.5 * 2^23, or k / 2 for k >> 1, lost most of the gain.) */
+UB_INLINE float ub_exp_poly(float x) {
+    float xc = x > -104.0f ? x : -104.0f; /* NaN: -104, then returned as x below */
+    xc = xc < 89.0f ? xc : 89.0f;
+    const float kf = ub_rint(xc * 1.44269504088896341f);
+    const float r = (xc - kf * 0.693145751953125f) - kf * 1.428606765330187045e-06f;
+    float p = 1.9875691500e-4f;
+    p = p * r + 1.3981999507e-3f;
+    p = p * r + 8.3334519073e-3f;
+    p = p * r + 4.1665795894e-2f;
+    p = p * r + 1.6666665459e-1f;
+    p = p * r + 5.0000001201e-1f;
+    p = p * r * r + r + 1.0f;
+    const int k = (int)kf, k1 = k >> 1, k2 = k - k1;
+    const float e = (p * ub_float_from_bits((ub_uint)(k1 + 127) << 23)) *
+                    ub_float_from_bits((ub_uint)(k2 + 127) << 23);
+    return x == x ? e : x;
 }
 
 #endif /* UB_DEFS_H */
