@@ -65,8 +65,8 @@ namespace {
 /// of 576 bunny pixels (upbp:bb1d, long photon beams) differed between one thread and two, at
 /// 2e-36 and 3e-42 (Upbp.BeamOnlySetsTraceOnlyTheBeamPaths, tests/upbp_test.cpp). Set before
 /// main() on the main thread, so every thread started later (TBB's, PoCL's) inherits it and
-/// every arena captures it. PoCL's kernels run in a mode of their own that keeps denormals (docs/opencl.md,
-/// floating point).
+/// every arena captures it. PoCL's kernels run in a mode of their own that keeps denormals
+/// (docs/opencl.md, floating point).
 [[maybe_unused]] const bool kFlushDenormals = [] {
     _mm_setcsr(_mm_getcsr() | _MM_FLUSH_ZERO_ON | _MM_DENORMALS_ZERO_ON);
     return true;
