@@ -28,6 +28,10 @@ namespace ub {
 
 namespace {
 
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 VertexCM::Algorithm parseAlgorithm(const std::string& name) {
     if (name == "lt" || name == "vlt") return VertexCM::Algorithm::LightTrace;
     if (name == "bpt" || name == "vbpt") return VertexCM::Algorithm::Bpt;
@@ -298,6 +302,7 @@ void VertexCM::renderIteration(int iteration, Image& out) {
     const bool beamsOnly = algorithm_ == Algorithm::Upbp && upbp_.photonBeams() && !upbp_.bpt &&
                            !upbp_.surf && !upbp_.photonPoints();
     const size_t tracedPaths = beamsOnly ? std::min(pathCount, size_t(beamPaths_)) : pathCount;
+    const auto lightStart = std::chrono::steady_clock::now();
     splats_.clear();
     const int chunkCount = SplatBuffer::kChunkCount;
     lightChunks_.resize(static_cast<size_t>(chunkCount));
@@ -338,6 +343,8 @@ void VertexCM::renderIteration(int iteration, Image& out) {
                   uint32_t(lightVertices_.size()));
     }
 
+    lastLightSeconds_ = secondsSince(lightStart);
+
     // (2) Hashed grid over the light vertices for merging (upbp: over the surface ones).
     if (surfBatch_) {
         // The surface vertices, in light-vertex order.
@@ -354,6 +361,7 @@ void VertexCM::renderIteration(int iteration, Image& out) {
     // (3) Camera pass: one subpath per pixel (lt traces only the primary ray, for
     // directly visible emitters). Each pixel has its own random stream.
     const bool layered = !layerNames_.empty();
+    const auto cameraStart = std::chrono::steady_clock::now();
     cameraRows_.resize(size_t(height));
     tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
         for (int y = r.begin(); y != r.end(); ++y) {
@@ -370,6 +378,7 @@ void VertexCM::renderIteration(int iteration, Image& out) {
         }
     });
     for (const CameraRecords& rec : cameraRows_) rejected_[0] += rec.rejected;
+    lastCameraSeconds_ = secondsSince(cameraStart);
 
     // (4) Light-tracing splats, added in a fixed order. UPBP layers: the camera pass without
     // surface merging plus the splats is the first layer, surface merging its own.
@@ -644,10 +653,12 @@ std::string VertexCM::iterationSummary() const {
     std::snprintf(buf, sizeof(buf),
                   "upbp (%s), last iteration: %zu light vertices, %zu photon points, %zu photon "
                   "beam pieces (%d beam paths), %zu query points, %zu query beam pieces; kernel "
-                  "pairs %s; lookups %.3f s, estimates %.3f s (%.3g queries/s)",
+                  "pairs %s; light pass %.3f s, camera pass %.3f s, lookups %.3f s, estimates "
+                  "%.3f s (%.3g queries/s)",
                   upbp_.describe().c_str(), lightVertices_.size(), photonPoints_.size(),
                   photonBeams_.size(), beamPaths_, queryPoints_.size(), queryBeams_.size(),
-                  pairs.c_str(), lastBuildSeconds_, lastEstimateSeconds_,
+                  pairs.c_str(), lastLightSeconds_, lastCameraSeconds_, lastBuildSeconds_,
+                  lastEstimateSeconds_,
                   lastEstimateSeconds_ > 0.0
                       ? double(queryPoints_.size() + queryBeams_.size()) / lastEstimateSeconds_
                       : 0.0);

@@ -291,6 +291,10 @@ class VertexCM : public Integrator {
     std::vector<std::string> layerNames_;   ///< UPBP technique layers
     std::vector<Image> layers_;             ///< the last iteration's layers
     double lastBuildSeconds_ = 0, lastEstimateSeconds_ = 0;
+    /// Wall-clock seconds of the last iteration's light pass (tracing the light subpaths, light
+    /// tracing to the camera included) and camera pass (camera subpaths, their connections and
+    /// the recording of queries), for iterationSummary.
+    double lastLightSeconds_ = 0, lastCameraSeconds_ = 0;
     size_t lastPairs_[4] = {0, 0, 0, 0};
     SplatBuffer splats_;
     // Contribution guard (render/contribution_guard.h): technique 0 is the camera pass and the
