@@ -143,9 +143,10 @@ UB_INLINE float ub_float_from_bits(ub_uint u) {
 #endif
 }
 
-/* exp(x) in float arithmetic, within one ulp of the exact value over the whole range (0.99 ulp
- * at most, measured on every seventh float by tests/opencl_headers_test.cpp, which also checks
- * that a PoCL kernel gives the same bits), for the kernels on PoCL's CPU devices (ub_exp).
+/* exp(x) in float arithmetic, within one ulp of the exact value where exp is a normal float
+ * (0.99 ulp at most, on every seventh float of that range when it was written;
+ * tests/opencl_headers_test.cpp checks every 61st, and that a PoCL kernel gives the same bits),
+ * for the kernels on PoCL's CPU devices (ub_exp).
  * Cody and Waite's reduction: k = round(x / ln 2), r = x - k ln 2 with ln 2 in two parts, the
  * first with nine trailing zero bits so that k * ln2Hi is exact (|k| <= 150); then
  * exp(r) = 1 + r + r^2 P(r) on |r| <= ln 2 / 2, P the degree-5 minimax polynomial of the Cephes
