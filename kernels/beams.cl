@@ -107,44 +107,6 @@ static void ub_query_medium_load(ub_query_medium* qm, __global const ub_medium_i
     qm->ready = 1;
 }
 
-/* Photon beam `beam`'s medium at t: in a homogeneous medium the closed form, without reading
- * the beam's table range (beams in homogeneous media have no table, and the range is a load per
- * pair: bb1d's kernel 1-2% faster on the bunny and mirrorballs, docs/performance.md, session
- * 38); otherwise from its table (ub_photon_beam_segment). */
-static ub_segment_eval ub_photon_beam_medium(ub_query_medium* qm, ub_beam pb, float t,
-                                             __global const ub_beam_piece* beamPieces,
-                                             __global const uint* beamRanges, uint beam) {
-    if (qm->m.homogeneous) return ub_homogeneous_segment_cp(qm->m, t, qm->mCont);
-    return ub_photon_beam_segment(qm->m, qm->mCont, qm->gi, &qm->acc, pb, t,
-                                  beamPieces + beamRanges[2u * beam], beamRanges[2u * beam + 1u]);
-}
-
-/* ub_homogeneous_segment_cp at t0 (into *e0) and at t1 (into *e1), the same values: the six
- * exponentials in one place, where the compiler can evaluate them as one vector. */
-static void ub_homogeneous_segment_pair(ub_medium_info m, float contProb, float t0, float t1,
-                                        ub_segment_eval* e0, ub_segment_eval* e1) {
-    float T[6];
-    for (int a = 0; a < 3; ++a) {
-        T[a] = ub_exp(-(m.sigmaT[a] * t0));
-        T[3 + a] = ub_exp(-(m.sigmaT[a] * t1));
-    }
-    float stop0 = 0.0f, pass0 = 0.0f, stop1 = 0.0f, pass1 = 0.0f;
-    for (int a = 0; a < 3; ++a) {
-        e0->transmittance[a] = T[a];
-        e1->transmittance[a] = T[3 + a];
-        e0->sigmaS[a] = e1->sigmaS[a] = m.sigmaS[a];
-        stop0 += m.sigmaT[a] * T[a];
-        pass0 += T[a];
-        stop1 += m.sigmaT[a] * T[3 + a];
-        pass1 += T[3 + a];
-    }
-    e0->stopFwdL = e0->stopRevStartL = stop0 * (1.0f / 3.0f);
-    e1->stopFwdL = e1->stopRevStartL = stop1 * (1.0f / 3.0f);
-    e0->passProb = pass0 * (1.0f / 3.0f);
-    e1->passProb = pass1 * (1.0f / 3.0f);
-    e0->contProb = e1->contProb = contProb;
-}
-
 /* pb2d's pairs, pending[0 .. np - 1] at beam parameters t[0 .. np - 1] in walk order: the
  * photons' records prefetched (UB_PREFETCH: PoCL's CPU devices; a hint or nothing elsewhere) and
  * their path lengths read, whose loads then overlap their cache misses, then the pairs'
@@ -252,7 +214,8 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
         if (!ub_bp2d_pair(q, part, radius * radius, minLength, maxLength, &t)) continue;
         ub_query_medium_load(&qm, media, grids, gridData, q.mediumId);
         ub_beam pb = beams[part.beam];
-        ub_segment_eval s = ub_photon_beam_medium(&qm, pb, t, beamPieces, beamRanges, part.beam);
+        ub_segment_eval s = ub_photon_beam_segment(qm.m, qm.mCont, qm.gi, &qm.acc, pb, t,
+                                                   beamPieces, beamRanges, part.beam);
         ub_float3 c = ub_bp2d_contribution(mis, pb, q, s, t, qm.m.g, normalization);
         sx += c.x;
         sy += c.y;
@@ -302,7 +265,8 @@ static void ub_bb1d_flush(__global const ub_beam* beams, __global const ub_beam_
             /* Both beams are in the query's medium: their six exponentials side by side. */
             ub_homogeneous_segment_pair(qm->m, qm->mCont, tls[j], tcs[j], &sl, &sc);
         } else {
-            sl = ub_photon_beam_medium(qm, pb, tls[j], beamPieces, beamRanges, beam);
+            sl = ub_photon_beam_segment(qm->m, qm->mCont, qm->gi, &qm->acc, pb, tls[j], beamPieces,
+                                        beamRanges, beam);
             sc = ub_query_beam_segment(qm->m, qm->mCont, qm->gi, &qm->acc, *qb, tcs[j], table,
                                        UB_QUERY_PIECES, tableState);
         }

@@ -190,15 +190,20 @@ UB_INLINE ub_segment_eval ub_beam_segment(ub_medium_info m, float mCont, ub_grid
     return m.homogeneous ? ub_homogeneous_segment_cp(m, t, mCont) : ub_grid_segment(g, acc, b, t);
 }
 
-/* A photon beam's medium at t from its table in a global buffer (count pieces from
- * `pieces`; count 0: no table, walk), else as ub_beam_segment. */
+/* Photon beam `beam`'s medium at t: the closed form in a homogeneous medium, else from its
+ * table in a global buffer (ranges[2 beam], ranges[2 beam + 1]: its first piece in `pieces`
+ * and their count; count 0: no table, walk). The range is read only for a grid medium: beams
+ * in homogeneous media have no table, and the load per pair cost bb1d's kernel 1-2%
+ * (docs/performance.md, session 38). */
 UB_INLINE ub_segment_eval ub_photon_beam_segment(ub_medium_info m, float mCont, ub_grid_info g,
                                                  UB_PRIVATE ub_grid_accessor* acc, ub_beam b,
                                                  float t, UB_GLOBAL const ub_beam_piece* pieces,
-                                                 ub_uint count) {
-    if (m.homogeneous || count == 0u) return ub_beam_segment(m, mCont, g, acc, b, t);
+                                                 UB_GLOBAL const ub_uint* ranges, ub_uint beam) {
+    if (m.homogeneous) return ub_homogeneous_segment_cp(m, t, mCont);
+    const ub_uint count = ranges[2u * beam + 1u];
+    if (count == 0u) return ub_grid_segment(g, acc, b, t);
     float sFirst = 0.0f, sLast = 0.0f;
-    const float tau = ub_beam_table_tau_g(pieces, count, t, &sFirst, &sLast);
+    const float tau = ub_beam_table_tau_g(pieces + ranges[2u * beam], count, t, &sFirst, &sLast);
     return ub_grey_segment(tau, sFirst, sLast, g.albedo[0], g.albedo[1], g.albedo[2]);
 }
 

@@ -10,6 +10,7 @@
 
 #include "cl/cl_runtime.h"
 #include "core/memory_budget.h"
+#include "core/seconds.h"
 #include "estimators/beam_medium.h"
 #include "estimators/bvh.h"
 #include "estimators/grid_access.h"
@@ -24,10 +25,6 @@
 namespace ub {
 
 namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// Box of the cylinder of radius r around o + t d, t in [t0, t1].
 Bounds3 cylinderBox(const Vec3& o, const Vec3& d, float t0, float t1, float r) {

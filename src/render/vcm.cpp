@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "core/parallel_gather.h"
 #include "core/rng.h"
+#include "core/seconds.h"
 #include "estimators/grid_access.h"
 #include "estimators/surface_merging.h"
 #include "estimators/volume_estimate.h"
@@ -27,10 +28,6 @@
 namespace ub {
 
 namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 VertexCM::Algorithm parseAlgorithm(const std::string& name) {
     if (name == "lt" || name == "vlt") return VertexCM::Algorithm::LightTrace;
