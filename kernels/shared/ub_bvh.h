@@ -41,11 +41,12 @@ typedef struct {
  * 4 j + 3 are block j, the last block padded with zeros): their lines and parameter ranges,
  * as a structure of arrays, so one load tests four candidates (ub_beam_lines_near4). The
  * ranges are widened by 1e-5 of their ends, and t1 is +infinity for a beam's last part, which
- * also holds parameters past its end (as ub_beam_part_holds decides): OpenCL C lets a float
- * division be off by 2.5 ulp, and a device may compute the filter's vector division and the
- * pair test's scalar one differently (seen on PoCL: without the margin the kernel lost pairs
- * at parts' ends, and its bunny bb1d image moved from 5.3e-7 to 1.3e-6 of the host twin's;
- * with it, back to 5.3e-7). 128 bytes. */
+ * also holds parameters past its end (as ub_beam_part_holds decides): the filter compares
+ * products where the pair test divides, OpenCL C lets a float division be off by 2.5 ulp, and
+ * a device may round the filter's vector operations and the pair test's scalar ones
+ * differently (seen on PoCL when the filter divided too: without the margin the kernel lost
+ * pairs at parts' ends, and its bunny bb1d image moved from 5.3e-7 to 1.3e-6 of the host
+ * twin's; with it, back to 5.3e-7). 128 bytes. */
 typedef struct UB_CACHE_ALIGNED {
     float ox[4], oy[4], oz[4];
     float dx[4], dy[4], dz[4];
@@ -67,7 +68,10 @@ UB_INLINE void ub_beam_keys4_set(UB_PRIVATE ub_beam_keys4* k, int j, ub_beam_par
 /* Bit j set when line j of the block passes within sqrt(radiusSqr) of the line o + t d and
  * the closest point of line j lies in part j's (widened) range, by the first two tests of
  * ub_beam_beam_near (not parallel; separation along d x d_j) and ub_beam_part_holds on its
- * parameter tB, with the same operations: a candidate it rejects, ub_bb1d_pair rejects. A
+ * parameter tB = num / sin2, the range compared against num without the division (sin2 >
+ * 1e-7 wherever a bit is set; a division is the costliest operation of the test on GPUs, and
+ * the margin above covers the different rounding): a candidate it rejects, ub_bb1d_pair
+ * rejects. A
  * filter ahead of the pair test, which still decides; the lanes are the caller's to mask.
  * The range test drops the parts next to the one that holds a pair, which share its line:
  * 45% of the candidates the lines alone passed on mirrorballs, 29% on the bunny. */
@@ -81,8 +85,8 @@ UB_INLINE ub_uint ub_beam_lines_near4(UB_PRIVATE const ub_beam_keys4* k, ub_floa
         float b = ub_f3_dot(d, dB);
         float sin2 = 1.0f - b * b;
         float sep = ub_f3_dot(w0, ub_f3_cross(d, dB));
-        float tB = (ub_f3_dot(dB, w0) - b * ub_f3_dot(d, w0)) / sin2;
-        int held = !(tB < k->t0[j] || tB >= k->t1[j]);
+        float num = ub_f3_dot(dB, w0) - b * ub_f3_dot(d, w0);
+        int held = !(num < k->t0[j] * sin2 || num >= k->t1[j] * sin2);
         mask |= (sin2 > 1e-7f && !(sep * sep > radiusSqr * sin2) && held) ? (1u << j) : 0u;
     }
     return mask;
@@ -173,10 +177,9 @@ UB_INLINE ub_uint ub_bvh_meets_global(__global const ub_bvh_node* n, ub_float3 o
         T ubCx = d.y * ubDz - d.z * ubDy, ubCy = d.z * ubDx - d.x * ubDz,         \
           ubCz = d.x * ubDy - d.y * ubDx;                                         \
         T ubSep = ubWx * ubCx + ubWy * ubCy + ubWz * ubCz;                        \
-        T ubTB = ((ubDx * ubWx + ubDy * ubWy + ubDz * ubWz) -                     \
-                  ubB * (d.x * ubWx + d.y * ubWy + d.z * ubWz)) /                 \
-                 ubSin2;                                                          \
-        IT ubHeld = !(ubTB < LOAD(t0) || ubTB >= LOAD(t1));                       \
+        T ubNum = (ubDx * ubWx + ubDy * ubWy + ubDz * ubWz) -                     \
+                  ubB * (d.x * ubWx + d.y * ubWy + d.z * ubWz);                   \
+        IT ubHeld = !(ubNum < LOAD(t0) * ubSin2 || ubNum >= LOAD(t1) * ubSin2);   \
         near = (ubSin2 > 1e-7f) & !(ubSep * ubSep > radiusSqr * ubSin2) & ubHeld; \
     }
 #define UB_KEYS_LOAD4(field) vload4(0, k->field)

@@ -237,11 +237,11 @@ inline uint32_t beamLinesNear4(const ub_beam_keys4& k, const ub_float3& o, const
         _mm_add_ps(_mm_add_ps(_mm_mul_ps(dBx, wx), _mm_mul_ps(dBy, wy)), _mm_mul_ps(dBz, wz));
     const __m128 dw =
         _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, wx), _mm_mul_ps(dy, wy)), _mm_mul_ps(dz, wz));
-    const __m128 tB = _mm_div_ps(_mm_sub_ps(e, _mm_mul_ps(b, dw)), sin2);
-    // sin2 > 1e-7, not sep^2 > r^2 sin2, not tB < t0 and not tB >= t1 (a NaN passes either
-    // test, as in the shared one).
-    const __m128 held =
-        _mm_andnot_ps(_mm_cmplt_ps(tB, _mm_loadu_ps(k.t0)), _mm_cmpnge_ps(tB, _mm_loadu_ps(k.t1)));
+    const __m128 num = _mm_sub_ps(e, _mm_mul_ps(b, dw));
+    // sin2 > 1e-7, not sep^2 > r^2 sin2, not num < t0 sin2 and not num >= t1 sin2 (a NaN passes
+    // either range test, as in the shared one).
+    const __m128 held = _mm_andnot_ps(_mm_cmplt_ps(num, _mm_mul_ps(_mm_loadu_ps(k.t0), sin2)),
+                                      _mm_cmpnge_ps(num, _mm_mul_ps(_mm_loadu_ps(k.t1), sin2)));
     const __m128 near = _mm_and_ps(
         _mm_and_ps(_mm_cmpgt_ps(sin2, _mm_set1_ps(1e-7f)),
                    _mm_cmpngt_ps(_mm_mul_ps(sep, sep), _mm_mul_ps(_mm_set1_ps(radiusSqr), sin2))),
