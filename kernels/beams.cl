@@ -22,6 +22,7 @@
 #include "ub_grid_medium.h"
 #include "ub_medium_homogeneous.h"
 #include "ub_pb2d.h"
+#include "ub_screen_tiles.h"
 
 /* = Bvh::kStackSize (src/estimators/bvh.h), whose build checks that no walk needs more */
 #define UB_BVH_STACK 64
@@ -279,15 +280,15 @@ static void ub_bb1d_flush(__global const ub_beam* beams, __global const ub_beam_
 }
 
 /* bb1d: query beams x photon beams (BVH over the diced beam parts). */
-__kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_beam_part* parts,
-                               __global const ub_beam_keys4* lines,
-                               __global const ub_beam_piece* beamPieces,
-                               __global const uint* beamRanges, __global const ub_bvh_node* nodes,
-                               __global const ub_grid_info* grids, __global const uchar* gridData,
-                               __global const ub_beam* queries, uint queryCount,
-                               __global const ub_medium_info* media, ub_mis_constants mis,
-                               float radius, float normalization, uint minLength, uint maxLength,
-                               __global float* out) {
+__kernel void ub_bb1d_estimate(
+    __global const ub_beam* beams, __global const ub_beam_part* parts,
+    __global const ub_beam_keys4* lines, __global const ub_beam_piece* beamPieces,
+    __global const uint* beamRanges, __global const ub_bvh_node* nodes,
+    __global const uint* tileStart, __global const ub_beam_keys4* tileLines,
+    __global const uint* tileParts, ub_screen_tiles tiles, __global const ub_grid_info* grids,
+    __global const uchar* gridData, __global const ub_beam* queries, uint queryCount,
+    __global const ub_medium_info* media, ub_mis_constants mis, float radius, float normalization,
+    uint minLength, uint maxLength, __global float* out) {
     uint i = get_global_id(0);
     if (i >= queryCount) return;
     ub_beam qb = queries[i];
@@ -300,32 +301,59 @@ __kernel void ub_bb1d_estimate(__global const ub_beam* beams, __global const ub_
     float sum[3] = {0.0f, 0.0f, 0.0f};
     uint pending[UB_BB1D_PENDING];
     int np = 0;
-    /* A leaf's candidates four at a time by their lines first, as the host twin does
-     * (src/estimators/bb1d_estimator.cpp), gathered and handled UB_BB1D_PENDING at a time. */
-    UB_BVH_LEAVES_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qb.length))
-    for (uint b = leafFirst / 4u; b * 4u < leafEnd; ++b) {
-        /* two blocks at once where the leaf has both (ub_beam_lines_near8_global) */
-        uint near;
-        if ((b + 1u) * 4u < leafEnd) {
-            uint m8 = ub_beam_lines_near8_global(lines + b, o, d, radius * radius);
-            near = (m8 & ub_block_lanes(b, leafFirst, leafEnd)) |
-                   ((m8 >> 4) & ub_block_lanes(b + 1u, leafFirst, leafEnd)) << 4;
-        } else {
-            near = ub_beam_lines_near4_global(lines + b, o, d, radius * radius) &
-                   ub_block_lanes(b, leafFirst, leafEnd);
-        }
-        for (; near != 0u; near &= near - 1u) {
-            pending[np++] = b * 4u + (31u - clz(near & (0u - near)));
-            if (np == UB_BB1D_PENDING) {
-                ub_query_medium_load(&qm, media, grids, gridData, qb.mediumId);
-                ub_bb1d_flush(beams, parts, beamPieces, beamRanges, &qm, &qb, table, &tableState,
-                              mis, radius, normalization, minLength, maxLength, pending, np, sum);
-                np = 0;
+    /* A query on a line through the eye reads its screen tile's parts and the common list
+     * (ub_screen_tiles.h) in place of the walk, in the same order as the host twin. */
+    int tile = ub_screen_tile_of(tiles, o, d);
+    if (tile >= 0) {
+        uint lists[2] = {(uint)tile, tiles.tilesX * tiles.tilesY};
+        for (int l = 0; l < 2; ++l) {
+            uint end = tileStart[lists[l] + 1u];
+            for (uint b = tileStart[lists[l]]; b < end; ++b) {
+                uint near = b + 1u < end
+                                ? ub_beam_lines_near8_global(tileLines + b, o, d, radius * radius)
+                                : ub_beam_lines_near4_global(tileLines + b, o, d, radius * radius);
+                for (; near != 0u; near &= near - 1u) {
+                    pending[np++] = tileParts[b * 4u + (31u - clz(near & (0u - near)))];
+                    if (np == UB_BB1D_PENDING) {
+                        ub_query_medium_load(&qm, media, grids, gridData, qb.mediumId);
+                        ub_bb1d_flush(beams, parts, beamPieces, beamRanges, &qm, &qb, table,
+                                      &tableState, mis, radius, normalization, minLength, maxLength,
+                                      pending, np, sum);
+                        np = 0;
+                    }
+                }
+                if (b + 1u < end) ++b; /* the pair's second block is done */
             }
         }
-        if ((b + 1u) * 4u < leafEnd) ++b; /* the pair's second block is done */
+    } else {
+        /* A leaf's candidates four at a time by their lines first, as the host twin does
+         * (src/estimators/bb1d_estimator.cpp), gathered and handled UB_BB1D_PENDING at a time. */
+        UB_BVH_LEAVES_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qb.length))
+        for (uint b = leafFirst / 4u; b * 4u < leafEnd; ++b) {
+            /* two blocks at once where the leaf has both (ub_beam_lines_near8_global) */
+            uint near;
+            if ((b + 1u) * 4u < leafEnd) {
+                uint m8 = ub_beam_lines_near8_global(lines + b, o, d, radius * radius);
+                near = (m8 & ub_block_lanes(b, leafFirst, leafEnd)) |
+                       ((m8 >> 4) & ub_block_lanes(b + 1u, leafFirst, leafEnd)) << 4;
+            } else {
+                near = ub_beam_lines_near4_global(lines + b, o, d, radius * radius) &
+                       ub_block_lanes(b, leafFirst, leafEnd);
+            }
+            for (; near != 0u; near &= near - 1u) {
+                pending[np++] = b * 4u + (31u - clz(near & (0u - near)));
+                if (np == UB_BB1D_PENDING) {
+                    ub_query_medium_load(&qm, media, grids, gridData, qb.mediumId);
+                    ub_bb1d_flush(beams, parts, beamPieces, beamRanges, &qm, &qb, table,
+                                  &tableState, mis, radius, normalization, minLength, maxLength,
+                                  pending, np, sum);
+                    np = 0;
+                }
+            }
+            if ((b + 1u) * 4u < leafEnd) ++b; /* the pair's second block is done */
+        }
+        UB_BVH_LEAVES_END
     }
-    UB_BVH_LEAVES_END
     if (np > 0) {
         ub_query_medium_load(&qm, media, grids, gridData, qb.mediumId);
         ub_bb1d_flush(beams, parts, beamPieces, beamRanges, &qm, &qb, table, &tableState, mis,

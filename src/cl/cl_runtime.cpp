@@ -18,6 +18,7 @@
 #include "core/file_status.h"
 #include "estimators/bvh.h"
 #include "estimators/hash_grid.h"
+#include "estimators/screen_tiles.h"
 
 namespace ub {
 
@@ -698,13 +699,16 @@ void ClRuntime::estimateBB1D(const std::vector<ub_beam>& beams,
                              const std::vector<ub_beam_keys4>& lines,
                              const std::vector<ub_beam_piece>& pieces,
                              const std::vector<uint32_t>& ranges, const Bvh& bvh,
-                             const std::vector<ub_beam>& queries, const EstimateArgs& a,
-                             std::vector<Rgb>* out) {
+                             const ScreenTiles& tiles, const std::vector<ub_beam>& queries,
+                             const EstimateArgs& a, std::vector<Rgb>* out) {
     if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
     requireLeafOrder(bvh, "bb1d");
+    if (tiles.start.empty() || tiles.lines.empty() || tiles.parts.empty())
+        throw std::logic_error("bb1d kernel given screen tiles that were not built");
     runEstimate(bb1d_, "clEnqueueNDRangeKernel(ub_bb1d_estimate)",
                 withGrids({bufferArg(beams), bufferArg(parts), bufferArg(lines), bufferArg(pieces),
-                           bufferArg(ranges), bufferArg(bvh.nodes())},
+                           bufferArg(ranges), bufferArg(bvh.nodes()), bufferArg(tiles.start),
+                           bufferArg(tiles.lines), bufferArg(tiles.parts), scalarArg(tiles.params)},
                           gridArgs(a)),
                 bufferArg(queries), queries.size(), a, out);
 }

@@ -34,6 +34,8 @@
 
 namespace ub {
 
+struct ScreenTiles;
+
 class HashGrid;
 class Bvh;
 
@@ -111,8 +113,8 @@ class ClRuntime {
     void estimateBB1D(const std::vector<ub_beam>& beams, const std::vector<ub_beam_part>& parts,
                       const std::vector<ub_beam_keys4>& lines,
                       const std::vector<ub_beam_piece>& pieces, const std::vector<uint32_t>& ranges,
-                      const Bvh& bvh, const std::vector<ub_beam>& queries, const EstimateArgs& a,
-                      std::vector<Rgb>* out);
+                      const Bvh& bvh, const ScreenTiles& tiles, const std::vector<ub_beam>& queries,
+                      const EstimateArgs& a, std::vector<Rgb>* out);
     /// Surface merging (kernels/surf.cl) over surface photons and surface queries; tables:
     /// the materials' rough-plastic coating tables (estimators/surface_merging.h).
     void estimateSurf(const std::vector<LightVertex>& photons, const HashGrid& grid,

@@ -8,6 +8,10 @@
 // in the part whose parameter range holds its closest-approach parameter.
 // Both beams' media up to the closest approach are evaluated exactly.
 //
+// Query beams on lines through a pinhole camera's eye (the camera rays' pieces) read the parts
+// their screen tile lists instead of walking the BVH (estimators/screen_tiles.h, the proof of
+// completeness in kernels/shared/ub_screen_tiles.h): the same pairs, tested the same way.
+//
 // The walk (estimators/bb1d_walk.inc):
 // - A leaf's candidates are tested four at a time by their lines and ranges
 //   (ub_beam_keys4: the pair test's first two rejections and its range test), then the pair
@@ -33,6 +37,7 @@
 
 #include "estimators/beam_medium.h"
 #include "estimators/bvh.h"
+#include "estimators/screen_tiles.h"
 #include "estimators/volume_estimate.h"
 #include "kernels/shared/ub_bb1d.h"
 #include "scene/scene.h"
@@ -53,6 +58,7 @@ struct Bb1dPass {
     const std::vector<BeamMedium>& photonMedia;
     const std::vector<ub_beam>& beams;
     const std::vector<ub_beam>& queries;
+    const ScreenTiles& tiles;
     float r, normalization;
     std::vector<Rgb>* out;
 };
@@ -135,24 +141,18 @@ uint32_t bb1dLinesNear8ForTests(const ub_beam_keys4* k, const ub_float3& o, cons
 
 void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
                   const std::vector<BeamPart>& parts, const std::vector<ub_beam_keys4>& lines,
-                  const std::vector<BeamMedium>& photonMedia, std::vector<Rgb>* out,
-                  size_t* pairs) {
+                  const std::vector<BeamMedium>& photonMedia, const ScreenTiles& tiles,
+                  std::vector<Rgb>* out, size_t* pairs) {
     const std::vector<ub_beam>& beams = *in.photonBeams;
     const std::vector<ub_beam>& queries = *in.queryBeams;
     if (beams.empty() || queries.empty() || beamParts.empty()) return;
     if (!beamParts.leafOrdered())
         throw std::logic_error("bb1d given a BVH whose parts are not in leaf order");
     const float r = in.radius[UB_TECH_BB1D];
-    const Bb1dPass pass{in,
-                        beamParts.nodes(),
-                        parts,
-                        lines,
-                        photonMedia,
-                        beams,
-                        queries,
-                        r,
-                        ub_bb1d_normalization(in.beamPathCount, r),
-                        out};
+    const Bb1dPass pass{
+        in,    beamParts.nodes(), parts, lines, photonMedia,
+        beams, queries,           tiles, r,     ub_bb1d_normalization(in.beamPathCount, r),
+        out};
     const bool useWide = bb1dWideWalk();
     forEachQueryBlock(queries.size(), 16, out, pairs, [&](size_t begin, size_t end, size_t* found) {
 #if UB_BB1D_HAS_WIDE

@@ -104,6 +104,7 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     Bvh beamBvh;
     std::vector<BeamPart> parts;
     std::vector<ub_beam_keys4> partLines;
+    ScreenTiles tiles;
     if (t.photonBeams()) {
         const float r = std::max(t.bp2d ? in.radius[UB_TECH_BP2D] : 0.0f,
                                  t.bb1d ? in.radius[UB_TECH_BB1D] : 0.0f);
@@ -155,6 +156,11 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
             partLines.assign((parts.size() + 3) / 4, ub_beam_keys4{});
             for (size_t i = 0; i < parts.size(); ++i)
                 ub_beam_keys4_set(&partLines[i / 4], int(i % 4), parts[i]);
+            // The parts by screen tile, for the query beams through the camera's eye.
+            buildScreenTiles(
+                in.scene->camera, in.scene->sceneSphere.radius, parts, r,
+                [&](size_t bytes) { reserve(bytes, "bb1d lookup (screen tiles)"); }, &tiles);
+            st.screenTiles = tiles.params;
         }
     }
     // The medium along every photon beam, tabulated once (estimators/beam_medium.h).
@@ -179,7 +185,8 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     st.buildSeconds = secondsSince(t0);
     st.lookupBytes += spheres.bytes() + sphereOrder.size() * sizeof(ub_photon_point) +
                       sphereKeys.size() * sizeof(ub_photon_keys4) + beamBvh.bytes() +
-                      parts.size() * sizeof(BeamPart) + partLines.size() * sizeof(ub_beam_keys4);
+                      parts.size() * sizeof(BeamPart) + partLines.size() * sizeof(ub_beam_keys4) +
+                      tiles.bytes();
 
     t0 = std::chrono::steady_clock::now();
     std::vector<Rgb> perPoint[4], perBeam[4];
@@ -241,13 +248,13 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         perBeam[UB_TECH_BB1D].assign(nBeams, Rgb(0.0f));
         const float r = in.radius[UB_TECH_BB1D];
         if (beamCl) {
-            beamCl->estimateBB1D(beams, parts, partLines, beamPieces, beamRanges, beamBvh,
+            beamCl->estimateBB1D(beams, parts, partLines, beamPieces, beamRanges, beamBvh, tiles,
                                  *in.queryBeams,
                                  clArgs(UB_TECH_BB1D, ub_bb1d_normalization(in.beamPathCount, r)),
                                  &perBeam[UB_TECH_BB1D]);
             st.pairs[UB_TECH_BB1D] = VolumeEstimateStats::kNotCounted;
         } else {
-            estimateBB1D(in, beamBvh, parts, partLines, photonMedia, &perBeam[UB_TECH_BB1D],
+            estimateBB1D(in, beamBvh, parts, partLines, photonMedia, tiles, &perBeam[UB_TECH_BB1D],
                          &st.pairs[UB_TECH_BB1D]);
         }
     }

@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "estimators/screen_tiles.h"
 #include "kernels/shared/ub_bvh.h"
 #include "kernels/shared/ub_medium_homogeneous.h"
 #include "kernels/shared/ub_upbp_records.h"
@@ -77,6 +78,8 @@ struct VolumeEstimateStats {
     size_t lookupBytes = 0;
     /// Query estimates dropped by the guard (NaN, infinite or negative), per technique.
     uint64_t rejected[4] = {0, 0, 0, 0};
+    /// The screen tiles bb1d read (enabled == 0: none; estimators/screen_tiles.h).
+    ub_screen_tiles screenTiles{};
 };
 
 /// The media as the kernels see them (one ub_medium_info per medium, at least one entry), and
@@ -142,7 +145,8 @@ void estimateBP2D(const VolumeEstimateInput& in, const Bvh& beamParts,
 /// lines: the parts' lines four to a block, in leaf order (kernels/shared/ub_bvh.h).
 void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
                   const std::vector<BeamPart>& parts, const std::vector<ub_beam_keys4>& lines,
-                  const std::vector<BeamMedium>& photonMedia, std::vector<Rgb>* out, size_t* pairs);
+                  const std::vector<BeamMedium>& photonMedia, const ScreenTiles& tiles,
+                  std::vector<Rgb>* out, size_t* pairs);
 /// Whether estimateBB1D tests part lines eight at a time (the CPU has AVX; bb1d_walk.inc).
 bool bb1dWideWalk();
 /// Lets estimateBB1D use the AVX walk where the CPU has it (the default) or not: the two give

@@ -1,0 +1,45 @@
+// Screen tiles for bb1d's camera rays (kernels/shared/ub_screen_tiles.h): the photon-beam
+// parts binned by the image tiles their boxes project to, read by the query beams whose lines
+// pass through a pinhole camera's eye in place of the BVH walk, by the host twin
+// (estimators/bb1d_walk.inc) and the kernel (kernels/beams.cl) alike.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "kernels/shared/ub_bvh.h"
+#include "kernels/shared/ub_screen_tiles.h"
+
+namespace ub {
+
+class Camera;
+
+struct ScreenTiles {
+    ub_screen_tiles params{};  ///< params.enabled == 0: every query walks the BVH
+    /// Block ranges of the lists: list k is blocks start[k] .. start[k + 1] - 1; lists 0 ..
+    /// tilesX * tilesY - 1 are the tiles', list tilesX * tilesY the one every tile reads.
+    std::vector<uint32_t> start;
+    std::vector<ub_beam_keys4> lines;  ///< the parts' lines, as the BVH's leaves have them
+    std::vector<uint32_t> parts;       ///< the part index of each lane (4 a block)
+    size_t bytes() const {
+        return start.size() * 4 + lines.size() * sizeof(ub_beam_keys4) + parts.size() * 4;
+    }
+};
+
+/// Bins parts (their index is their position) for the camera: nothing when the camera is not a
+/// pinhole or the lists would exceed a bound (16 entries per part on average; then every query
+/// walks the BVH). r: the radius the parts' boxes are grown by; sceneRadius sets the tolerance.
+/// reserve(bytes) is called before the lists are allocated (the memory budget). The buffers
+/// are never empty (the kernels are given one block at least).
+void buildScreenTiles(const Camera& camera, float sceneRadius,
+                      const std::vector<ub_beam_part>& parts, float r,
+                      const std::function<void(size_t)>& reserve, ScreenTiles* out);
+
+/// Lets the bb1d estimate use screen tiles (the default) or not: the two find the same pairs,
+/// which a test checks.
+void setScreenTilesForTests(bool allowed);
+bool screenTilesAllowed();
+
+}  // namespace ub
