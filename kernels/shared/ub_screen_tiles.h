@@ -15,13 +15,15 @@
  *    tolerance, and its direction projects inside the image;
  *  - a point X = o + t d (t >= 0) of the query is then within tolerance of the point X0 =
  *    eye + s d (s >= -tolerance) of the exact line through the eye;
- *  - a pair needs X within r of the part's segment, so X lies in the part's box (the segment's
- *    bounds grown by r), and X0 in that box grown by tolerance; the host grows it by twice
- *    that, against rounding;
- *  - if every corner of the grown box is in front of the eye (depth > tolerance), X0 is too,
- *    so s > 0 and X0 projects where d does; the box is convex and projection keeps segments
- *    straight in front of the eye, so its corners' projections bound X0's: the tiles the
- *    corners' bounding rectangle covers (widened by 1/64 pixel against rounding) hold it;
+ *  - a pair needs X within r of the part's segment, so X0 lies within r + tolerance of it, in
+ *    the part's box: the segment grown by r + 2 tolerance along itself and along two axes
+ *    across it (an oriented box; the second tolerance is for rounding);
+ *  - if every corner of the box is in front of the eye (depth > tolerance), X0 is too, so
+ *    s > 0 and X0 projects where d does; the box is convex and projection keeps segments
+ *    straight in front of the eye, so X0 projects into the convex hull of the corners'
+ *    projections: in each row of tiles, the host lists the part in the tiles that the hull's
+ *    span across the row's band covers (band and span widened by 1/64 pixel against
+ *    rounding);
  *  - a box with every corner behind the eye by more than tolerance holds no such X0 and is
  *    left out; any other part (a box across the eye's plane, or covering more tiles than the
  *    host allows) goes into the list every tile reads, number tilesX * tilesY.

@@ -15,11 +15,70 @@ namespace ub {
 namespace {
 std::atomic<bool> tilesAllowed{true};
 
-/// Where a part goes: a rectangle of tiles, the list every tile reads, or nowhere.
+/// Where a part goes: rows y0 .. y1 of tiles (each row's span from the corners), the list
+/// every tile reads, or nowhere.
 struct Placement {
     enum Kind : uint8_t { kTiles, kEverywhere, kNone } kind = kNone;
-    uint16_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // inclusive
+    uint32_t y0 = 0, y1 = 0, x0 = 0, x1 = 0;
+    uint8_t n = 8;     ///< corners, then (makeHull) the hull's vertices
+    float x[8], y[8];  ///< raster positions of the box's corners
 };
+
+/// Replaces the 8 corners of p by their convex hull, counter-clockwise in (x, y) (Andrew's
+/// monotone chain; a hull of the projected box has 4 to 6 vertices).
+void makeHull(Placement* p) {
+    int order[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+    std::sort(order, order + 8, [&](int i, int j) {
+        return p->x[i] < p->x[j] || (p->x[i] == p->x[j] && p->y[i] < p->y[j]);
+    });
+    auto cross = [&](int o, int a, int b) {
+        return (p->x[a] - p->x[o]) * (p->y[b] - p->y[o]) -
+               (p->y[a] - p->y[o]) * (p->x[b] - p->x[o]);
+    };
+    int hull[16], n = 0;
+    for (int k = 0; k < 8; ++k) {  // lower hull
+        while (n >= 2 && cross(hull[n - 2], hull[n - 1], order[k]) <= 0.0f) --n;
+        hull[n++] = order[k];
+    }
+    for (int k = 6, lower = n + 1; k >= 0; --k) {  // upper hull
+        while (n >= lower && cross(hull[n - 2], hull[n - 1], order[k]) <= 0.0f) --n;
+        hull[n++] = order[k];
+    }
+    --n;  // the last point is the first
+    float x[8], y[8];
+    for (int k = 0; k < n; ++k) {
+        x[k] = p->x[hull[k]];
+        y[k] = p->y[hull[k]];
+    }
+    for (int k = 0; k < n; ++k) {
+        p->x[k] = x[k];
+        p->y[k] = y[k];
+    }
+    p->n = uint8_t(std::max(n, 1));
+}
+
+/// The raster x range of p's hull within the band y in [lo, hi]: its vertices in the band and
+/// its edges' crossings of the band's two lines (empty, lo > hi, where it misses the band).
+/// The hull is computed in float: a corner it drops as collinear lies on an edge it keeps, up
+/// to rounding far below the margin the callers add.
+void hullSpan(const Placement& p, float lo, float hi, float* xlo, float* xhi) {
+    float a = INFINITY, b = -INFINITY;
+    for (int i = 0; i < p.n; ++i) {
+        const int j = i + 1 == p.n ? 0 : i + 1;
+        if (p.y[i] >= lo && p.y[i] <= hi) {
+            a = std::min(a, p.x[i]);
+            b = std::max(b, p.x[i]);
+        }
+        for (float line : {lo, hi})
+            if ((p.y[i] - line) * (p.y[j] - line) < 0.0f) {
+                const float x = p.x[i] + (line - p.y[i]) * (p.x[j] - p.x[i]) / (p.y[j] - p.y[i]);
+                a = std::min(a, x);
+                b = std::max(b, x);
+            }
+    }
+    *xlo = a;
+    *xhi = b;
+}
 }  // namespace
 
 void setScreenTilesForTests(bool allowed) {
@@ -49,10 +108,10 @@ void buildScreenTiles(const Camera& camera, float sceneRadius,
     if (!tilesAllowed || !camera.isPinhole() || parts.empty() || width <= 0 || height <= 0 ||
         parts.size() >= (size_t(1) << 31))
         return finishEmpty();
-    // About 4096 tiles (4 x 4 pixels at 256 x 256): on the bunny and mirrorballs, 4-pixel tiles
-    // hold 100-200 parts a query against 150-400 for 8 pixels, and 240-340 part lines and 60-90
-    // nodes for the BVH walk (docs/performance.md, session 39).
-    const int tile = std::max(4, int(std::ceil(std::sqrt(double(width) * height / 4096.0))));
+    // About 1024 tiles (8 x 8 pixels at 256 x 256). Measured on the bunny and mirrorballs
+    // (bb1d, lookups plus estimates, docs/performance.md, session 39): 4096 and 16384 tiles
+    // give fewer candidates a query but cost more to build, and were no faster.
+    const int tile = std::max(2, int(std::ceil(std::sqrt(double(width) * height / 1024.0))));
     ub_screen_tiles& s = out->params;
     const Vec3 eye = camera.position();
     const Vec3 axes[3] = {camera.right(), camera.up(), camera.forward()};
@@ -68,7 +127,6 @@ void buildScreenTiles(const Camera& camera, float sceneRadius,
     s.tileSize = uint32_t(tile);
     s.tilesX = uint32_t((width + tile - 1) / tile);
     s.tilesY = uint32_t((height + tile - 1) / tile);
-    if (s.tilesX > 65535 || s.tilesY > 65535) return finishEmpty();  // Placement's 16 bits
     // About a hundred times the rounding of a camera ray's points (a few ulp of their
     // coordinates): a query off the eye's lines by more walks the BVH.
     float extent = std::fabs(eye.x) + std::fabs(eye.y) + std::fabs(eye.z) + 2.0f * sceneRadius;
@@ -79,61 +137,69 @@ void buildScreenTiles(const Camera& camera, float sceneRadius,
     const size_t maxRect = std::max<size_t>(1, tileCount / 4);
     const float grow = r + 2.0f * s.tolerance, margin = 1.0f / 64.0f;
 
+    // The box of a part: its segment grown along itself and across it (the frame's two other
+    // axes) by r plus twice the tolerance, which holds every point within that distance of the
+    // segment (an oriented box, much tighter than the axis-aligned one for a slanted part).
     std::vector<Placement> place(parts.size());
     tbb::parallel_for(size_t(0), parts.size(), [&](size_t i) {
         const ub_beam_part& p = parts[i];
         const Vec3 o(p.origin[0], p.origin[1], p.origin[2]), d(p.dir[0], p.dir[1], p.dir[2]);
-        const Vec3 a = o + d * p.t0, b = o + d * p.t1;
-        Vec3 lo(std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z));
-        Vec3 hi(std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z));
-        lo = lo - Vec3(grow);
-        hi = hi + Vec3(grow);
+        const Frame f(d);
+        const Vec3 ends[2] = {o + d * (p.t0 - grow), o + d * (p.t1 + grow)};
+        Placement& pl = place[i];
         int front = 0, behind = 0;
-        float xlo = INFINITY, ylo = INFINITY, xhi = -INFINITY, yhi = -INFINITY;
+        float ylo = INFINITY, yhi = -INFINITY, xlo = INFINITY, xhi = -INFINITY;
         for (int c = 0; c < 8; ++c) {
-            const Vec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+            const Vec3 corner =
+                ends[c & 1] + f.s * ((c & 2) ? grow : -grow) + f.t * ((c & 4) ? grow : -grow);
             const Vec3 v = corner - eye;
             const float depth = dot(v, axes[2]);
             if (depth > s.tolerance) {
                 ++front;
-                float x, y;
-                ub_screen_raster(s, ub_make_float3(v.x, v.y, v.z), &x, &y);
-                xlo = std::min(xlo, x);
-                xhi = std::max(xhi, x);
-                ylo = std::min(ylo, y);
-                yhi = std::max(yhi, y);
+                ub_screen_raster(s, ub_make_float3(v.x, v.y, v.z), &pl.x[c], &pl.y[c]);
+                xlo = std::min(xlo, pl.x[c]);
+                xhi = std::max(xhi, pl.x[c]);
+                ylo = std::min(ylo, pl.y[c]);
+                yhi = std::max(yhi, pl.y[c]);
             } else if (depth < -s.tolerance) {
                 ++behind;
             }
         }
-        Placement& pl = place[i];
         if (behind == 8) return;  // kNone
         if (front < 8 || !std::isfinite(xlo + xhi + ylo + yhi)) {
             pl.kind = Placement::kEverywhere;
             return;
         }
-        xlo -= margin, ylo -= margin, xhi += margin, yhi += margin;
-        if (xhi < 0.0f || yhi < 0.0f || xlo >= s.width || ylo >= s.height) return;  // off image
+        if (xhi + margin < 0.0f || yhi + margin < 0.0f || xlo - margin >= s.width ||
+            ylo - margin >= s.height)
+            return;  // off the image: no query reads it
         auto tileOf = [&](float v, uint32_t n) {
-            return uint16_t(std::min<float>(float(n - 1), std::max(0.0f, std::floor(v / tile))));
+            return uint32_t(std::min<float>(float(n - 1), std::max(0.0f, std::floor(v / tile))));
         };
-        pl.x0 = tileOf(xlo, s.tilesX), pl.x1 = tileOf(xhi, s.tilesX);
-        pl.y0 = tileOf(ylo, s.tilesY), pl.y1 = tileOf(yhi, s.tilesY);
-        const size_t rect = size_t(pl.x1 - pl.x0 + 1) * size_t(pl.y1 - pl.y0 + 1);
+        pl.y0 = tileOf(ylo - margin, s.tilesY), pl.y1 = tileOf(yhi + margin, s.tilesY);
+        pl.x0 = tileOf(xlo - margin, s.tilesX), pl.x1 = tileOf(xhi + margin, s.tilesX);
+        const size_t rect =
+            size_t(tileOf(xhi + margin, s.tilesX) - tileOf(xlo - margin, s.tilesX) + 1) *
+            size_t(pl.y1 - pl.y0 + 1);
         pl.kind = rect > maxRect ? Placement::kEverywhere : Placement::kTiles;
+        if (pl.kind == Placement::kTiles) makeHull(&pl);
     });
+    // The tiles of part pl in row y: its hull's span in the row's band, widened by the margin.
+    auto rowTiles = [&](const Placement& pl, uint32_t y, uint32_t* x0, uint32_t* x1) {
+        float a, b;
+        hullSpan(pl, float(y * s.tileSize) - margin, float((y + 1) * s.tileSize) + margin, &a, &b);
+        if (!(a <= b) || b + margin < 0.0f || a - margin >= s.width) return false;
+        *x0 = uint32_t(std::max(0.0f, std::floor((a - margin) / tile)));
+        *x1 = uint32_t(std::min<float>(float(s.tilesX - 1), std::floor((b + margin) / tile)));
+        return *x0 <= *x1;
+    };
     // The parts of each tile row, ascending, so that rows fill their tiles in parallel.
     std::vector<uint32_t> rowStart(size_t(s.tilesY) + 1, 0u), common;
-    size_t entries = 0;
-    for (const Placement& pl : place) {
-        if (pl.kind != Placement::kTiles) continue;
-        for (uint32_t y = pl.y0; y <= pl.y1; ++y) ++rowStart[y + 1];
-        entries += size_t(pl.x1 - pl.x0 + 1) * size_t(pl.y1 - pl.y0 + 1);
-    }
+    for (const Placement& pl : place)
+        if (pl.kind == Placement::kTiles)
+            for (uint32_t y = pl.y0; y <= pl.y1; ++y) ++rowStart[y + 1];
     for (uint32_t i = 0; i < uint32_t(parts.size()); ++i)
         if (place[i].kind == Placement::kEverywhere) common.push_back(i);
-    entries += common.size();
-    if (entries > 16 * parts.size() + 4096) return finishEmpty();  // the BVH walk's memory
     for (size_t y = 0; y < s.tilesY; ++y) rowStart[y + 1] += rowStart[y];
     std::vector<uint32_t> rowParts(rowStart.back()), rowNext(rowStart.begin(), rowStart.end() - 1);
     for (uint32_t i = 0; i < uint32_t(parts.size()); ++i) {
@@ -146,10 +212,14 @@ void buildScreenTiles(const Camera& camera, float sceneRadius,
     count[tileCount] = uint32_t(common.size());
     tbb::parallel_for(uint32_t(0), s.tilesY, [&](uint32_t y) {
         for (uint32_t k = rowStart[y]; k < rowStart[y + 1]; ++k) {
-            const Placement& pl = place[rowParts[k]];
-            for (uint32_t x = pl.x0; x <= pl.x1; ++x) ++count[y * s.tilesX + x];
+            uint32_t x0, x1;
+            if (rowTiles(place[rowParts[k]], y, &x0, &x1))
+                for (uint32_t x = x0; x <= x1; ++x) ++count[y * s.tilesX + x];
         }
     });
+    size_t entries = 0;
+    for (uint32_t c : count) entries += c;
+    if (entries > 16 * parts.size() + 4096) return finishEmpty();  // the BVH walk's memory
     out->start.assign(tileCount + 2, 0u);
     for (size_t k = 0; k <= tileCount; ++k) out->start[k + 1] = out->start[k] + (count[k] + 3) / 4;
     const size_t blocks = std::max<size_t>(1, out->start[tileCount + 1]);
@@ -167,8 +237,9 @@ void buildScreenTiles(const Camera& camera, float sceneRadius,
         for (uint32_t x = 0; x < s.tilesX; ++x) next[x] = out->start[y * s.tilesX + x] * 4;
         for (uint32_t k = rowStart[y]; k < rowStart[y + 1]; ++k) {
             const uint32_t i = rowParts[k];
-            const Placement& pl = place[i];
-            for (uint32_t x = pl.x0; x <= pl.x1; ++x) put(next[x]++, i);
+            uint32_t x0, x1;
+            if (rowTiles(place[i], y, &x0, &x1))
+                for (uint32_t x = x0; x <= x1; ++x) put(next[x]++, i);
         }
     });
     for (size_t k = 0; k < common.size(); ++k)
