@@ -5,8 +5,8 @@
  * the image as the camera projects a point, falls where the part's box projects. The host
  * bins the parts by the image tiles their boxes cover (src/estimators/screen_tiles.cpp), and
  * such a query reads its tile's parts instead of walking the BVH: on the bunny and
- * mirrorballs these queries were 40% of bb1d's node visits and 60-70% of its part lines
- * (docs/performance.md, session 39).
+ * mirrorballs these queries were a fifth to a quarter of the query beams and 40% of the nodes
+ * bb1d's walk visited (docs/performance.md, session 39).
  *
  * Why a tile holds every part a query of it can pair with (each step a bound, not an
  * estimate):
