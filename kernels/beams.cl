@@ -134,7 +134,9 @@ static void ub_pb2d_flush(__global const ub_photon_point* photons, ub_query_medi
 /* pb2d: query beams x photon points (BVH over the photons' kernel spheres). */
 __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
                                __global const ub_photon_keys4* keys,
-                               __global const ub_bvh_node* nodes,
+                               __global const ub_bvh_node* nodes, __global const uint* tileStart,
+                               __global const ub_photon_keys4* tileKeys,
+                               __global const uint* tileItems, ub_screen_tiles tiles,
                                __global const ub_grid_info* grids, __global const uchar* gridData,
                                __global const ub_beam* queries, uint queryCount,
                                __global const ub_medium_info* media, ub_mis_constants mis,
@@ -158,33 +160,61 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
     float pendingT[UB_PB2D_PENDING];
     float sum[3] = {0.0f, 0.0f, 0.0f};
     int np = 0;
-    UB_BVH_LEAVES_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qLength))
-    for (uint b = leafFirst / 4u; b * 4u < leafEnd; ++b) {
-        /* two blocks at once where the leaf has both (ub_pb2d_near8_global) */
-        float t[8];
-        uint near;
-        if ((b + 1u) * 4u < leafEnd) {
-            uint m8 = ub_pb2d_near8_global(keys + b, o, d, qLength, qMedium, r2, t);
-            near = (m8 & ub_block_lanes(b, leafFirst, leafEnd)) |
-                   ((m8 >> 4) & ub_block_lanes(b + 1u, leafFirst, leafEnd)) << 4;
-        } else {
-            near = ub_pb2d_near4_global(keys + b, o, d, qLength, qMedium, r2, t) &
-                   ub_block_lanes(b, leafFirst, leafEnd);
-        }
-        for (; near != 0u; near &= near - 1u) {
-            uint lane = 31u - clz(near & (0u - near));
-            pending[np] = b * 4u + lane;
-            pendingT[np++] = t[lane];
-            if (np == UB_PB2D_PENDING) {
-                ub_query_medium_load(&qm, media, grids, gridData, qMedium);
-                ub_pb2d_flush(photons, &qm, &qb, table, &tableState, mis, normalization, minLength,
-                              maxLength, pending, pendingT, np, sum);
-                np = 0;
+    /* A query on a line through the eye reads its screen tile's photons and the common list
+     * (ub_screen_tiles.h) in place of the walk, in the same order as the host twin. */
+    int tile = ub_screen_tile_of(tiles, o, d);
+    if (tile >= 0) {
+        uint lists[2] = {(uint)tile, tiles.tilesX * tiles.tilesY};
+        for (int l = 0; l < 2; ++l) {
+            uint end = tileStart[lists[l] + 1u];
+            for (uint b = tileStart[lists[l]]; b < end; ++b) {
+                float t[8];
+                uint near = b + 1u < end
+                                ? ub_pb2d_near8_global(tileKeys + b, o, d, qLength, qMedium, r2, t)
+                                : ub_pb2d_near4_global(tileKeys + b, o, d, qLength, qMedium, r2, t);
+                for (; near != 0u; near &= near - 1u) {
+                    uint lane = 31u - clz(near & (0u - near));
+                    pending[np] = tileItems[b * 4u + lane];
+                    pendingT[np++] = t[lane];
+                    if (np == UB_PB2D_PENDING) {
+                        ub_query_medium_load(&qm, media, grids, gridData, qMedium);
+                        ub_pb2d_flush(photons, &qm, &qb, table, &tableState, mis, normalization,
+                                      minLength, maxLength, pending, pendingT, np, sum);
+                        np = 0;
+                    }
+                }
+                if (b + 1u < end) ++b; /* the pair's second block is done */
             }
         }
-        if ((b + 1u) * 4u < leafEnd) ++b; /* the pair's second block is done */
+    } else {
+        UB_BVH_LEAVES_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qLength))
+        for (uint b = leafFirst / 4u; b * 4u < leafEnd; ++b) {
+            /* two blocks at once where the leaf has both (ub_pb2d_near8_global) */
+            float t[8];
+            uint near;
+            if ((b + 1u) * 4u < leafEnd) {
+                uint m8 = ub_pb2d_near8_global(keys + b, o, d, qLength, qMedium, r2, t);
+                near = (m8 & ub_block_lanes(b, leafFirst, leafEnd)) |
+                       ((m8 >> 4) & ub_block_lanes(b + 1u, leafFirst, leafEnd)) << 4;
+            } else {
+                near = ub_pb2d_near4_global(keys + b, o, d, qLength, qMedium, r2, t) &
+                       ub_block_lanes(b, leafFirst, leafEnd);
+            }
+            for (; near != 0u; near &= near - 1u) {
+                uint lane = 31u - clz(near & (0u - near));
+                pending[np] = b * 4u + lane;
+                pendingT[np++] = t[lane];
+                if (np == UB_PB2D_PENDING) {
+                    ub_query_medium_load(&qm, media, grids, gridData, qMedium);
+                    ub_pb2d_flush(photons, &qm, &qb, table, &tableState, mis, normalization,
+                                  minLength, maxLength, pending, pendingT, np, sum);
+                    np = 0;
+                }
+            }
+            if ((b + 1u) * 4u < leafEnd) ++b; /* the pair's second block is done */
+        }
+        UB_BVH_LEAVES_END
     }
-    UB_BVH_LEAVES_END
     if (np > 0) {
         ub_query_medium_load(&qm, media, grids, gridData, qMedium);
         ub_pb2d_flush(photons, &qm, &qb, table, &tableState, mis, normalization, minLength,

@@ -390,60 +390,62 @@ TEST(OpenClEstimate, Bb1dWideWalkEqualsTheFourLaneOne) {
     EXPECT_GT(sum, 0.0);
 }
 
-// bb1d's query beams on lines through the camera's eye read the parts of their screen tile
-// (kernels/shared/ub_screen_tiles.h) in place of the BVH walk. The tiles must hold every part
-// such a query pairs with, so the host twin finds as many pairs with them as without, and its
-// layer differs only by the order of each query's sum (bound: 1e-5 relative per pixel and
-// channel). The VDB smoke's camera is outside the medium, so these queries start where their
-// camera rays enter it, off the eye. The kernel reads the same tiles in the same order, and
-// BeamKernelsInAGridMediumEqualTheirTwins holds it to this twin.
-TEST(OpenClEstimate, Bb1dScreenTilesFindTheBvhWalksPairs) {
+// bb1d's and pb2d's query beams on lines through the camera's eye read the parts or photons of
+// their screen tile (kernels/shared/ub_screen_tiles.h) in place of the BVH walk. The tiles must
+// hold every part or photon such a query pairs with, so the host twins find as many pairs with
+// them as without, and their layers differ only by the order of each query's sum (bound: 1e-5
+// relative per pixel and channel). The VDB smoke's camera is outside the medium, so these
+// queries start where their camera rays enter it, off the eye. The kernels read the same tiles
+// in the same order, and BeamKernelsInAGridMediumEqualTheirTwins holds them to these twins.
+TEST(OpenClEstimate, ScreenTilesFindTheBvhWalksPairs) {
     auto scene = smoke32();
     ASSERT_TRUE(scene);
     RenderOptions opt = smokeOptions();
-    opt.algorithm = "upbp:bb1d";
+    opt.algorithm = "upbp:pb2d+bb1d";
     VertexCM engine(*scene, opt);
     Image img;
     engine.renderIteration(1, img);
     VolumeEstimateInput vin = smokeRecords(scene.get(), engine);
+    vin.radius[UB_TECH_PB2D] = engine.volumeRadiusAt(UB_TECH_PB2D, 1);
     vin.radius[UB_TECH_BB1D] = engine.volumeRadiusAt(UB_TECH_BB1D, 1);
     vin.mis = ub_mis_enable_volume(ub_mis_make_constants(0.01f, 1024.0f, 1, 1, UB_MIS_POWER), 0.0f,
-                                   0.0f, 0.0f, vin.radius[UB_TECH_BB1D], 256.0f, 1, 0);
-    vin.techniques.bb1d = true;
-    std::array<Image, 2> layers;
-    std::array<size_t, 2> pairs{};
+                                   vin.radius[UB_TECH_PB2D], 0.0f, vin.radius[UB_TECH_BB1D], 256.0f,
+                                   1, 0);
+    vin.techniques.pb2d = vin.techniques.bb1d = true;
+    std::array<std::array<Image, 4>, 2> layers;
+    std::array<VolumeEstimateStats, 2> stats;
     for (int pass = 0; pass < 2; ++pass) {
         setScreenTilesForTests(pass == 0);
         Image image(32, 32);
-        std::array<Image, 4> perTechnique;
-        for (Image& l : perTechnique) l = Image(32, 32);
-        VolumeEstimateStats st;
-        estimateVolume(vin, &image, &perTechnique, &st);
-        layers[size_t(pass)] = perTechnique[UB_TECH_BB1D];
-        pairs[size_t(pass)] = st.pairs[UB_TECH_BB1D];
-        EXPECT_EQ(st.screenTiles.enabled, pass == 0 ? 1u : 0u);
-        if (pass == 0) {
-            size_t onTiles = 0;
-            for (const ub_beam& q : engine.queryBeams())
-                onTiles +=
-                    ub_screen_tile_of(st.screenTiles, ub_f3_from(q.origin), ub_f3_from(q.dir)) >= 0;
-            // The camera rays' pieces in the smoke, a quarter of the query beams or more.
-            EXPECT_GT(onTiles, engine.queryBeams().size() / 4);
-            std::printf("%zu of %zu query beams on screen tiles\n", onTiles,
-                        engine.queryBeams().size());
-        }
+        for (Image& l : layers[size_t(pass)]) l = Image(32, 32);
+        estimateVolume(vin, &image, &layers[size_t(pass)], &stats[size_t(pass)]);
     }
     setScreenTilesForTests(true);
-    EXPECT_GT(pairs[0], 100u);
-    EXPECT_EQ(pairs[0], pairs[1]);
-    double sum = 0;
-    for (size_t i = 0; i < layers[0].pixels.size(); ++i)
-        for (int c = 0; c < 3; ++c) {
-            const float x = layers[1].pixels[i][c], y = layers[0].pixels[i][c];
-            ASSERT_NEAR(y, x, 1e-5f * std::fabs(x) + 1e-12f) << "pixel " << i;
-            sum += x;
-        }
-    EXPECT_GT(sum, 0.0);
+    EXPECT_EQ(stats[0].screenTiles.enabled, 1u);
+    EXPECT_EQ(stats[0].photonScreenTiles.enabled, 1u);
+    EXPECT_EQ(stats[1].screenTiles.enabled, 0u);
+    EXPECT_EQ(stats[1].photonScreenTiles.enabled, 0u);
+    size_t onTiles = 0;
+    for (const ub_beam& q : engine.queryBeams())
+        onTiles +=
+            ub_screen_tile_of(stats[0].screenTiles, ub_f3_from(q.origin), ub_f3_from(q.dir)) >= 0;
+    // The camera rays' pieces in the smoke, a quarter of the query beams or more.
+    EXPECT_GT(onTiles, engine.queryBeams().size() / 4);
+    std::printf("%zu of %zu query beams on screen tiles\n", onTiles, engine.queryBeams().size());
+    for (int t : {UB_TECH_PB2D, UB_TECH_BB1D}) {
+        EXPECT_GT(stats[0].pairs[t], 100u) << "technique " << t;
+        EXPECT_EQ(stats[0].pairs[t], stats[1].pairs[t]) << "technique " << t;
+        double sum = 0;
+        const Image &a = layers[1][size_t(t)], &b = layers[0][size_t(t)];
+        for (size_t i = 0; i < a.pixels.size(); ++i)
+            for (int c = 0; c < 3; ++c) {
+                const float x = a.pixels[i][c], y = b.pixels[i][c];
+                ASSERT_NEAR(y, x, 1e-5f * std::fabs(x) + 1e-12f)
+                    << "technique " << t << " pixel " << i;
+                sum += x;
+            }
+        EXPECT_GT(sum, 0.0) << "technique " << t;
+    }
 }
 
 TEST(OpenClEstimate, ProgramCacheHitAndCorruptEntry) {

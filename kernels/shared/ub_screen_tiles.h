@@ -1,10 +1,11 @@
-/* Screen tiles for bb1d's camera rays.
+/* Screen tiles for the camera rays of bb1d (photon-beam parts) and pb2d (photon points).
  *
  * A query beam whose line passes through a pinhole camera's eye (the camera subpath's first
- * segment, at any part of it) meets a photon-beam part only if its direction, projected to
- * the image as the camera projects a point, falls where the part's box projects. The host
- * bins the parts by the image tiles their boxes cover (src/estimators/screen_tiles.cpp), and
- * such a query reads its tile's parts instead of walking the BVH: on the bunny and
+ * segment, at any part of it) meets a photon-beam part (a photon point) only if its direction,
+ * projected to the image as the camera projects a point, falls where the part's box (the
+ * photon's cube) projects. The host bins the parts and the photons by the image tiles their
+ * boxes cover (src/estimators/screen_tiles.cpp), and such a query reads its tile's list
+ * instead of walking the BVH: on the bunny and
  * mirrorballs these queries were a fifth to a quarter of the query beams and 40% of the nodes
  * bb1d's walk visited (docs/performance.md, session 39).
  *
@@ -17,7 +18,8 @@
  *    eye + s d (s >= -tolerance) of the exact line through the eye;
  *  - a pair needs X within r of the part's segment, so X0 lies within r + tolerance of it, in
  *    the part's box: the segment grown by r + 2 tolerance along itself and along two axes
- *    across it (an oriented box; the second tolerance is for rounding);
+ *    across it (an oriented box; the second tolerance is for rounding); for pb2d, X within r
+ *    of the photon, and the box is the cube of half-width r + 2 tolerance around it;
  *  - if every corner of the box is in front of the eye (depth > tolerance), X0 is too, so
  *    s > 0 and X0 projects where d does; the box is convex and projection keeps segments
  *    straight in front of the eye, so X0 projects into the convex hull of the corners'
@@ -27,10 +29,11 @@
  *  - a box with every corner behind the eye by more than tolerance holds no such X0 and is
  *    left out; any other part (a box across the eye's plane, or covering more tiles than the
  *    host allows) goes into the list every tile reads, number tilesX * tilesY.
- * Each tile's list is a run of ub_beam_keys4 blocks (kernels/shared/ub_bvh.h) with the
- * parts' indices beside them; unused lanes have empty ranges (t0 = t1 = +infinity), which
- * the line filter rejects. Parts are listed in ascending index, so the host twin and the
- * kernel find the same candidates in the same order.
+ * Each tile's list is a run of blocks of four, as the BVH leaves hold them (ub_beam_keys4,
+ * kernels/shared/ub_bvh.h; ub_photon_keys4, ub_upbp_records.h), with the items' indices
+ * beside them; unused lanes have empty ranges (t0 = t1 = +infinity) or no medium, which the
+ * filters reject. Items are listed in ascending index, so the host twin and the kernel find
+ * the same candidates in the same order.
  */
 #ifndef UB_SCREEN_TILES_H
 #define UB_SCREEN_TILES_H

@@ -669,14 +669,18 @@ void ClRuntime::estimatePP3D(const std::vector<ub_photon_point>& photons, const 
 
 void ClRuntime::estimatePB2D(const std::vector<ub_photon_point>& photons,
                              const std::vector<ub_photon_keys4>& keys, const Bvh& spheres,
-                             const std::vector<ub_beam>& queries, const EstimateArgs& a,
-                             std::vector<Rgb>* out) {
+                             const ScreenTiles& tiles, const std::vector<ub_beam>& queries,
+                             const EstimateArgs& a, std::vector<Rgb>* out) {
     if (photons.empty() || spheres.empty()) return out->assign(queries.size(), Rgb(0.0f));
     requireLeafOrder(spheres, "pb2d");
-    runEstimate(
-        pb2d_, "clEnqueueNDRangeKernel(ub_pb2d_estimate)",
-        withGrids({bufferArg(photons), bufferArg(keys), bufferArg(spheres.nodes())}, gridArgs(a)),
-        bufferArg(queries), queries.size(), a, out);
+    if (tiles.start.empty() || tiles.photonKeys.empty() || tiles.items.empty())
+        throw std::logic_error("pb2d kernel given screen tiles that were not built");
+    runEstimate(pb2d_, "clEnqueueNDRangeKernel(ub_pb2d_estimate)",
+                withGrids({bufferArg(photons), bufferArg(keys), bufferArg(spheres.nodes()),
+                           bufferArg(tiles.start), bufferArg(tiles.photonKeys),
+                           bufferArg(tiles.items), scalarArg(tiles.params)},
+                          gridArgs(a)),
+                bufferArg(queries), queries.size(), a, out);
 }
 
 void ClRuntime::estimateBP2D(const std::vector<ub_beam>& beams,
@@ -703,12 +707,12 @@ void ClRuntime::estimateBB1D(const std::vector<ub_beam>& beams,
                              const EstimateArgs& a, std::vector<Rgb>* out) {
     if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
     requireLeafOrder(bvh, "bb1d");
-    if (tiles.start.empty() || tiles.lines.empty() || tiles.parts.empty())
+    if (tiles.start.empty() || tiles.lines.empty() || tiles.items.empty())
         throw std::logic_error("bb1d kernel given screen tiles that were not built");
     runEstimate(bb1d_, "clEnqueueNDRangeKernel(ub_bb1d_estimate)",
                 withGrids({bufferArg(beams), bufferArg(parts), bufferArg(lines), bufferArg(pieces),
                            bufferArg(ranges), bufferArg(bvh.nodes()), bufferArg(tiles.start),
-                           bufferArg(tiles.lines), bufferArg(tiles.parts), scalarArg(tiles.params)},
+                           bufferArg(tiles.lines), bufferArg(tiles.items), scalarArg(tiles.params)},
                           gridArgs(a)),
                 bufferArg(queries), queries.size(), a, out);
 }

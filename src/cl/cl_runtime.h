@@ -101,8 +101,8 @@ class ClRuntime {
     /// keys[i] = ub_photon_key_of(photons[i]) (kernels/shared/ub_pb2d.h).
     void estimatePB2D(const std::vector<ub_photon_point>& photons,
                       const std::vector<ub_photon_keys4>& keys, const Bvh& spheres,
-                      const std::vector<ub_beam>& queries, const EstimateArgs& a,
-                      std::vector<Rgb>* out);
+                      const ScreenTiles& tiles, const std::vector<ub_beam>& queries,
+                      const EstimateArgs& a, std::vector<Rgb>* out);
     /// bp2d and bb1d: pieces and ranges are the photon beams' medium tables
     /// (estimators/beam_medium.h flattenBeamTables; 2 ranges per beam, all 0 in homogeneous
     /// media).

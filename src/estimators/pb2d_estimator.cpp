@@ -5,11 +5,14 @@
 // photon points within r_pb2d of the beam (UPBP Table 1, "P-B2D"; per-pair value,
 // MIS weight and normalisation 1 / (N_L pi r^2) in kernels/shared/ub_pb2d.h).
 // Lookup: BVH over the photon points as boxes of their kernel sphere, traversed by
-// the beam's segment (estimators/bvh.h). The medium along the query beam up to the
-// photon's projection is evaluated exactly (regular tracking).
+// the beam's segment (estimators/bvh.h); query beams on lines through a pinhole camera's eye
+// read the photons their screen tile lists instead (estimators/screen_tiles.h; the same
+// pairs). The medium along the query beam up to the photon's projection is evaluated exactly
+// (regular tracking).
 
 #include "estimators/beam_medium.h"
 #include "estimators/bvh.h"
+#include "estimators/screen_tiles.h"
 #include "estimators/volume_estimate.h"
 #include "kernels/shared/ub_pb2d.h"
 #include "scene/scene.h"
@@ -59,7 +62,8 @@ uint32_t pb2dNear4ForTests(const ub_photon_keys4& k, const ub_float3& o, const u
 
 void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres,
                   const std::vector<ub_photon_point>& photons,
-                  const std::vector<ub_photon_keys4>& keys, std::vector<Rgb>* out, size_t* pairs) {
+                  const std::vector<ub_photon_keys4>& keys, const ScreenTiles& tiles,
+                  std::vector<Rgb>* out, size_t* pairs) {
     const std::vector<ub_beam>& queries = *in.queryBeams;
     if (photons.empty() || queries.empty()) return;
     const float r = in.radius[UB_TECH_PB2D];
@@ -94,6 +98,26 @@ void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres,
             }
             np = 0;
         };
+        // A query on a line through the eye reads its screen tile's photons and the common
+        // list (kernels/shared/ub_screen_tiles.h) instead of walking the BVH.
+        const int tile = ub_screen_tile_of(tiles.params, o, d);
+        if (tile >= 0) {
+            const uint32_t common = tiles.params.tilesX * tiles.params.tilesY;
+            for (uint32_t list : {uint32_t(tile), common})
+                for (uint32_t b = tiles.start[list]; b < tiles.start[list + 1]; ++b) {
+                    float t[4];
+                    uint32_t near =
+                        pb2dNear4(tiles.photonKeys[b], o, d, qb.length, qb.mediumId, r * r, t);
+                    for (; near != 0; near &= near - 1) {
+                        const int lane = __builtin_ctz(near);
+                        pending[np] = tiles.items[b * 4 + uint32_t(lane)];
+                        pendingT[np++] = t[lane];
+                        if (np == kPending) flush();
+                    }
+                }
+            flush();
+            return sum;
+        }
         photonSpheres.querySegmentLeaves(
             Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length, [&](uint32_t first, uint32_t end) {
                 for (uint32_t b = first / 4; b * 4 < end; ++b) {

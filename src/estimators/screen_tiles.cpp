@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 
+#include "core/vec.h"
 #include "scene/camera.h"
 
 namespace ub {
@@ -88,25 +89,21 @@ bool screenTilesAllowed() {
     return tilesAllowed;
 }
 
-void buildScreenTiles(const Camera& camera, float sceneRadius,
-                      const std::vector<ub_beam_part>& parts, float r,
-                      const std::function<void(size_t)>& reserve, ScreenTiles* out) {
+namespace {
+/// The lists of n items whose boxes' corners corners(i, grow, out) gives (a box holding every
+/// point within grow of item i); out gets params, start and items (kNoItem in unused lanes).
+void buildLists(const Camera& camera, float sceneRadius, size_t n, float r,
+                const std::function<void(size_t, float, Vec3*)>& corners,
+                const std::function<void(size_t)>& reserve, ScreenTiles* out) {
     *out = ScreenTiles();
-    out->start.assign(2, 0u);
-    auto padBlock = [&] {
-        ub_beam_keys4 k{};
-        for (int j = 0; j < 4; ++j) k.t0[j] = k.t1[j] = INFINITY;  // rejected by the filter
-        return k;
-    };
     auto finishEmpty = [&] {
         out->params.enabled = 0;
         out->start.assign(2, 0u);
-        out->lines.assign(1, padBlock());
-        out->parts.assign(4, 0u);
+        out->items.assign(4, ScreenTiles::kNoItem);
     };
     const int width = camera.width(), height = camera.height();
-    if (!tilesAllowed || !camera.isPinhole() || parts.empty() || width <= 0 || height <= 0 ||
-        parts.size() >= (size_t(1) << 31))
+    if (!tilesAllowed || !camera.isPinhole() || n == 0 || width <= 0 || height <= 0 ||
+        n >= (size_t(1) << 31))
         return finishEmpty();
     // About 1024 tiles (8 x 8 pixels at 256 x 256). Measured on the bunny and mirrorballs
     // (bb1d, lookups plus estimates, docs/performance.md, session 39): 4096 and 16384 tiles
@@ -137,22 +134,17 @@ void buildScreenTiles(const Camera& camera, float sceneRadius,
     const size_t maxRect = std::max<size_t>(1, tileCount / 4);
     const float grow = r + 2.0f * s.tolerance, margin = 1.0f / 64.0f;
 
-    // The box of a part: its segment grown along itself and across it (the frame's two other
-    // axes) by r plus twice the tolerance, which holds every point within that distance of the
-    // segment (an oriented box, much tighter than the axis-aligned one for a slanted part).
-    std::vector<Placement> place(parts.size());
-    tbb::parallel_for(size_t(0), parts.size(), [&](size_t i) {
-        const ub_beam_part& p = parts[i];
-        const Vec3 o(p.origin[0], p.origin[1], p.origin[2]), d(p.dir[0], p.dir[1], p.dir[2]);
-        const Frame f(d);
-        const Vec3 ends[2] = {o + d * (p.t0 - grow), o + d * (p.t1 + grow)};
+    // Each item's box (corners) grown by r plus twice the tolerance holds every point within
+    // r + tolerance of it.
+    std::vector<Placement> place(n);
+    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+        Vec3 box[8];
+        corners(i, grow, box);
         Placement& pl = place[i];
         int front = 0, behind = 0;
         float ylo = INFINITY, yhi = -INFINITY, xlo = INFINITY, xhi = -INFINITY;
         for (int c = 0; c < 8; ++c) {
-            const Vec3 corner =
-                ends[c & 1] + f.s * ((c & 2) ? grow : -grow) + f.t * ((c & 4) ? grow : -grow);
-            const Vec3 v = corner - eye;
+            const Vec3 v = box[c] - eye;
             const float depth = dot(v, axes[2]);
             if (depth > s.tolerance) {
                 ++front;
@@ -173,8 +165,9 @@ void buildScreenTiles(const Camera& camera, float sceneRadius,
         if (xhi + margin < 0.0f || yhi + margin < 0.0f || xlo - margin >= s.width ||
             ylo - margin >= s.height)
             return;  // off the image: no query reads it
-        auto tileOf = [&](float v, uint32_t n) {
-            return uint32_t(std::min<float>(float(n - 1), std::max(0.0f, std::floor(v / tile))));
+        auto tileOf = [&](float v, uint32_t count) {
+            return uint32_t(
+                std::min<float>(float(count - 1), std::max(0.0f, std::floor(v / tile))));
         };
         pl.y0 = tileOf(ylo - margin, s.tilesY), pl.y1 = tileOf(yhi + margin, s.tilesY);
         pl.x0 = tileOf(xlo - margin, s.tilesX), pl.x1 = tileOf(xhi + margin, s.tilesX);
@@ -198,11 +191,11 @@ void buildScreenTiles(const Camera& camera, float sceneRadius,
     for (const Placement& pl : place)
         if (pl.kind == Placement::kTiles)
             for (uint32_t y = pl.y0; y <= pl.y1; ++y) ++rowStart[y + 1];
-    for (uint32_t i = 0; i < uint32_t(parts.size()); ++i)
+    for (uint32_t i = 0; i < uint32_t(n); ++i)
         if (place[i].kind == Placement::kEverywhere) common.push_back(i);
     for (size_t y = 0; y < s.tilesY; ++y) rowStart[y + 1] += rowStart[y];
     std::vector<uint32_t> rowParts(rowStart.back()), rowNext(rowStart.begin(), rowStart.end() - 1);
-    for (uint32_t i = 0; i < uint32_t(parts.size()); ++i) {
+    for (uint32_t i = 0; i < uint32_t(n); ++i) {
         const Placement& pl = place[i];
         if (pl.kind == Placement::kTiles)
             for (uint32_t y = pl.y0; y <= pl.y1; ++y) rowParts[rowNext[y]++] = i;
@@ -219,19 +212,15 @@ void buildScreenTiles(const Camera& camera, float sceneRadius,
     });
     size_t entries = 0;
     for (uint32_t c : count) entries += c;
-    if (entries > 16 * parts.size() + 4096) return finishEmpty();  // the BVH walk's memory
+    if (entries > 16 * n + 4096) return finishEmpty();  // the BVH walk's memory
     out->start.assign(tileCount + 2, 0u);
     for (size_t k = 0; k <= tileCount; ++k) out->start[k + 1] = out->start[k] + (count[k] + 3) / 4;
     const size_t blocks = std::max<size_t>(1, out->start[tileCount + 1]);
     reserve(out->start.size() * 4 + blocks * (sizeof(ub_beam_keys4) + 16));
-    out->lines.assign(blocks, padBlock());
-    out->parts.assign(blocks * 4, 0u);
-    // Fill in ascending part index (the kernel and the host twin read the same order); a row's
+    out->items.assign(blocks * 4, ScreenTiles::kNoItem);
+    // Fill in ascending item index (the kernel and the host twin read the same order); a row's
     // tiles are its own, so rows fill in parallel.
-    auto put = [&](uint32_t lane, uint32_t i) {
-        ub_beam_keys4_set(&out->lines[lane / 4], int(lane % 4), parts[i]);
-        out->parts[lane] = i;
-    };
+    auto put = [&](uint32_t lane, uint32_t i) { out->items[lane] = i; };
     tbb::parallel_for(uint32_t(0), s.tilesY, [&](uint32_t y) {
         std::vector<uint32_t> next(s.tilesX);
         for (uint32_t x = 0; x < s.tilesX; ++x) next[x] = out->start[y * s.tilesX + x] * 4;
@@ -245,6 +234,70 @@ void buildScreenTiles(const Camera& camera, float sceneRadius,
     for (size_t k = 0; k < common.size(); ++k)
         put(uint32_t(out->start[tileCount] * 4 + k), common[k]);
     s.enabled = 1;
+}
+}  // namespace
+
+void buildScreenTiles(const Camera& camera, float sceneRadius,
+                      const std::vector<ub_beam_part>& parts, float r,
+                      const std::function<void(size_t)>& reserve, ScreenTiles* out) {
+    // Each part's oriented box: its segment grown by `grow` along itself and along the two
+    // other axes of a frame around it.
+    buildLists(
+        camera, sceneRadius, parts.size(), r,
+        [&](size_t i, float grow, Vec3* box) {
+            const ub_beam_part& p = parts[i];
+            const Vec3 o(p.origin[0], p.origin[1], p.origin[2]), d(p.dir[0], p.dir[1], p.dir[2]);
+            const Frame f(d);
+            const Vec3 ends[2] = {o + d * (p.t0 - grow), o + d * (p.t1 + grow)};
+            for (int c = 0; c < 8; ++c)
+                box[c] =
+                    ends[c & 1] + f.s * ((c & 2) ? grow : -grow) + f.t * ((c & 4) ? grow : -grow);
+        },
+        reserve, out);
+    // The lanes' lines; unused lanes get empty ranges (t0 = t1 = +infinity), which the line
+    // filter rejects.
+    out->lines.resize(out->items.size() / 4);
+    tbb::parallel_for(size_t(0), out->lines.size(), [&](size_t b) {
+        ub_beam_keys4& k = out->lines[b];
+        for (int j = 0; j < 4; ++j) {
+            const uint32_t i = out->items[4 * b + size_t(j)];
+            if (i != ScreenTiles::kNoItem) {
+                ub_beam_keys4_set(&k, j, parts[i]);
+            } else {
+                k.ox[j] = k.oy[j] = k.oz[j] = k.dx[j] = k.dy[j] = k.dz[j] = 0.0f;
+                k.t0[j] = k.t1[j] = INFINITY;
+            }
+        }
+    });
+}
+
+void buildPhotonScreenTiles(const Camera& camera, float sceneRadius,
+                            const std::vector<ub_photon_point>& photons, float r,
+                            const std::function<void(size_t)>& reserve, ScreenTiles* out) {
+    // Each photon's cube of half-width `grow`.
+    buildLists(
+        camera, sceneRadius, photons.size(), r,
+        [&](size_t i, float grow, Vec3* box) {
+            const Vec3 p(photons[i].pos[0], photons[i].pos[1], photons[i].pos[2]);
+            for (int c = 0; c < 8; ++c)
+                box[c] = p + Vec3((c & 1) ? grow : -grow, (c & 2) ? grow : -grow,
+                                  (c & 4) ? grow : -grow);
+        },
+        reserve, out);
+    // The lanes' keys; unused lanes are in no medium, which the filter rejects.
+    out->photonKeys.resize(out->items.size() / 4);
+    tbb::parallel_for(size_t(0), out->photonKeys.size(), [&](size_t b) {
+        ub_photon_keys4& k = out->photonKeys[b];
+        for (int j = 0; j < 4; ++j) {
+            const uint32_t i = out->items[4 * b + size_t(j)];
+            if (i != ScreenTiles::kNoItem) {
+                ub_photon_keys4_set(&k, j, photons[i]);
+            } else {
+                k.px[j] = k.py[j] = k.pz[j] = 0.0f;
+                k.mediumId[j] = UB_NO_MEDIUM;
+            }
+        }
+    });
 }
 
 }  // namespace ub

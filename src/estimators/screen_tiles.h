@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "kernels/shared/ub_bvh.h"
+#include "kernels/shared/ub_pb2d.h"
 #include "kernels/shared/ub_screen_tiles.h"
 
 namespace ub {
@@ -21,10 +22,13 @@ struct ScreenTiles {
     /// Block ranges of the lists: list k is blocks start[k] .. start[k + 1] - 1; lists 0 ..
     /// tilesX * tilesY - 1 are the tiles', list tilesX * tilesY the one every tile reads.
     std::vector<uint32_t> start;
-    std::vector<ub_beam_keys4> lines;  ///< the parts' lines, as the BVH's leaves have them
-    std::vector<uint32_t> parts;       ///< the part index of each lane (4 a block)
+    static constexpr uint32_t kNoItem = 0xffffffffu;
+    std::vector<uint32_t> items;       ///< the item (part, photon) index of each lane, 4 a block
+    std::vector<ub_beam_keys4> lines;  ///< bb1d: the parts' lines, as the BVH's leaves have them
+    std::vector<ub_photon_keys4> photonKeys;  ///< pb2d: the photons' keys, as the BVH's leaves
     size_t bytes() const {
-        return start.size() * 4 + lines.size() * sizeof(ub_beam_keys4) + parts.size() * 4;
+        return start.size() * 4 + items.size() * 4 + lines.size() * sizeof(ub_beam_keys4) +
+               photonKeys.size() * sizeof(ub_photon_keys4);
     }
 };
 
@@ -39,8 +43,14 @@ void buildScreenTiles(const Camera& camera, float sceneRadius,
                       const std::vector<ub_beam_part>& parts, float r,
                       const std::function<void(size_t)>& reserve, ScreenTiles* out);
 
-/// Lets the bb1d estimate use screen tiles (the default) or not: the two find the same pairs,
-/// which a test checks.
+/// The same for pb2d's photon points (their index is their position), each binned by its cube
+/// of half-width r (a photon within r of a camera ray lies in it).
+void buildPhotonScreenTiles(const Camera& camera, float sceneRadius,
+                            const std::vector<ub_photon_point>& photons, float r,
+                            const std::function<void(size_t)>& reserve, ScreenTiles* out);
+
+/// Lets the bb1d and pb2d estimates use screen tiles (the default) or not: the two find the same
+/// pairs, which a test checks.
 void setScreenTilesForTests(bool allowed);
 bool screenTilesAllowed();
 

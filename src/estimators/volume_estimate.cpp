@@ -73,6 +73,7 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     Bvh spheres;
     std::vector<ub_photon_point> sphereOrder;
     std::vector<ub_photon_keys4> sphereKeys;
+    ScreenTiles photonTiles;
     if (t.pb2d) {
         // Boxes, nodes (at most 2 n / leaf size + 1) and the primitive list.
         reserve(photons.size() * (sizeof(Bounds3) + sizeof(Vec3) + 4 + Bvh::kNodeBytesPerBox),
@@ -100,6 +101,11 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
             for (int j = 0; j < 4; ++j) k.mediumId[j] = UB_NO_MEDIUM;
         for (size_t i = 0; i < sphereOrder.size(); ++i)
             ub_photon_keys4_set(&sphereKeys[i / 4], int(i % 4), sphereOrder[i]);
+        // The photons by screen tile, for the query beams through the camera's eye.
+        buildPhotonScreenTiles(
+            in.scene->camera, in.scene->sceneSphere.radius, sphereOrder, r,
+            [&](size_t bytes) { reserve(bytes, "pb2d lookup (screen tiles)"); }, &photonTiles);
+        st.photonScreenTiles = photonTiles.params;
     }
     Bvh beamBvh;
     std::vector<BeamPart> parts;
@@ -186,7 +192,7 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     st.lookupBytes += spheres.bytes() + sphereOrder.size() * sizeof(ub_photon_point) +
                       sphereKeys.size() * sizeof(ub_photon_keys4) + beamBvh.bytes() +
                       parts.size() * sizeof(BeamPart) + partLines.size() * sizeof(ub_beam_keys4) +
-                      tiles.bytes();
+                      tiles.bytes() + photonTiles.bytes();
 
     t0 = std::chrono::steady_clock::now();
     std::vector<Rgb> perPoint[4], perBeam[4];
@@ -235,12 +241,12 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         perBeam[UB_TECH_PB2D].assign(nBeams, Rgb(0.0f));
         const float r = in.radius[UB_TECH_PB2D];
         if (beamCl) {
-            beamCl->estimatePB2D(sphereOrder, sphereKeys, spheres, *in.queryBeams,
+            beamCl->estimatePB2D(sphereOrder, sphereKeys, spheres, photonTiles, *in.queryBeams,
                                  clArgs(UB_TECH_PB2D, ub_pb2d_normalization(in.lightPathCount, r)),
                                  &perBeam[UB_TECH_PB2D]);
             st.pairs[UB_TECH_PB2D] = VolumeEstimateStats::kNotCounted;
         } else {
-            estimatePB2D(in, spheres, sphereOrder, sphereKeys, &perBeam[UB_TECH_PB2D],
+            estimatePB2D(in, spheres, sphereOrder, sphereKeys, photonTiles, &perBeam[UB_TECH_PB2D],
                          &st.pairs[UB_TECH_PB2D]);
         }
     }

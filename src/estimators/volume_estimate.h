@@ -78,8 +78,8 @@ struct VolumeEstimateStats {
     size_t lookupBytes = 0;
     /// Query estimates dropped by the guard (NaN, infinite or negative), per technique.
     uint64_t rejected[4] = {0, 0, 0, 0};
-    /// The screen tiles bb1d read (enabled == 0: none; estimators/screen_tiles.h).
-    ub_screen_tiles screenTiles{};
+    /// The screen tiles bb1d and pb2d read (enabled == 0: none; estimators/screen_tiles.h).
+    ub_screen_tiles screenTiles{}, photonScreenTiles{};
 };
 
 /// The media as the kernels see them (one ub_medium_info per medium, at least one entry), and
@@ -134,7 +134,8 @@ void estimatePP3D(const VolumeEstimateInput& in, const HashGrid& grid, std::vect
 /// keys: the photons' keys four to a block (ub_photon_keys4), in the same order.
 void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres,
                   const std::vector<ub_photon_point>& photons,
-                  const std::vector<ub_photon_keys4>& keys, std::vector<Rgb>* out, size_t* pairs);
+                  const std::vector<ub_photon_keys4>& keys, const ScreenTiles& tiles,
+                  std::vector<Rgb>* out, size_t* pairs);
 /// The host's SSE form of ub_pb2d_near4 (kernels/shared/ub_pb2d.h), for tests.
 uint32_t pb2dNear4ForTests(const ub_photon_keys4& k, const ub_float3& o, const ub_float3& d,
                            float length, uint32_t mediumId, float radiusSqr, float* t);
