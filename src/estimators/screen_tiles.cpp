@@ -20,7 +20,7 @@ std::atomic<bool> tilesAllowed{true};
 /// every tile reads, or nowhere.
 struct Placement {
     enum Kind : uint8_t { kTiles, kEverywhere, kNone } kind = kNone;
-    uint32_t y0 = 0, y1 = 0, x0 = 0, x1 = 0;
+    uint32_t y0 = 0, y1 = 0;
     uint8_t n = 8;     ///< corners, then (makeHull) the hull's vertices
     float x[8], y[8];  ///< raster positions of the box's corners
 };
@@ -170,7 +170,6 @@ void buildLists(const Camera& camera, float sceneRadius, size_t n, float r,
                 std::min<float>(float(count - 1), std::max(0.0f, std::floor(v / tile))));
         };
         pl.y0 = tileOf(ylo - margin, s.tilesY), pl.y1 = tileOf(yhi + margin, s.tilesY);
-        pl.x0 = tileOf(xlo - margin, s.tilesX), pl.x1 = tileOf(xhi + margin, s.tilesX);
         const size_t rect =
             size_t(tileOf(xhi + margin, s.tilesX) - tileOf(xlo - margin, s.tilesX) + 1) *
             size_t(pl.y1 - pl.y0 + 1);
@@ -235,6 +234,16 @@ void buildLists(const Camera& camera, float sceneRadius, size_t n, float r,
         put(uint32_t(out->start[tileCount] * 4 + k), common[k]);
     s.enabled = 1;
 }
+
+/// The blocks of keys beside out->items: set(&block, lane, item) for each lane, item kNoItem
+/// for an unused one.
+template <class Keys, class Set>
+void fillBlocks(const ScreenTiles& tiles, std::vector<Keys>* blocks, Set set) {
+    blocks->resize(tiles.items.size() / 4);
+    tbb::parallel_for(size_t(0), blocks->size(), [&](size_t b) {
+        for (int j = 0; j < 4; ++j) set(&(*blocks)[b], j, tiles.items[4 * b + size_t(j)]);
+    });
+}
 }  // namespace
 
 void buildScreenTiles(const Camera& camera, float sceneRadius,
@@ -256,18 +265,10 @@ void buildScreenTiles(const Camera& camera, float sceneRadius,
         reserve, out);
     // The lanes' lines; unused lanes get empty ranges (t0 = t1 = +infinity), which the line
     // filter rejects.
-    out->lines.resize(out->items.size() / 4);
-    tbb::parallel_for(size_t(0), out->lines.size(), [&](size_t b) {
-        ub_beam_keys4& k = out->lines[b];
-        for (int j = 0; j < 4; ++j) {
-            const uint32_t i = out->items[4 * b + size_t(j)];
-            if (i != ScreenTiles::kNoItem) {
-                ub_beam_keys4_set(&k, j, parts[i]);
-            } else {
-                k.ox[j] = k.oy[j] = k.oz[j] = k.dx[j] = k.dy[j] = k.dz[j] = 0.0f;
-                k.t0[j] = k.t1[j] = INFINITY;
-            }
-        }
+    fillBlocks(*out, &out->lines, [&](ub_beam_keys4* k, int j, uint32_t i) {
+        if (i != ScreenTiles::kNoItem) return ub_beam_keys4_set(k, j, parts[i]);
+        k->ox[j] = k->oy[j] = k->oz[j] = k->dx[j] = k->dy[j] = k->dz[j] = 0.0f;
+        k->t0[j] = k->t1[j] = INFINITY;
     });
 }
 
@@ -285,18 +286,10 @@ void buildPhotonScreenTiles(const Camera& camera, float sceneRadius,
         },
         reserve, out);
     // The lanes' keys; unused lanes are in no medium, which the filter rejects.
-    out->photonKeys.resize(out->items.size() / 4);
-    tbb::parallel_for(size_t(0), out->photonKeys.size(), [&](size_t b) {
-        ub_photon_keys4& k = out->photonKeys[b];
-        for (int j = 0; j < 4; ++j) {
-            const uint32_t i = out->items[4 * b + size_t(j)];
-            if (i != ScreenTiles::kNoItem) {
-                ub_photon_keys4_set(&k, j, photons[i]);
-            } else {
-                k.px[j] = k.py[j] = k.pz[j] = 0.0f;
-                k.mediumId[j] = UB_NO_MEDIUM;
-            }
-        }
+    fillBlocks(*out, &out->photonKeys, [&](ub_photon_keys4* k, int j, uint32_t i) {
+        if (i != ScreenTiles::kNoItem) return ub_photon_keys4_set(k, j, photons[i]);
+        k->px[j] = k->py[j] = k->pz[j] = 0.0f;
+        k->mediumId[j] = UB_NO_MEDIUM;
     });
 }
 

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "kernels/shared/ub_bvh.h"
-#include "kernels/shared/ub_pb2d.h"
 #include "kernels/shared/ub_screen_tiles.h"
+#include "kernels/shared/ub_upbp_records.h"
 
 namespace ub {
 
