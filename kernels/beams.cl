@@ -38,24 +38,25 @@
  * src/estimators/pb2d_estimator.cpp. */
 #define UB_PB2D_PENDING 32
 
-/* The walk of kernels/shared/ub_bvh.h, in the host twin's order (src/estimators/bvh.h): pop
- * a node; MASK (an expression of `n`, the node in global memory) gives the children that pass;
- * the statements between UB_BVH_LEAVES_BEGIN and UB_BVH_LEAVES_END run for those that are
- * leaves, child 0 first, with the leaf's entries leafFirst .. leafEnd - 1 (the items are in the
- * BVH's leaf order, Bvh::permuteToLeafOrder, so a leaf's entries are items, read without an
- * index array), and those between UB_BVH_WALK_BEGIN and UB_BVH_WALK_END for each entry `k` of
- * them (`continue` skips a primitive); then the walk pushes those that are inner nodes,
- * child 3 first. The children come from bit masks, leaves lowest bit first and pushes highest
- * bit first, rather than from a loop over the four with two branches each: 10% off the pb2d
- * walk on cornell-fog, host and kernel alike (docs/performance.md). A begin/end pair rather than
- * one macro taking the block: a block with commas needs a variadic macro, which OpenCL C 1.2 does
- * not have (NVIDIA's compiler rejects it: "variadic macros not supported in OpenCL", seen on an
- * H200, docs/opencl.md). */
-#define UB_BVH_LEAVES_BEGIN(nodes, MASK)                                     \
+/* The walk of kernels/shared/ub_bvh.h, in the host twin's order (src/estimators/bvh.h), from
+ * ROOT (the query's medium's tree, Bvh::build's groups; none when UB_BVH_NONE): pop a node; MASK
+ * (an expression of `n`, the node in global memory) gives the children that pass; the statements
+ * between UB_BVH_LEAVES_BEGIN and UB_BVH_LEAVES_END run for those that are leaves, child 0 first,
+ * with the leaf's entries leafFirst .. leafEnd - 1 (the items are in the BVH's leaf order,
+ * Bvh::permuteToLeafOrder, so a leaf's entries are items, read without an index array), and those
+ * between UB_BVH_WALK_BEGIN and UB_BVH_WALK_END for each entry `k` of them (`continue` skips a
+ * primitive); then the walk pushes those that are inner nodes, child 3 first. The children come
+ * from bit masks, leaves lowest bit first and pushes highest bit first, rather than from a loop
+ * over the four with two branches each: 10% off the pb2d walk on cornell-fog, host and kernel alike
+ * (docs/performance.md). A begin/end pair rather than one macro taking the block: a block with
+ * commas needs a variadic macro, which OpenCL C 1.2 does not have (NVIDIA's compiler rejects it:
+ * "variadic macros not supported in OpenCL", seen on an H200, docs/opencl.md). */
+#define UB_BVH_LEAVES_BEGIN(nodes, ROOT, MASK)                               \
     {                                                                        \
         uint ubStack[UB_BVH_STACK];                                          \
         int ubTop = 0;                                                       \
-        ubStack[ubTop++] = 0u;                                               \
+        uint ubRoot = (ROOT);                                                \
+        if (ubRoot != UB_BVH_NONE) ubStack[ubTop++] = ubRoot;                \
         while (ubTop > 0) {                                                  \
             __global const ub_bvh_node* n = nodes + ubStack[--ubTop];        \
             uint ubMask = (MASK);                                            \
@@ -77,8 +78,8 @@
     }                                     \
     }
 /* The walk item by item (`k`) within UB_BVH_LEAVES_BEGIN/END's leaves. */
-#define UB_BVH_WALK_BEGIN(nodes, MASK) \
-    UB_BVH_LEAVES_BEGIN(nodes, MASK)   \
+#define UB_BVH_WALK_BEGIN(nodes, ROOT, MASK) \
+    UB_BVH_LEAVES_BEGIN(nodes, ROOT, MASK)   \
     for (uint k = leafFirst; k < leafEnd; ++k) {
 #define UB_BVH_WALK_END \
     }                   \
@@ -132,16 +133,14 @@ static void ub_pb2d_flush(__global const ub_photon_point* photons, ub_query_medi
 }
 
 /* pb2d: query beams x photon points (BVH over the photons' kernel spheres). */
-__kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
-                               __global const ub_photon_keys4* keys,
-                               __global const ub_bvh_node* nodes, __global const uint* tileStart,
-                               __global const ub_photon_keys4* tileKeys,
-                               __global const uint* tileItems, ub_screen_tiles tiles,
-                               __global const ub_grid_info* grids, __global const uchar* gridData,
-                               __global const ub_beam* queries, uint queryCount,
-                               __global const ub_medium_info* media, ub_mis_constants mis,
-                               float radius, float normalization, uint minLength, uint maxLength,
-                               __global float* out) {
+__kernel void ub_pb2d_estimate(
+    __global const ub_photon_point* photons, __global const ub_photon_keys4* keys,
+    __global const ub_bvh_node* nodes, __global const uint* roots, __global const uint* tileStart,
+    __global const ub_photon_keys4* tileKeys, __global const uint* tileItems, ub_screen_tiles tiles,
+    __global const ub_grid_info* grids, __global const uchar* gridData,
+    __global const ub_beam* queries, uint queryCount, __global const ub_medium_info* media,
+    ub_mis_constants mis, float radius, float normalization, uint minLength, uint maxLength,
+    __global float* out) {
     uint i = get_global_id(0);
     if (i >= queryCount) return;
     ub_beam qb = queries[i];
@@ -187,7 +186,7 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
             }
         }
     } else {
-        UB_BVH_LEAVES_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qLength))
+        UB_BVH_LEAVES_BEGIN(nodes, roots[qMedium], ub_bvh_meets_global(n, o, invD, qLength))
         for (uint b = leafFirst / 4u; b * 4u < leafEnd; ++b) {
             /* two blocks at once where the leaf has both (ub_pb2d_near8_global) */
             float t[8];
@@ -227,7 +226,8 @@ __kernel void ub_pb2d_estimate(__global const ub_photon_point* photons,
 __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_beam_part* parts,
                                __global const ub_beam_piece* beamPieces,
                                __global const uint* beamRanges, __global const ub_bvh_node* nodes,
-                               __global const ub_grid_info* grids, __global const uchar* gridData,
+                               __global const uint* roots, __global const ub_grid_info* grids,
+                               __global const uchar* gridData,
                                __global const ub_query_point* queries, uint queryCount,
                                __global const ub_medium_info* media, ub_mis_constants mis,
                                float radius, float normalization, uint minLength, uint maxLength,
@@ -239,7 +239,7 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
     qm.ready = 0;
     ub_float3 p = ub_f3_from(q.pos);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    UB_BVH_WALK_BEGIN(nodes, ub_bvh_contains_global(n, p)) {
+    UB_BVH_WALK_BEGIN(nodes, roots[q.mediumId], ub_bvh_contains_global(n, p)) {
         ub_beam_part part = parts[k];
         float t = 0.0f;
         if (!ub_bp2d_pair(q, part, radius * radius, minLength, maxLength, &t)) continue;
@@ -313,7 +313,7 @@ static void ub_bb1d_flush(__global const ub_beam* beams, __global const ub_beam_
 __kernel void ub_bb1d_estimate(
     __global const ub_beam* beams, __global const ub_beam_part* parts,
     __global const ub_beam_keys4* lines, __global const ub_beam_piece* beamPieces,
-    __global const uint* beamRanges, __global const ub_bvh_node* nodes,
+    __global const uint* beamRanges, __global const ub_bvh_node* nodes, __global const uint* roots,
     __global const uint* tileStart, __global const ub_beam_keys4* tileLines,
     __global const uint* tileParts, ub_screen_tiles tiles, __global const ub_grid_info* grids,
     __global const uchar* gridData, __global const ub_beam* queries, uint queryCount,
@@ -358,7 +358,7 @@ __kernel void ub_bb1d_estimate(
     } else {
         /* A leaf's candidates four at a time by their lines first, as the host twin does
          * (src/estimators/bb1d_estimator.cpp), gathered and handled UB_BB1D_PENDING at a time. */
-        UB_BVH_LEAVES_BEGIN(nodes, ub_bvh_meets_global(n, o, invD, qb.length))
+        UB_BVH_LEAVES_BEGIN(nodes, roots[qb.mediumId], ub_bvh_meets_global(n, o, invD, qb.length))
         for (uint b = leafFirst / 4u; b * 4u < leafEnd; ++b) {
             /* two blocks at once where the leaf has both (ub_beam_lines_near8_global) */
             uint near;

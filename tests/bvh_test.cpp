@@ -143,6 +143,72 @@ TEST(Bvh, WalksReportExactlyTheBoxesOfSmallCubesAndDegenerateSets) {
     EXPECT_EQ(visits, 0);
 }
 
+// Built with groups (the medium of each photon or beam part), each group has a tree of its own:
+// a walk from root(g) reports exactly the boxes of group g that a walk of the whole set
+// reports, and nothing of another group; empty and unknown groups have no root; an
+// ungrouped build and a build with one group make the same nodes (the splits round the
+// absolute leaf-order position, which is the same on trees starting at 0).
+TEST(Bvh, GroupedBuildWalksOneGroupsBoxesOnly) {
+    Rng rng(21, 1);
+    const std::vector<Bounds3> boxes = beamBoxes(rng, 2500);
+    std::vector<uint32_t> groups(boxes.size());
+    for (uint32_t& g : groups) g = rng.uniform() < 0.15f ? 0u : (rng.uniform() < 0.5f ? 1u : 3u);
+    for (uint32_t leaf : {1u, 12u}) {
+        Bvh grouped, whole;
+        grouped.build(boxes, leaf, Bvh::kStackSize, &groups);
+        whole.build(boxes, leaf);
+        EXPECT_EQ(grouped.root(2), UB_BVH_NONE);
+        EXPECT_EQ(grouped.root(9), UB_BVH_NONE);
+        EXPECT_EQ(whole.root(9), 0u);
+        EXPECT_NE(grouped.root(0), grouped.root(1));
+        EXPECT_LE(grouped.stackNeed(), Bvh::kStackSize);
+        // The leaf-order position of each box, for querySegmentLeaves.
+        Bvh ordered;
+        ordered.build(boxes, leaf, Bvh::kStackSize, &groups);
+        std::vector<uint32_t> boxAt(boxes.size());
+        for (uint32_t i = 0; i < boxAt.size(); ++i) boxAt[i] = i;
+        ordered.permuteToLeafOrder(&boxAt);
+        Rng q(22 + leaf, 3);
+        for (int k = 0; k < 300; ++k) {
+            const Vec3 p = randomIn(q, -0.1f, 1.1f);
+            const Vec3 d = normalize(randomIn(q, -1.0f, 1.0f));
+            const float len = 0.05f + 1.5f * q.uniform();
+            std::vector<uint32_t> all;
+            whole.queryPoint(p, [&](uint32_t i) { all.push_back(i); });
+            std::vector<uint32_t> union_;
+            for (uint32_t g : {0u, 1u, 2u, 3u}) {
+                std::vector<uint32_t> found, seg;
+                grouped.queryPoint(p, g, [&](uint32_t i) { found.push_back(i); });
+                ordered.querySegmentLeaves(p, d, len, g, [&](uint32_t first, uint32_t end) {
+                    for (uint32_t i = first; i < end; ++i) seg.push_back(boxAt[i]);
+                });
+                for (uint32_t i : found) ASSERT_EQ(groups[i], g) << "point query " << k;
+                for (uint32_t i : seg) ASSERT_EQ(groups[i], g) << "segment query " << k;
+                for (uint32_t i = 0; i < boxes.size(); ++i) {
+                    if (groups[i] != g || nearBoundary(p, d, len, boxes[i])) continue;
+                    if (segmentMeetsBox(p, d, len, boxes[i]))
+                        ASSERT_NE(std::find(seg.begin(), seg.end(), i), seg.end())
+                            << "segment query " << k << " box " << i;
+                }
+                union_.insert(union_.end(), found.begin(), found.end());
+            }
+            // Leaves of one box: the groups' walks together report what the whole walk does.
+            if (leaf == 1) {
+                std::sort(all.begin(), all.end());
+                std::sort(union_.begin(), union_.end());
+                ASSERT_EQ(union_, all) << "point query " << k;
+            }
+        }
+        // One group: the same tree as without groups.
+        Bvh one;
+        const std::vector<uint32_t> zeros(boxes.size(), 0u);
+        one.build(boxes, leaf, Bvh::kStackSize, &zeros);
+        ASSERT_EQ(one.nodeCount(), whole.nodeCount());
+        EXPECT_EQ(0, std::memcmp(one.nodes().data(), whole.nodes().data(),
+                                 whole.nodeCount() * sizeof(BvhNode)));
+    }
+}
+
 // The walks hold Bvh::kStackSize entries (and UB_BVH_STACK in kernels/beams.cl), with no
 // check as they push. Boxes whose sizes fall geometrically along a line make the largest-box
 // collapse leave inner children one binary level down at every four-wide level of the small

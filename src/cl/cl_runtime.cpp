@@ -673,11 +673,12 @@ void ClRuntime::estimatePB2D(const std::vector<ub_photon_point>& photons,
                              const EstimateArgs& a, std::vector<Rgb>* out) {
     if (photons.empty() || spheres.empty()) return out->assign(queries.size(), Rgb(0.0f));
     requireLeafOrder(spheres, "pb2d");
+    const std::vector<uint32_t> roots = spheres.roots(uint32_t(a.media->size()));
     if (tiles.start.empty() || tiles.photonKeys.empty() || tiles.items.empty())
         throw std::logic_error("pb2d kernel given screen tiles that were not built");
     runEstimate(pb2d_, "clEnqueueNDRangeKernel(ub_pb2d_estimate)",
                 withGrids({bufferArg(photons), bufferArg(keys), bufferArg(spheres.nodes()),
-                           bufferArg(tiles.start), bufferArg(tiles.photonKeys),
+                           bufferArg(roots), bufferArg(tiles.start), bufferArg(tiles.photonKeys),
                            bufferArg(tiles.items), scalarArg(tiles.params)},
                           gridArgs(a)),
                 bufferArg(queries), queries.size(), a, out);
@@ -691,9 +692,10 @@ void ClRuntime::estimateBP2D(const std::vector<ub_beam>& beams,
                              std::vector<Rgb>* out) {
     if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
     requireLeafOrder(bvh, "bp2d");
+    const std::vector<uint32_t> roots = bvh.roots(uint32_t(a.media->size()));
     runEstimate(bp2d_, "clEnqueueNDRangeKernel(ub_bp2d_estimate)",
                 withGrids({bufferArg(beams), bufferArg(parts), bufferArg(pieces), bufferArg(ranges),
-                           bufferArg(bvh.nodes())},
+                           bufferArg(bvh.nodes()), bufferArg(roots)},
                           gridArgs(a)),
                 bufferArg(queries), queries.size(), a, out);
 }
@@ -707,12 +709,14 @@ void ClRuntime::estimateBB1D(const std::vector<ub_beam>& beams,
                              const EstimateArgs& a, std::vector<Rgb>* out) {
     if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
     requireLeafOrder(bvh, "bb1d");
+    const std::vector<uint32_t> roots = bvh.roots(uint32_t(a.media->size()));
     if (tiles.start.empty() || tiles.lines.empty() || tiles.items.empty())
         throw std::logic_error("bb1d kernel given screen tiles that were not built");
     runEstimate(bb1d_, "clEnqueueNDRangeKernel(ub_bb1d_estimate)",
                 withGrids({bufferArg(beams), bufferArg(parts), bufferArg(lines), bufferArg(pieces),
-                           bufferArg(ranges), bufferArg(bvh.nodes()), bufferArg(tiles.start),
-                           bufferArg(tiles.lines), bufferArg(tiles.items), scalarArg(tiles.params)},
+                           bufferArg(ranges), bufferArg(bvh.nodes()), bufferArg(roots),
+                           bufferArg(tiles.start), bufferArg(tiles.lines), bufferArg(tiles.items),
+                           scalarArg(tiles.params)},
                           gridArgs(a)),
                 bufferArg(queries), queries.size(), a, out);
 }

@@ -52,6 +52,7 @@ constexpr int kPending = 32;
 /// What every query of a pass reads.
 struct Bb1dPass {
     const VolumeEstimateInput& in;
+    const Bvh& bvh;  ///< walked from the query's medium's root (Bvh::build's groups)
     const std::vector<BvhNode>& nodes;
     const std::vector<BeamPart>& parts;
     const std::vector<ub_beam_keys4>& lines;
@@ -149,10 +150,18 @@ void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
     if (!beamParts.leafOrdered())
         throw std::logic_error("bb1d given a BVH whose parts are not in leaf order");
     const float r = in.radius[UB_TECH_BB1D];
-    const Bb1dPass pass{
-        in,    beamParts.nodes(), parts, lines, photonMedia,
-        beams, queries,           tiles, r,     ub_bb1d_normalization(in.beamPathCount, r),
-        out};
+    const Bb1dPass pass{in,
+                        beamParts,
+                        beamParts.nodes(),
+                        parts,
+                        lines,
+                        photonMedia,
+                        beams,
+                        queries,
+                        tiles,
+                        r,
+                        ub_bb1d_normalization(in.beamPathCount, r),
+                        out};
     const bool useWide = bb1dWideWalk();
     forEachQueryBlock(queries.size(), 16, out, pairs, [&](size_t begin, size_t end, size_t* found) {
 #if UB_BB1D_HAS_WIDE

@@ -27,7 +27,7 @@ void estimateBP2D(const VolumeEstimateInput& in, const Bvh& beamParts,
         const float g = in.scene->media[q.mediumId].g;
         const ub_float3 p = ub_f3_from(q.pos);
         Rgb sum(0.0f);
-        beamParts.queryPoint(Vec3(p.x, p.y, p.z), [&](uint32_t k) {
+        beamParts.queryPoint(Vec3(p.x, p.y, p.z), q.mediumId, [&](uint32_t k) {
             const BeamPart& part = parts[k];
             float t = 0.0f;
             if (!ub_bp2d_pair(q, part, r * r, ub_uint(in.minLength), ub_uint(in.maxLength), &t))

@@ -4,40 +4,85 @@
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
+#include <atomic>
 #include <limits>
 #include <stdexcept>
 #include <string>
 
 namespace ub {
 
-void Bvh::build(const std::vector<Bounds3>& boxes, uint32_t leafSize, int stackLimit) {
+namespace {
+std::atomic<bool> treesPerMedium{true};
+}  // namespace
+
+void setMediumTreesForTests(bool allowed) {
+    treesPerMedium = allowed;
+}
+bool mediumTreesAllowed() {
+    return treesPerMedium;
+}
+
+void Bvh::build(const std::vector<Bounds3>& boxes, uint32_t leafSize, int stackLimit,
+                const std::vector<uint32_t>* groups) {
     leafSize_ = std::max(1u, leafSize);
     nodes_.clear();
+    roots_.clear();
+    grouped_ = groups != nullptr;
     prims_.resize(boxes.size());
+    if (groups && groups->size() != boxes.size())
+        throw std::logic_error("Bvh::build: one group per box expected");
     if (boxes.empty()) return;
     std::vector<Vec3> centres(boxes.size());
-    for (uint32_t i = 0; i < boxes.size(); ++i) {
-        prims_[i] = i;
-        centres[i] = boxes[i].center();
+    for (uint32_t i = 0; i < boxes.size(); ++i) centres[i] = boxes[i].center();
+    // The boxes group by group (a stable counting sort, so that the layout depends on the
+    // input alone), each group's range [starts[g], starts[g + 1]).
+    std::vector<uint32_t> starts(1, 0);
+    if (groups) {
+        const uint32_t highest = *std::max_element(groups->begin(), groups->end());
+        if (highest >= (1u << 20))
+            throw std::logic_error("Bvh::build: group " + std::to_string(highest) +
+                                   " out of range (media ids expected)");
+        const uint32_t count = highest + 1;
+        starts.assign(count + 1, 0);
+        for (uint32_t g : *groups) ++starts[g + 1];
+        for (uint32_t g = 0; g < count; ++g) starts[g + 1] += starts[g];
+        std::vector<uint32_t> next(starts.begin(), starts.end() - 1);
+        for (uint32_t i = 0; i < boxes.size(); ++i) prims_[next[(*groups)[i]]++] = i;
+    } else {
+        starts.push_back(uint32_t(boxes.size()));
+        for (uint32_t i = 0; i < boxes.size(); ++i) prims_[i] = i;
     }
     std::vector<Node2> tree;
-    tree.reserve(2 * boxes.size() / leafSize_ + 1);
-    buildNode(boxes, centres, tree, 0, uint32_t(boxes.size()));
-    nodes_.reserve(tree.size() / 3 + 1);
-    collapse(tree, 0, false);
-    stackNeed_ = stackNeed(0, 0);
+    tree.reserve(2 * boxes.size() / leafSize_ + starts.size());
+    std::vector<uint32_t> binaryRoots(starts.size() - 1, UB_BVH_NONE);
+    for (size_t g = 0; g + 1 < starts.size(); ++g)
+        if (starts[g] < starts[g + 1])
+            binaryRoots[g] = buildNode(boxes, centres, tree, starts[g], starts[g + 1]);
+    nodes_.reserve(tree.size() / 3 + starts.size());
+    stackNeed_ = collapseAll(tree, binaryRoots, false);
     if (stackNeed_ > std::min(stackLimit, kStackSize)) {
         // Opening the largest box first can leave a child one binary level down on a path of
         // small boxes; opening the shallowest first consumes two binary levels per four-wide
         // level (a leaf needs no entry), so with median splits (binary depth <= 33) the walk
         // holds at most 3 * 17 + 1 = 52 entries.
-        nodes_.clear();
-        collapse(tree, 0, true);
-        stackNeed_ = stackNeed(0, 0);
+        stackNeed_ = collapseAll(tree, binaryRoots, true);
         if (stackNeed_ > std::min(stackLimit, kStackSize))
             throw std::logic_error("Bvh::build: a walk would need " + std::to_string(stackNeed_) +
                                    " stack entries, more than " + std::to_string(stackLimit));
     }
+}
+
+int Bvh::collapseAll(const std::vector<Node2>& tree, const std::vector<uint32_t>& binaryRoots,
+                     bool shallowFirst) {
+    nodes_.clear();
+    roots_.assign(binaryRoots.size(), UB_BVH_NONE);
+    int need = 0;
+    for (size_t g = 0; g < binaryRoots.size(); ++g) {
+        if (binaryRoots[g] == UB_BVH_NONE) continue;
+        roots_[g] = collapse(tree, binaryRoots[g], shallowFirst);
+        need = std::max(need, stackNeed(roots_[g], 0));
+    }
+    return need;
 }
 
 int Bvh::stackNeed(uint32_t node, int base) const {
@@ -89,9 +134,11 @@ uint32_t Bvh::buildNode(const std::vector<Bounds3>& boxes, const std::vector<Vec
     // leaf order: the walks read a leaf's candidates four to a block (ub_beam_keys4,
     // ub_photon_keys4), and a leaf of 9.6 parts on average straddled 3.15 blocks (counted,
     // mirrorballs bb1d; 2.45 since).
-    uint32_t half = (end - begin) / 2;
-    if (leafSize_ % 4 == 0) half = (half + 3) & ~3u;
-    const uint32_t mid = begin + half;
+    // The rounding is of the absolute position, so that a group's tree starting off a
+    // multiple of four (Bvh::build's groups) has one straddling leaf at most; without groups
+    // every range starts on a multiple of four and it is the same as rounding the half.
+    uint32_t mid = begin + (end - begin) / 2;
+    if (leafSize_ % 4 == 0 && ((mid + 3) & ~3u) < end) mid = (mid + 3) & ~3u;
     std::nth_element(prims_.begin() + begin, prims_.begin() + mid, prims_.begin() + end,
                      [&](uint32_t a, uint32_t b) { return centres[a][axis] < centres[b][axis]; });
     if (end - begin >= kParallelBuild) {

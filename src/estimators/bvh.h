@@ -16,6 +16,10 @@
 // mirrorballs: about 300 nodes per query beam for 4.5 pairs), and the wide nodes halve the loads
 // and the depth (measured, docs/performance.md).
 //
+// With groups (the medium of each photon or part), each group is built as a tree of its own
+// over its range of the leaf order, and a walk starts at its query's medium's root (roots()
+// for the kernels): the estimators' walks never visit another medium's nodes.
+//
 // Own code rather than Embree's user geometry: the nodes are a flat array of
 // fixed-size records, which the OpenCL backend uploads and traverses as they are
 // (kernels cannot call Embree), so the host twin walks the same structure.
@@ -74,6 +78,11 @@ inline uint32_t bvhInnerChildren(const BvhNode& n) {
            uint32_t(n.count[2] == 0) << 2 | uint32_t(n.count[3] == 0) << 3;
 }
 
+/// Lets the volumetric estimates build one tree per medium (the default; Bvh::build's groups)
+/// or one over all media: the two find the same pairs, which a test checks.
+void setMediumTreesForTests(bool allowed);
+bool mediumTreesAllowed();
+
 class Bvh {
   public:
     /// Entries of a walk's stack: the walks here and in kernels/beams.cl (UB_BVH_STACK) hold
@@ -84,8 +93,27 @@ class Bvh {
     static constexpr size_t kNodeBytesPerBox = 2 * 32 + sizeof(BvhNode);
     /// Builds over boxes[i], i = 0..n-1, leaves of at most leafSize; visits report i. The
     /// walks' stack holds stackLimit entries (tests pass less to reach the fallback collapse).
+    /// With groups (one id per box, e.g. the medium of a photon or beam part), each group gets
+    /// a tree of its own, rooted at root(group), and the boxes are laid out group by group:
+    /// a walk for one group then visits none of the other groups' nodes. Every pair test of
+    /// the volumetric estimators rejects a photon or part of another medium than its query's,
+    /// so walking the query's medium's tree finds the same pairs. Counted on the SmallUPBP
+    /// bunny (`upbp:bb1d`): the query beams inside the bunny's medium, two thirds of them,
+    /// made 70% of the walk's node visits for the 5.5% of the parts in their medium.
     void build(const std::vector<Bounds3>& boxes, uint32_t leafSize = 4,
-               int stackLimit = kStackSize);
+               int stackLimit = kStackSize, const std::vector<uint32_t>* groups = nullptr);
+    /// The node a walk for `group` starts at: UB_BVH_NONE if the group has no box. Without
+    /// groups (and for an ungrouped build, any group) node 0, unless the tree is empty.
+    uint32_t root(uint32_t group) const {
+        if (!grouped_) return nodes_.empty() ? UB_BVH_NONE : 0u;
+        return group < roots_.size() ? roots_[group] : UB_BVH_NONE;
+    }
+    /// root(g) for g = 0 .. n - 1 (what the kernels read, one entry per medium).
+    std::vector<uint32_t> roots(uint32_t n) const {
+        std::vector<uint32_t> r(n);
+        for (uint32_t g = 0; g < n; ++g) r[g] = root(g);
+        return r;
+    }
     bool empty() const { return nodes_.empty(); }
     size_t nodeCount() const { return nodes_.size(); }
     size_t bytes() const { return nodes_.size() * sizeof(BvhNode) + prims_.size() * 4; }
@@ -103,28 +131,33 @@ class Bvh {
     /// which build fills with one entry per box).
     bool leafOrdered() const { return prims_.empty(); }
 
-    /// visit(i) for every primitive whose box contains p.
+    /// visit(i) for every primitive whose box contains p (of every group, group by group).
     template <class Visit>
     void queryPoint(const Vec3& p, Visit&& visit) const;
+    /// The same, for the primitives of one group only.
+    template <class Visit>
+    void queryPoint(const Vec3& p, uint32_t group, Visit&& visit) const;
     /// visit(i) for every primitive whose box meets the segment o + t d, t in [0, len].
     template <class Visit>
     void querySegment(const Vec3& o, const Vec3& d, float len, Visit&& visit) const;
-    /// The same walk, leaf by leaf: visitRange(first, end) for the leaf-order positions
-    /// first .. end - 1 of each leaf met, in querySegment's order. Needs leafOrdered().
+    /// The walk of one group's tree, leaf by leaf: visitRange(first, end) for the leaf-order
+    /// positions first .. end - 1 of each leaf met. Needs leafOrdered().
     template <class VisitRange>
-    void querySegmentLeaves(const Vec3& o, const Vec3& d, float len, VisitRange&& visitRange) const;
+    void querySegmentLeaves(const Vec3& o, const Vec3& d, float len, uint32_t group,
+                            VisitRange&& visitRange) const;
 
   private:
     /// The walk of kernels/shared/ub_bvh.h: visit(i) for the primitives of every leaf whose
     /// path passes; childMask(node) gives the children that pass.
     template <class ChildMask, class Visit>
     void traverse(ChildMask&& childMask, Visit&& visit) const;
-    /// The walk itself: visit(i) with i the leaf-order position.
+    /// The walk itself, of every group's tree: visit(i) with i the leaf-order position.
     template <class ChildMask, class Visit>
     void walk(ChildMask&& childMask, Visit&& visit) const;
-    /// The walk, leaf by leaf: visitRange(first, end) over leaf-order positions.
+    /// The walk of the tree at `root`, leaf by leaf: visitRange(first, end) over leaf-order
+    /// positions.
     template <class ChildMask, class VisitRange>
-    void walkLeaves(ChildMask&& childMask, VisitRange&& visitRange) const;
+    void walkLeaves(uint32_t root, ChildMask&& childMask, VisitRange&& visitRange) const;
     /// A node of the binary tree built first.
     struct Node2 {
         Bounds3 box;
@@ -135,8 +168,14 @@ class Bvh {
                        std::vector<Node2>& tree, uint32_t begin, uint32_t end);
     uint32_t collapse(const std::vector<Node2>& tree, uint32_t self, bool shallowFirst);
     int stackNeed(uint32_t node, int base) const;
+    /// Collapses the binary trees at binaryRoots[g] into nodes_ (roots_[g]), and returns the
+    /// largest stackNeed of their walks.
+    int collapseAll(const std::vector<Node2>& tree, const std::vector<uint32_t>& binaryRoots,
+                    bool shallowFirst);
     uint32_t leafSize_ = 4;
     int stackNeed_ = 0;
+    bool grouped_ = false;
+    std::vector<uint32_t> roots_;  ///< per group: its tree's root node, or UB_BVH_NONE
 
     std::vector<BvhNode> nodes_;
     std::vector<uint32_t> prims_;  ///< leaf entry -> box index; empty once leaf-ordered
@@ -153,17 +192,19 @@ void Bvh::traverse(ChildMask&& childMask, Visit&& visit) const {
 
 template <class ChildMask, class Visit>
 void Bvh::walk(ChildMask&& childMask, Visit&& visit) const {
-    walkLeaves(childMask, [&](uint32_t first, uint32_t end) {
+    auto visitRange = [&](uint32_t first, uint32_t end) {
         for (uint32_t i = first; i < end; ++i) visit(i);
-    });
+    };
+    if (!grouped_) return walkLeaves(root(0), childMask, visitRange);
+    for (uint32_t r : roots_) walkLeaves(r, childMask, visitRange);
 }
 
 template <class ChildMask, class VisitRange>
-void Bvh::walkLeaves(ChildMask&& childMask, VisitRange&& visitRange) const {
-    if (nodes_.empty()) return;
+void Bvh::walkLeaves(uint32_t root, ChildMask&& childMask, VisitRange&& visitRange) const {
+    if (root == UB_BVH_NONE) return;
     uint32_t stack[kStackSize];  // stackNeed() <= kStackSize entries (checked by build)
     int top = 0;
-    stack[top++] = 0;
+    stack[top++] = root;
     while (top > 0) {
         const BvhNode& n = nodes_[stack[--top]];
         const uint32_t mask = childMask(n);
@@ -201,6 +242,16 @@ void Bvh::queryPoint(const Vec3& p, Visit&& visit) const {
 }
 
 template <class Visit>
+void Bvh::queryPoint(const Vec3& p, uint32_t group, Visit&& visit) const {
+    const ub_float3 q = ub_make_float3(p.x, p.y, p.z);
+    auto mask = [&](const BvhNode& n) { return ub_bvh_contains(&n, q); };
+    auto range = [&](uint32_t first, uint32_t end) {
+        for (uint32_t i = first; i < end; ++i) visit(leafOrdered() ? i : prims_[i]);
+    };
+    walkLeaves(root(group), mask, range);
+}
+
+template <class Visit>
 void Bvh::querySegment(const Vec3& o, const Vec3& d, float len, Visit&& visit) const {
     const ub_float3 oo = ub_make_float3(o.x, o.y, o.z);
     const ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
@@ -208,11 +259,12 @@ void Bvh::querySegment(const Vec3& o, const Vec3& d, float len, Visit&& visit) c
 }
 
 template <class VisitRange>
-void Bvh::querySegmentLeaves(const Vec3& o, const Vec3& d, float len,
+void Bvh::querySegmentLeaves(const Vec3& o, const Vec3& d, float len, uint32_t group,
                              VisitRange&& visitRange) const {
     const ub_float3 oo = ub_make_float3(o.x, o.y, o.z);
     const ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
-    walkLeaves([&](const BvhNode& n) { return bvhMeets4(n, oo, invD, len); }, visitRange);
+    walkLeaves(
+        root(group), [&](const BvhNode& n) { return bvhMeets4(n, oo, invD, len); }, visitRange);
 }
 
 /// ub_beam_lines_near4 (kernels/shared/ub_bvh.h) in SSE: the same operations in the same order

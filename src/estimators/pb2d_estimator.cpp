@@ -118,20 +118,21 @@ void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres,
             flush();
             return sum;
         }
-        photonSpheres.querySegmentLeaves(
-            Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length, [&](uint32_t first, uint32_t end) {
-                for (uint32_t b = first / 4; b * 4 < end; ++b) {
-                    float t[4];
-                    uint32_t near = pb2dNear4(keys[b], o, d, qb.length, qb.mediumId, r * r, t) &
-                                    ub_block_lanes(b, first, end);
-                    for (; near != 0; near &= near - 1) {
-                        const int lane = __builtin_ctz(near);
-                        pending[np] = b * 4 + uint32_t(lane);
-                        pendingT[np++] = t[lane];
-                        if (np == kPending) flush();
-                    }
-                }
-            });
+        photonSpheres.querySegmentLeaves(Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), qb.length,
+                                         qb.mediumId, [&](uint32_t first, uint32_t end) {
+                                             for (uint32_t b = first / 4; b * 4 < end; ++b) {
+                                                 float t[4];
+                                                 uint32_t near = pb2dNear4(keys[b], o, d, qb.length,
+                                                                           qb.mediumId, r * r, t) &
+                                                                 ub_block_lanes(b, first, end);
+                                                 for (; near != 0; near &= near - 1) {
+                                                     const int lane = __builtin_ctz(near);
+                                                     pending[np] = b * 4 + uint32_t(lane);
+                                                     pendingT[np++] = t[lane];
+                                                     if (np == kPending) flush();
+                                                 }
+                                             }
+                                         });
         flush();
         return sum;
     });

@@ -88,7 +88,10 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         // Leaves of up to 12 photons, tested four at a time (ub_photon_keys4): against 4, the
         // pb2d estimate pass 8-11% faster on the bunny and cornell-fog, host and kernel, and the
         // BVH builds faster (docs/performance.md).
-        spheres.build(boxes, 12);
+        // One tree per medium (Bvh::build's groups): a query walks its medium's photons only.
+        std::vector<uint32_t> media(photons.size());
+        for (size_t i = 0; i < photons.size(); ++i) media[i] = photons[i].mediumId;
+        spheres.build(boxes, 12, Bvh::kStackSize, mediumTreesAllowed() ? &media : nullptr);
         // A copy of the photons in leaf order, read one after the other by the walks.
         reserve(photons.size() * sizeof(ub_photon_point), "pb2d lookup (photons in leaf order)");
         sphereOrder = photons;
@@ -153,7 +156,10 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
         // Leaves of up to 12 parts: bb1d tests a leaf's lines four at a time (ub_beam_keys4),
         // which makes a candidate cheaper than a node; against 8, bb1d's estimate pass 5-12%
         // faster on cornell-fog and mirrorballs, bp2d within noise (docs/performance.md).
-        beamBvh.build(boxes, 12);
+        // One tree per medium (Bvh::build's groups): a query walks its medium's parts only.
+        std::vector<uint32_t> media(parts.size());
+        for (size_t i = 0; i < parts.size(); ++i) media[i] = parts[i].mediumId;
+        beamBvh.build(boxes, 12, Bvh::kStackSize, mediumTreesAllowed() ? &media : nullptr);
         // The parts in leaf order, so that a walk reads its candidates one after the other.
         beamBvh.permuteToLeafOrder(&parts);
         if (t.bb1d) {
