@@ -315,10 +315,11 @@ __kernel void ub_bb1d_estimate(
     __global const ub_beam_keys4* lines, __global const ub_beam_piece* beamPieces,
     __global const uint* beamRanges, __global const ub_bvh_node* nodes, __global const uint* roots,
     __global const uint* tileStart, __global const ub_beam_keys4* tileLines,
-    __global const uint* tileParts, ub_screen_tiles tiles, __global const ub_grid_info* grids,
-    __global const uchar* gridData, __global const ub_beam* queries, uint queryCount,
-    __global const ub_medium_info* media, ub_mis_constants mis, float radius, float normalization,
-    uint minLength, uint maxLength, __global float* out) {
+    __global const uint* tileParts, __global const ub_beam_part* tileItemParts,
+    ub_screen_tiles tiles, __global const ub_grid_info* grids, __global const uchar* gridData,
+    __global const ub_beam* queries, uint queryCount, __global const ub_medium_info* media,
+    ub_mis_constants mis, float radius, float normalization, uint minLength, uint maxLength,
+    __global float* out) {
     uint i = get_global_id(0);
     if (i >= queryCount) return;
     ub_beam qb = queries[i];
@@ -331,8 +332,9 @@ __kernel void ub_bb1d_estimate(
     float sum[3] = {0.0f, 0.0f, 0.0f};
     uint pending[UB_BB1D_PENDING];
     int np = 0;
-    /* A query on a line through the eye reads its screen tile's parts and the common list
-     * (ub_screen_tiles.h) in place of the walk, in the same order as the host twin. */
+    /* A query on a line through the eye reads its screen tile's items (whole photon beams, or
+     * parts, tileItemParts) and the common list (ub_screen_tiles.h) in place of the walk, in
+     * the same order as the host twin. */
     int tile = ub_screen_tile_of(tiles, o, d);
     if (tile >= 0) {
         uint lists[2] = {(uint)tile, tiles.tilesX * tiles.tilesY};
@@ -346,7 +348,7 @@ __kernel void ub_bb1d_estimate(
                     pending[np++] = tileParts[b * 4u + (31u - clz(near & (0u - near)))];
                     if (np == UB_BB1D_PENDING) {
                         ub_query_medium_load(&qm, media, grids, gridData, qb.mediumId);
-                        ub_bb1d_flush(beams, parts, beamPieces, beamRanges, &qm, &qb, table,
+                        ub_bb1d_flush(beams, tileItemParts, beamPieces, beamRanges, &qm, &qb, table,
                                       &tableState, mis, radius, normalization, minLength, maxLength,
                                       pending, np, sum);
                         np = 0;
@@ -354,6 +356,13 @@ __kernel void ub_bb1d_estimate(
                 }
                 if (b + 1u < end) ++b; /* the pair's second block is done */
             }
+        }
+        if (np > 0) {
+            ub_query_medium_load(&qm, media, grids, gridData, qb.mediumId);
+            ub_bb1d_flush(beams, tileItemParts, beamPieces, beamRanges, &qm, &qb, table,
+                          &tableState, mis, radius, normalization, minLength, maxLength, pending,
+                          np, sum);
+            np = 0;
         }
     } else {
         /* A leaf's candidates four at a time by their lines first, as the host twin does

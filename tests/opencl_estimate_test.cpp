@@ -449,6 +449,67 @@ TEST(OpenClEstimate, ScreenTilesFindTheBvhWalksPairs) {
     }
 }
 
+// bb1d's screen tiles bin a photon beam whole where its box lies in front of the eye, and by
+// its BVH parts otherwise (estimators/screen_tiles.h). In the infinite fog the camera stands
+// among the beams, so both kinds are binned, and some parts cross the eye's plane into the
+// list every tile reads. The host twin finds as many bb1d pairs with tiles as without, and its
+// layer differs only by the order of each query's sum (bound: 1e-5 relative per pixel and
+// channel); WholeRenderAgreesBetweenBackends holds the kernel to the twin in this scene.
+TEST(OpenClEstimate, ScreenTilesWithBeamsAroundTheEye) {
+    auto scene = infiniteFog(32);
+    RenderOptions opt = fogUpbpOptions("host", "upbp:bb1d");
+    opt.beamPaths = 1024;
+    VertexCM engine(*scene, opt);
+    Image img;
+    engine.renderIteration(1, img);
+    // Beams wholly in front of the eye, and beams with an end behind it.
+    const Vec3 eye = scene->camera.position(), forward = scene->camera.forward();
+    size_t front = 0, across = 0;
+    for (const ub_beam& b : engine.photonBeams()) {
+        const Vec3 o(b.origin[0], b.origin[1], b.origin[2]), d(b.dir[0], b.dir[1], b.dir[2]);
+        const float d0 = dot(o - eye, forward), d1 = dot(o + d * b.length - eye, forward);
+        (std::min(d0, d1) > 0.5f ? front : across) += 1;
+    }
+    EXPECT_GT(front, 100u);
+    EXPECT_GT(across, 100u);
+    VolumeEstimateInput vin;
+    vin.scene = scene.get();
+    vin.lightPathCount = 32.0f * 32.0f;
+    vin.beamPathCount = 1024.0f;
+    vin.minLength = 0;
+    vin.maxLength = uint32_t(opt.maxPathLength);
+    vin.photonPoints = &engine.photonPoints();
+    vin.photonBeams = &engine.photonBeams();
+    vin.queryPoints = &engine.queryPoints();
+    vin.queryBeams = &engine.queryBeams();
+    vin.radius[UB_TECH_BB1D] = engine.volumeRadiusAt(UB_TECH_BB1D, 1);
+    vin.mis = ub_mis_enable_volume(ub_mis_make_constants(0.01f, 1024.0f, 1, 1, UB_MIS_POWER), 0.0f,
+                                   0.0f, 0.0f, vin.radius[UB_TECH_BB1D], 1024.0f, 1, 0);
+    vin.techniques.bb1d = true;
+    std::array<std::array<Image, 4>, 2> layers;
+    std::array<VolumeEstimateStats, 2> stats;
+    for (int pass = 0; pass < 2; ++pass) {
+        setScreenTilesForTests(pass == 0);
+        Image image(32, 32);
+        for (Image& l : layers[size_t(pass)]) l = Image(32, 32);
+        estimateVolume(vin, &image, &layers[size_t(pass)], &stats[size_t(pass)]);
+    }
+    setScreenTilesForTests(true);
+    EXPECT_EQ(stats[0].screenTiles.enabled, 1u);
+    EXPECT_EQ(stats[1].screenTiles.enabled, 0u);
+    EXPECT_GT(stats[0].pairs[UB_TECH_BB1D], 1000u);
+    EXPECT_EQ(stats[0].pairs[UB_TECH_BB1D], stats[1].pairs[UB_TECH_BB1D]);
+    double sum = 0;
+    const Image &a = layers[1][UB_TECH_BB1D], &b = layers[0][UB_TECH_BB1D];
+    for (size_t i = 0; i < a.pixels.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            const float x = a.pixels[i][c], y = b.pixels[i][c];
+            ASSERT_NEAR(y, x, 1e-5f * std::fabs(x) + 1e-12f) << "pixel " << i;
+            sum += x;
+        }
+    EXPECT_GT(sum, 0.0);
+}
+
 // The beam estimators walk one BVH per medium (Bvh::build's groups): a query visits only the
 // tree of its own medium, since every pair test rejects a photon or part of another medium.
 // In the bundled glass sphere of juice in haze (two media, 32 x 32), the host twins find as

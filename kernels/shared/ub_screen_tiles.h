@@ -1,4 +1,7 @@
-/* Screen tiles for the camera rays of bb1d (photon-beam parts) and pb2d (photon points).
+/* Screen tiles for the camera rays of bb1d (photon beams) and pb2d (photon points).
+ *
+ * bb1d's items are segments of photon beams: a whole beam where its box lies in front of the
+ * eye, else the beam's BVH parts (src/estimators/screen_tiles.cpp); "part" below is either.
  *
  * A query beam whose line passes through a pinhole camera's eye (the camera subpath's first
  * segment, at any part of it) meets a photon-beam part (a photon point) only if its direction,
@@ -27,8 +30,8 @@
  *    span across the row's band covers (band and span widened by 1/64 pixel against
  *    rounding);
  *  - a box with every corner behind the eye by more than tolerance holds no such X0 and is
- *    left out; any other part (a box across the eye's plane, or covering more tiles than the
- *    host allows) goes into the list every tile reads, number tilesX * tilesY.
+ *    left out; any other part (a box across the eye's plane, or whose hull's spans cover more
+ *    tiles than the host allows) goes into the list every tile reads, number tilesX * tilesY.
  * Each tile's list is a run of blocks of four, as the BVH leaves hold them (ub_beam_keys4,
  * kernels/shared/ub_bvh.h; ub_photon_keys4, ub_upbp_records.h), with the items' indices
  * beside them; unused lanes have empty ranges (t0 = t1 = +infinity) or no medium, which the

@@ -710,13 +710,14 @@ void ClRuntime::estimateBB1D(const std::vector<ub_beam>& beams,
     if (beams.empty() || bvh.empty()) return out->assign(queries.size(), Rgb(0.0f));
     requireLeafOrder(bvh, "bb1d");
     const std::vector<uint32_t> roots = bvh.roots(uint32_t(a.media->size()));
-    if (tiles.start.empty() || tiles.lines.empty() || tiles.items.empty())
+    if (tiles.start.empty() || tiles.lines.empty() || tiles.items.empty() ||
+        tiles.itemParts.empty())
         throw std::logic_error("bb1d kernel given screen tiles that were not built");
     runEstimate(bb1d_, "clEnqueueNDRangeKernel(ub_bb1d_estimate)",
                 withGrids({bufferArg(beams), bufferArg(parts), bufferArg(lines), bufferArg(pieces),
                            bufferArg(ranges), bufferArg(bvh.nodes()), bufferArg(roots),
                            bufferArg(tiles.start), bufferArg(tiles.lines), bufferArg(tiles.items),
-                           scalarArg(tiles.params)},
+                           bufferArg(tiles.itemParts), scalarArg(tiles.params)},
                           gridArgs(a)),
                 bufferArg(queries), queries.size(), a, out);
 }

@@ -90,6 +90,13 @@ bool screenTilesAllowed() {
 }
 
 namespace {
+/// About a hundred times the rounding of a camera ray's points (a few ulp of their
+/// coordinates): a query off the eye's lines by more walks the BVH.
+float screenTolerance(const Camera& camera, float sceneRadius) {
+    const Vec3 eye = camera.position();
+    return 1e-5f * (std::fabs(eye.x) + std::fabs(eye.y) + std::fabs(eye.z) + 2.0f * sceneRadius);
+}
+
 /// The lists of n items whose boxes' corners corners(i, grow, out) gives (a box holding every
 /// point within grow of item i); out gets params, start and items (kNoItem in unused lanes).
 void buildLists(const Camera& camera, float sceneRadius, size_t n, float r,
@@ -124,16 +131,22 @@ void buildLists(const Camera& camera, float sceneRadius, size_t n, float r,
     s.tileSize = uint32_t(tile);
     s.tilesX = uint32_t((width + tile - 1) / tile);
     s.tilesY = uint32_t((height + tile - 1) / tile);
-    // About a hundred times the rounding of a camera ray's points (a few ulp of their
-    // coordinates): a query off the eye's lines by more walks the BVH.
-    float extent = std::fabs(eye.x) + std::fabs(eye.y) + std::fabs(eye.z) + 2.0f * sceneRadius;
-    s.tolerance = 1e-5f * extent;
+    s.tolerance = screenTolerance(camera, sceneRadius);
     const size_t tileCount = size_t(s.tilesX) * s.tilesY;
-    // A part covering more than a quarter of the tiles costs each tile's queries one test in
+    // An item covering more than a quarter of the tiles costs each tile's queries one test in
     // the common list, at one entry.
     const size_t maxRect = std::max<size_t>(1, tileCount / 4);
     const float grow = r + 2.0f * s.tolerance, margin = 1.0f / 64.0f;
 
+    // The tiles of item pl in row y: its hull's span in the row's band, widened by the margin.
+    auto rowTiles = [&](const Placement& pl, uint32_t y, uint32_t* x0, uint32_t* x1) {
+        float a, b;
+        hullSpan(pl, float(y * s.tileSize) - margin, float((y + 1) * s.tileSize) + margin, &a, &b);
+        if (!(a <= b) || b + margin < 0.0f || a - margin >= s.width) return false;
+        *x0 = uint32_t(std::max(0.0f, std::floor((a - margin) / tile)));
+        *x1 = uint32_t(std::min<float>(float(s.tilesX - 1), std::floor((b + margin) / tile)));
+        return *x0 <= *x1;
+    };
     // Each item's box (corners) grown by r plus twice the tolerance holds every point within
     // r + tolerance of it.
     std::vector<Placement> place(n);
@@ -173,18 +186,19 @@ void buildLists(const Camera& camera, float sceneRadius, size_t n, float r,
         const size_t rect =
             size_t(tileOf(xhi + margin, s.tilesX) - tileOf(xlo - margin, s.tilesX) + 1) *
             size_t(pl.y1 - pl.y0 + 1);
-        pl.kind = rect > maxRect ? Placement::kEverywhere : Placement::kTiles;
-        if (pl.kind == Placement::kTiles) makeHull(&pl);
+        pl.kind = Placement::kTiles;
+        makeHull(&pl);
+        if (rect > maxRect) {
+            // A long thin item (a whole beam across the image) covers far fewer tiles than its
+            // bounding rectangle: count the tiles of its rows.
+            size_t covered = 0;
+            for (uint32_t y = pl.y0; y <= pl.y1 && covered <= maxRect; ++y) {
+                uint32_t x0, x1;
+                if (rowTiles(pl, y, &x0, &x1)) covered += x1 - x0 + 1;
+            }
+            if (covered > maxRect) pl.kind = Placement::kEverywhere;
+        }
     });
-    // The tiles of part pl in row y: its hull's span in the row's band, widened by the margin.
-    auto rowTiles = [&](const Placement& pl, uint32_t y, uint32_t* x0, uint32_t* x1) {
-        float a, b;
-        hullSpan(pl, float(y * s.tileSize) - margin, float((y + 1) * s.tileSize) + margin, &a, &b);
-        if (!(a <= b) || b + margin < 0.0f || a - margin >= s.width) return false;
-        *x0 = uint32_t(std::max(0.0f, std::floor((a - margin) / tile)));
-        *x1 = uint32_t(std::min<float>(float(s.tilesX - 1), std::floor((b + margin) / tile)));
-        return *x0 <= *x1;
-    };
     // The parts of each tile row, ascending, so that rows fill their tiles in parallel.
     std::vector<uint32_t> rowStart(size_t(s.tilesY) + 1, 0u), common;
     for (const Placement& pl : place)
@@ -246,30 +260,67 @@ void fillBlocks(const ScreenTiles& tiles, std::vector<Keys>* blocks, Set set) {
 }
 }  // namespace
 
-void buildScreenTiles(const Camera& camera, float sceneRadius,
+void buildScreenTiles(const Camera& camera, float sceneRadius, const std::vector<ub_beam>& beams,
                       const std::vector<ub_beam_part>& parts, float r,
                       const std::function<void(size_t)>& reserve, ScreenTiles* out) {
-    // Each part's oriented box: its segment grown by `grow` along itself and along the two
+    // The items: a beam whose box (its segment grown by `grow` along itself and across, as
+    // below) has every corner deeper than the tolerance in front of the eye is one item; a
+    // corner is at most 3 grow shallower than the shallower end of the segment. The other
+    // beams go by their parts, so that only their parts near the eye's plane join the list
+    // every tile reads.
+    const Vec3 eye = camera.position(), forward = camera.forward();
+    const float tolerance = screenTolerance(camera, sceneRadius), grow = r + 2.0f * tolerance;
+    std::vector<uint8_t> whole(beams.size());
+    tbb::parallel_for(size_t(0), beams.size(), [&](size_t i) {
+        const ub_beam& b = beams[i];
+        const Vec3 o(b.origin[0], b.origin[1], b.origin[2]), d(b.dir[0], b.dir[1], b.dir[2]);
+        const float d0 = dot(o - eye, forward), d1 = dot(o + d * b.length - eye, forward);
+        whole[i] = std::min(d0, d1) > 4.0f * grow + 2.0f * tolerance ? 1 : 0;
+    });
+    std::vector<ub_beam_part> items;
+    reserve((beams.size() + parts.size()) * sizeof(ub_beam_part));
+    items.reserve(beams.size());
+    for (uint32_t i = 0; i < beams.size(); ++i) {
+        if (!whole[i]) continue;
+        const ub_beam& b = beams[i];
+        ub_beam_part p{};
+        for (int c = 0; c < 3; ++c) {
+            p.origin[c] = b.origin[c];
+            p.dir[c] = b.dir[c];
+        }
+        p.length = b.length;
+        p.mediumId = b.mediumId;
+        p.pathLength = b.pathLength;
+        p.beam = i;
+        p.t0 = 0.0f;
+        p.t1 = b.length;
+        items.push_back(p);
+    }
+    for (const ub_beam_part& p : parts)
+        if (!whole[p.beam]) items.push_back(p);
+    // Each item's oriented box: its segment grown by `grow` along itself and along the two
     // other axes of a frame around it.
     buildLists(
-        camera, sceneRadius, parts.size(), r,
-        [&](size_t i, float grow, Vec3* box) {
-            const ub_beam_part& p = parts[i];
+        camera, sceneRadius, items.size(), r,
+        [&](size_t i, float g, Vec3* box) {
+            const ub_beam_part& p = items[i];
             const Vec3 o(p.origin[0], p.origin[1], p.origin[2]), d(p.dir[0], p.dir[1], p.dir[2]);
             const Frame f(d);
-            const Vec3 ends[2] = {o + d * (p.t0 - grow), o + d * (p.t1 + grow)};
+            const Vec3 ends[2] = {o + d * (p.t0 - g), o + d * (p.t1 + g)};
             for (int c = 0; c < 8; ++c)
-                box[c] =
-                    ends[c & 1] + f.s * ((c & 2) ? grow : -grow) + f.t * ((c & 4) ? grow : -grow);
+                box[c] = ends[c & 1] + f.s * ((c & 2) ? g : -g) + f.t * ((c & 4) ? g : -g);
         },
         reserve, out);
     // The lanes' lines; unused lanes get empty ranges (t0 = t1 = +infinity), which the line
     // filter rejects.
     fillBlocks(*out, &out->lines, [&](ub_beam_keys4* k, int j, uint32_t i) {
-        if (i != ScreenTiles::kNoItem) return ub_beam_keys4_set(k, j, parts[i]);
+        if (i != ScreenTiles::kNoItem) return ub_beam_keys4_set(k, j, items[i]);
         k->ox[j] = k->oy[j] = k->oz[j] = k->dx[j] = k->dy[j] = k->dz[j] = 0.0f;
         k->t0[j] = k->t1[j] = INFINITY;
     });
+    // The kernels are given one record at least.
+    if (items.empty()) items.push_back(ub_beam_part{});
+    out->itemParts = std::move(items);
 }
 
 void buildPhotonScreenTiles(const Camera& camera, float sceneRadius,

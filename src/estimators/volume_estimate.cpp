@@ -170,7 +170,7 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
                 ub_beam_keys4_set(&partLines[i / 4], int(i % 4), parts[i]);
             // The parts by screen tile, for the query beams through the camera's eye.
             buildScreenTiles(
-                in.scene->camera, in.scene->sceneSphere.radius, parts, r,
+                in.scene->camera, in.scene->sceneSphere.radius, beams, parts, r,
                 [&](size_t bytes) { reserve(bytes, "bb1d lookup (screen tiles)"); }, &tiles);
             st.screenTiles = tiles.params;
         }
