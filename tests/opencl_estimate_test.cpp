@@ -61,21 +61,28 @@ RenderOptions smokeOptions() {
     return opt;
 }
 
-/// The estimate pass's input for smoke32()'s records after one iteration of `engine`
-/// (smokeOptions: 32 x 32 light subpaths, 256 beam paths, lengths up to 6); the caller sets
+/// The estimate pass's input for the records of `engine` after one iteration at 32 x 32
+/// (32 x 32 light subpaths, beamPaths beam paths, lengths up to maxLength); the caller sets
 /// the techniques, radii and MIS constants.
-VolumeEstimateInput smokeRecords(const Scene* scene, const VertexCM& engine) {
+VolumeEstimateInput records32(const Scene* scene, const VertexCM& engine, float beamPaths,
+                              uint32_t maxLength) {
     VolumeEstimateInput vin;
     vin.scene = scene;
     vin.lightPathCount = 32.0f * 32.0f;
-    vin.beamPathCount = 256.0f;
+    vin.beamPathCount = beamPaths;
     vin.minLength = 0;
-    vin.maxLength = 6;
+    vin.maxLength = maxLength;
     vin.photonPoints = &engine.photonPoints();
     vin.photonBeams = &engine.photonBeams();
     vin.queryPoints = &engine.queryPoints();
     vin.queryBeams = &engine.queryBeams();
     return vin;
+}
+
+/// records32 for smoke32() after one iteration with smokeOptions (256 beam paths, lengths up
+/// to 6).
+VolumeEstimateInput smokeRecords(const Scene* scene, const VertexCM& engine) {
+    return records32(scene, engine, 256.0f, 6);
 }
 
 RenderOptions pp3dOptions(const std::string& backend) {
@@ -472,16 +479,7 @@ TEST(OpenClEstimate, ScreenTilesWithBeamsAroundTheEye) {
     }
     EXPECT_GT(front, 100u);
     EXPECT_GT(across, 100u);
-    VolumeEstimateInput vin;
-    vin.scene = scene.get();
-    vin.lightPathCount = 32.0f * 32.0f;
-    vin.beamPathCount = 1024.0f;
-    vin.minLength = 0;
-    vin.maxLength = uint32_t(opt.maxPathLength);
-    vin.photonPoints = &engine.photonPoints();
-    vin.photonBeams = &engine.photonBeams();
-    vin.queryPoints = &engine.queryPoints();
-    vin.queryBeams = &engine.queryBeams();
+    VolumeEstimateInput vin = records32(scene.get(), engine, 1024.0f, uint32_t(opt.maxPathLength));
     vin.radius[UB_TECH_BB1D] = engine.volumeRadiusAt(UB_TECH_BB1D, 1);
     vin.mis = ub_mis_enable_volume(ub_mis_make_constants(0.01f, 1024.0f, 1, 1, UB_MIS_POWER), 0.0f,
                                    0.0f, 0.0f, vin.radius[UB_TECH_BB1D], 1024.0f, 1, 0);
@@ -547,16 +545,7 @@ TEST(OpenClEstimate, MediumTreesFindTheSameBeamPairs) {
         EXPECT_GT(inMedium(engine.photonPoints()), 50) << "medium " << m;
         EXPECT_GT(inMedium(engine.photonBeams()), 20) << "medium " << m;
     }
-    VolumeEstimateInput vin;
-    vin.scene = scene.get();
-    vin.lightPathCount = 32.0f * 32.0f;
-    vin.beamPathCount = 1024.0f;
-    vin.minLength = 0;
-    vin.maxLength = 8;
-    vin.photonPoints = &engine.photonPoints();
-    vin.photonBeams = &engine.photonBeams();
-    vin.queryPoints = &engine.queryPoints();
-    vin.queryBeams = &engine.queryBeams();
+    VolumeEstimateInput vin = records32(scene.get(), engine, 1024.0f, 8);
     for (int t : {UB_TECH_PB2D, UB_TECH_BP2D, UB_TECH_BB1D}) vin.radius[t] = 0.1f;
     vin.mis = ub_mis_enable_volume(ub_mis_make_constants(0.01f, 1024.0f, 1, 1, UB_MIS_POWER), 0.0f,
                                    0.1f, 0.1f, 0.1f, 1024.0f, 1, 0);

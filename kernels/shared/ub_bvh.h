@@ -11,6 +11,7 @@
 #ifndef UB_BVH_H
 #define UB_BVH_H
 
+#include "ub_upbp_records.h"
 #include "ub_vec3.h"
 
 /* count[c] == UB_BVH_NONE: no child c; count[c] == 0: child c is the inner node child[c];
@@ -36,6 +37,23 @@ typedef struct {
     float t0, t1;
     ub_uint pathLength;
 } ub_beam_part;
+
+/* The part [t0, t1] of photon beam b, whose index is `beam` (the BVH's parts; a whole beam,
+ * t0 = 0 and t1 = b.length, in the screen tiles). */
+UB_INLINE ub_beam_part ub_beam_part_of(ub_beam b, ub_uint beam, float t0, float t1) {
+    ub_beam_part p;
+    for (int c = 0; c < 3; ++c) {
+        p.origin[c] = b.origin[c];
+        p.dir[c] = b.dir[c];
+    }
+    p.length = b.length;
+    p.mediumId = b.mediumId;
+    p.beam = beam;
+    p.t0 = t0;
+    p.t1 = t1;
+    p.pathLength = b.pathLength;
+    return p;
+}
 
 /* What a bb1d walk tests first of four consecutive beam parts (in leaf order: parts 4 j ..
  * 4 j + 3 are block j, the last block padded with zeros): their lines and parameter ranges,

@@ -280,22 +280,8 @@ void buildScreenTiles(const Camera& camera, float sceneRadius, const std::vector
     std::vector<ub_beam_part> items;
     reserve((beams.size() + parts.size()) * sizeof(ub_beam_part));
     items.reserve(beams.size());
-    for (uint32_t i = 0; i < beams.size(); ++i) {
-        if (!whole[i]) continue;
-        const ub_beam& b = beams[i];
-        ub_beam_part p{};
-        for (int c = 0; c < 3; ++c) {
-            p.origin[c] = b.origin[c];
-            p.dir[c] = b.dir[c];
-        }
-        p.length = b.length;
-        p.mediumId = b.mediumId;
-        p.pathLength = b.pathLength;
-        p.beam = i;
-        p.t0 = 0.0f;
-        p.t1 = b.length;
-        items.push_back(p);
-    }
+    for (uint32_t i = 0; i < beams.size(); ++i)
+        if (whole[i]) items.push_back(ub_beam_part_of(beams[i], i, 0.0f, beams[i].length));
     for (const ub_beam_part& p : parts)
         if (!whole[p.beam]) items.push_back(p);
     // Each item's oriented box: its segment grown by `grow` along itself and along the two

@@ -138,18 +138,7 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
             for (int k = 0; k < n; ++k) {
                 const float a = b.length * float(k) / float(n);
                 const float e = k + 1 == n ? b.length : b.length * float(k + 1) / float(n);
-                ub_beam_part part{};
-                for (int c = 0; c < 3; ++c) {
-                    part.origin[c] = b.origin[c];
-                    part.dir[c] = b.dir[c];
-                }
-                part.length = b.length;
-                part.mediumId = b.mediumId;
-                part.pathLength = b.pathLength;
-                part.beam = i;
-                part.t0 = a;
-                part.t1 = e;
-                parts.push_back(part);
+                parts.push_back(ub_beam_part_of(b, i, a, e));
                 boxes.push_back(cylinderBox(vec(b.origin), vec(b.dir), a, e, r));
             }
         }
