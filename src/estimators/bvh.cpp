@@ -1,6 +1,7 @@
 // Bvh build (see bvh.h): a binary tree of median splits, collapsed into four-wide nodes.
 #include "estimators/bvh.h"
 
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
@@ -32,8 +33,6 @@ void Bvh::build(const std::vector<Bounds3>& boxes, uint32_t leafSize, int stackL
     if (groups && groups->size() != boxes.size())
         throw std::logic_error("Bvh::build: one group per box expected");
     if (boxes.empty()) return;
-    std::vector<Vec3> centres(boxes.size());
-    for (uint32_t i = 0; i < boxes.size(); ++i) centres[i] = boxes[i].center();
     // The boxes group by group (a stable counting sort, so that the layout depends on the
     // input alone), each group's range [starts[g], starts[g + 1]).
     std::vector<uint32_t> starts(1, 0);
@@ -52,12 +51,19 @@ void Bvh::build(const std::vector<Bounds3>& boxes, uint32_t leafSize, int stackL
         starts.push_back(uint32_t(boxes.size()));
         for (uint32_t i = 0; i < boxes.size(); ++i) prims_[i] = i;
     }
+    // The build partitions (centre, index) records in place; prims_ takes their order.
+    std::vector<BuildRef> refs(boxes.size());
+    tbb::parallel_for(size_t(0), boxes.size(), [&](size_t i) {
+        const Vec3 c = boxes[prims_[i]].center();
+        refs[i] = BuildRef{{c.x, c.y, c.z}, prims_[i]};
+    });
     std::vector<Node2> tree;
     tree.reserve(2 * boxes.size() / leafSize_ + starts.size());
     std::vector<uint32_t> binaryRoots(starts.size() - 1, UB_BVH_NONE);
     for (size_t g = 0; g + 1 < starts.size(); ++g)
         if (starts[g] < starts[g + 1])
-            binaryRoots[g] = buildNode(boxes, centres, tree, starts[g], starts[g + 1]);
+            binaryRoots[g] = buildNode(boxes, refs, tree, starts[g], starts[g + 1]);
+    for (size_t i = 0; i < refs.size(); ++i) prims_[i] = refs[i].index;
     nodes_.reserve(tree.size() / 3 + starts.size());
     stackNeed_ = collapseAll(tree, binaryRoots, false);
     if (stackNeed_ > std::min(stackLimit, kStackSize)) {
@@ -109,21 +115,26 @@ constexpr uint32_t kParallelBuild = 8192;
 
 }  // namespace
 
-uint32_t Bvh::buildNode(const std::vector<Bounds3>& boxes, const std::vector<Vec3>& centres,
+uint32_t Bvh::buildNode(const std::vector<Bounds3>& boxes, std::vector<BuildRef>& refs,
                         std::vector<Node2>& tree, uint32_t begin, uint32_t end) {
     const uint32_t self = uint32_t(tree.size());
     tree.emplace_back();
     Node2 node;
-    Bounds3 cbox;
-    for (uint32_t i = begin; i < end; ++i) {
-        node.box.extend(boxes[prims_[i]]);
-        cbox.extend(centres[prims_[i]]);
-    }
-    const Vec3 ext = cbox.hi - cbox.lo;
+    // The split axis: the longest of the centres' box, read from the contiguous records. The
+    // node's box is its children's union (computed after them), a leaf's its boxes' union.
+    float lo[3] = {refs[begin].centre[0], refs[begin].centre[1], refs[begin].centre[2]};
+    float hi[3] = {lo[0], lo[1], lo[2]};
+    for (uint32_t i = begin + 1; i < end; ++i)
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = std::min(lo[a], refs[i].centre[a]);
+            hi[a] = std::max(hi[a], refs[i].centre[a]);
+        }
+    const Vec3 ext(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
     const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
     // Depth stays below 34 for n < 2^32: median splits halve the range, and a range whose
     // centres coincide becomes a leaf however large it is.
     if (end - begin <= leafSize_ || !(ext[axis] > 0.0f)) {
+        for (uint32_t i = begin; i < end; ++i) node.box.extend(boxes[refs[i].index]);
         node.first = begin;
         node.count = end - begin;
         tree[self] = node;
@@ -139,10 +150,11 @@ uint32_t Bvh::buildNode(const std::vector<Bounds3>& boxes, const std::vector<Vec
     // every range starts on a multiple of four and it is the same as rounding the half.
     uint32_t mid = begin + (end - begin) / 2;
     if (leafSize_ % 4 == 0 && ((mid + 3) & ~3u) < end) mid = (mid + 3) & ~3u;
-    std::nth_element(prims_.begin() + begin, prims_.begin() + mid, prims_.begin() + end,
-                     [&](uint32_t a, uint32_t b) { return centres[a][axis] < centres[b][axis]; });
+    std::nth_element(
+        refs.begin() + begin, refs.begin() + mid, refs.begin() + end,
+        [axis](const BuildRef& a, const BuildRef& b) { return a.centre[axis] < b.centre[axis]; });
     if (end - begin >= kParallelBuild) {
-        // The halves own disjoint ranges of prims_. Appending a half moves its inner nodes'
+        // The halves own disjoint ranges of refs. Appending a half moves its inner nodes'
         // right-child indices by its new first index (leaves index primitives, which stay).
         auto appendSubtree = [&tree](const std::vector<Node2>& sub) {
             const uint32_t base = uint32_t(tree.size());
@@ -152,14 +164,18 @@ uint32_t Bvh::buildNode(const std::vector<Bounds3>& boxes, const std::vector<Vec
             }
         };
         std::vector<Node2> left, right;
-        tbb::parallel_invoke([&] { buildNode(boxes, centres, left, begin, mid); },
-                             [&] { buildNode(boxes, centres, right, mid, end); });
+        tbb::parallel_invoke([&] { buildNode(boxes, refs, left, begin, mid); },
+                             [&] { buildNode(boxes, refs, right, mid, end); });
+        node.box = left[0].box;
+        node.box.extend(right[0].box);
         appendSubtree(left);
         node.first = uint32_t(tree.size());
         appendSubtree(right);
     } else {
-        buildNode(boxes, centres, tree, begin, mid);
-        node.first = buildNode(boxes, centres, tree, mid, end);
+        const uint32_t l = buildNode(boxes, refs, tree, begin, mid);
+        node.first = buildNode(boxes, refs, tree, mid, end);
+        node.box = tree[l].box;
+        node.box.extend(tree[node.first].box);
     }
     node.count = 0;
     tree[self] = node;

@@ -164,7 +164,13 @@ class Bvh {
         uint32_t first = 0;  // leaf: first primitive; inner: the right child (left is next)
         uint32_t count = 0;  // leaf: > 0
     };
-    uint32_t buildNode(const std::vector<Bounds3>& boxes, const std::vector<Vec3>& centres,
+    /// A box's centre and index, what the build partitions (contiguous, so that the splits
+    /// read no box or centre through an index).
+    struct BuildRef {
+        float centre[3];
+        uint32_t index;
+    };
+    uint32_t buildNode(const std::vector<Bounds3>& boxes, std::vector<BuildRef>& refs,
                        std::vector<Node2>& tree, uint32_t begin, uint32_t end);
     uint32_t collapse(const std::vector<Node2>& tree, uint32_t self, bool shallowFirst);
     int stackNeed(uint32_t node, int base) const;
