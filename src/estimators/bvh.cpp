@@ -122,9 +122,10 @@ uint32_t Bvh::buildNode(const std::vector<Bounds3>& boxes, std::vector<BuildRef>
     Node2 node;
     // The split axis: the longest of the centres' box, read from the contiguous records. The
     // node's box is its children's union (computed after them), a leaf's its boxes' union.
-    float lo[3] = {refs[begin].centre[0], refs[begin].centre[1], refs[begin].centre[2]};
-    float hi[3] = {lo[0], lo[1], lo[2]};
-    for (uint32_t i = begin + 1; i < end; ++i)
+    // As Bounds3::extend from an empty box, so that a NaN centre is skipped as before.
+    const float inf = std::numeric_limits<float>::infinity();
+    float lo[3] = {inf, inf, inf}, hi[3] = {-inf, -inf, -inf};
+    for (uint32_t i = begin; i < end; ++i)
         for (int a = 0; a < 3; ++a) {
             lo[a] = std::min(lo[a], refs[i].centre[a]);
             hi[a] = std::max(hi[a], refs[i].centre[a]);
