@@ -54,8 +54,7 @@ void Bvh::build(const std::vector<Bounds3>& boxes, uint32_t leafSize, int stackL
     // The build partitions (centre, index) records in place; prims_ takes their order.
     std::vector<BuildRef> refs(boxes.size());
     tbb::parallel_for(size_t(0), boxes.size(), [&](size_t i) {
-        const Vec3 c = boxes[prims_[i]].center();
-        refs[i] = BuildRef{{c.x, c.y, c.z}, prims_[i]};
+        refs[i] = BuildRef{boxes[prims_[i]].center(), prims_[i]};
     });
     std::vector<Node2> tree;
     tree.reserve(2 * boxes.size() / leafSize_ + starts.size());
@@ -122,15 +121,9 @@ uint32_t Bvh::buildNode(const std::vector<Bounds3>& boxes, std::vector<BuildRef>
     Node2 node;
     // The split axis: the longest of the centres' box, read from the contiguous records. The
     // node's box is its children's union (computed after them), a leaf's its boxes' union.
-    // As Bounds3::extend from an empty box, so that a NaN centre is skipped as before.
-    const float inf = std::numeric_limits<float>::infinity();
-    float lo[3] = {inf, inf, inf}, hi[3] = {-inf, -inf, -inf};
-    for (uint32_t i = begin; i < end; ++i)
-        for (int a = 0; a < 3; ++a) {
-            lo[a] = std::min(lo[a], refs[i].centre[a]);
-            hi[a] = std::max(hi[a], refs[i].centre[a]);
-        }
-    const Vec3 ext(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+    Bounds3 cbox;
+    for (uint32_t i = begin; i < end; ++i) cbox.extend(refs[i].centre);
+    const Vec3 ext = cbox.hi - cbox.lo;
     const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
     // Depth stays below 34 for n < 2^32: median splits halve the range, and a range whose
     // centres coincide becomes a leaf however large it is.

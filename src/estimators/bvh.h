@@ -167,9 +167,10 @@ class Bvh {
     /// A box's centre and index, what the build partitions (contiguous, so that the splits
     /// read no box or centre through an index).
     struct BuildRef {
-        float centre[3];
+        Vec3 centre;
         uint32_t index;
     };
+    static_assert(sizeof(BuildRef) == 16, "one record a 16-byte slot");
     uint32_t buildNode(const std::vector<Bounds3>& boxes, std::vector<BuildRef>& refs,
                        std::vector<Node2>& tree, uint32_t begin, uint32_t end);
     uint32_t collapse(const std::vector<Node2>& tree, uint32_t self, bool shallowFirst);
