@@ -188,14 +188,33 @@ const std::vector<Case> kCases = {
      {"scene.json:3:",
       "cannot read bitmap 'image.exr': corrupt OpenEXR image: the channel list attribute ends "
       "inside a channel entry"}},
+    // OpenEXR reads a known type's attribute by its type and goes on from where that read
+    // stops, not from the announced end: a channel list without its closing empty name inside
+    // the attribute (2.9 KB, a mutation of a reference image) and a float attribute announcing
+    // 16,464 bytes (3.2 KB) made it parse the rest as other attributes, one announcing 1.9 and
+    // 1.6 GB (CI's fuzz run at a675f59, 2026-12-06, and local runs with seeds 1 and 11 and a
+    // 320 MB allocation limit).
+    {"fuzz_exr_image",
+     "chlist-without-end.exr",
+     2,
+     {"scene.json:3:",
+      "cannot read bitmap 'image.exr': corrupt OpenEXR image: the channel list attribute does "
+      "not end with an empty channel name within its size"}},
+    {"fuzz_exr_image",
+     "float-attribute-wrong-size.exr",
+     2,
+     {"scene.json:3:", "cannot read bitmap 'image.exr': corrupt OpenEXR image: header attribute '",
+      "' (float) has 16464 bytes, expected 4"}},
     // readExr allocated the pixels of the data window (12033 x 12033, 1.7 GB) before reading
-    // any from a 20 KB file.
+    // any from a 20 KB file. Its data window attribute also announces 14,864 bytes, which the
+    // attribute check now stops first; the window check is tested by
+    // JsonLoaderErrors.ImageHeaderWithAbsurdSizeIsAnError.
     {"fuzz_exr_image",
      "huge-window-small-file.exr",
      2,
      {"scene.json:3:",
-      "cannot read bitmap 'image.exr': corrupt OpenEXR image: 12033 x 12033 pixels need at "
-      "least 280606 bytes of compressed pixel data, more than the 20678 bytes of the file"}},
+      "cannot read bitmap 'image.exr': corrupt OpenEXR image: header attribute 'dataWindow' "
+      "(box2i) has 14864 bytes, expected 16"}},
     // PLY, first read through Assimp 5.2 behind a header check, now by unibeam's own reader
     // (scene/ply_reader.h). Assimp leaked on this malformed ASCII body; the reader names the
     // value that is no number.

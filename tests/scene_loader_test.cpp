@@ -876,6 +876,23 @@ TEST(JsonLoaderErrors, ImageHeaderWithAbsurdSizeIsAnError) {
                     contains(m, "cannot read OpenEXR image: "))
             << m;
     }
+
+    // A window within the size limits whose pixels cannot be in the file: 4000 x 4000 half
+    // pixels are 32 MB, more than 1032 (deflate's best ratio) times the file's bytes. 4 KB of
+    // zeros after the chunks give OpenEXR the 250 line offsets it reads on opening.
+    const int32_t corner4000 = 3999;
+    std::memcpy(&bytes[at + tag.size() + 4 + 8], &corner4000, 4);
+    std::memcpy(&bytes[at + tag.size() + 4 + 12], &corner4000, 4);
+    std::ofstream(exr, std::ios::binary | std::ios::trunc) << bytes << std::string(4096, '\0');
+    try {
+        readExr(exr);
+        ADD_FAILURE() << "readExr accepted a 4000 x 4000 data window in a tiny file";
+    } catch (const InputError& err) {
+        EXPECT_TRUE(contains(err.what(),
+                             "corrupt OpenEXR image: 4000 x 4000 pixels need at "
+                             "least 31007 bytes of compressed pixel data"))
+            << err.what();
+    }
 }
 
 // OpenEXR sizes its buffers from the channel list when it opens a file: readExr checks the
@@ -907,6 +924,60 @@ TEST(JsonLoaderErrors, OpenExrChannelListIsCheckedBeforeOpening) {
                 << m;
         }
     }
+}
+
+// OpenEXR reads an attribute of a known type by its type, not by the size the file
+// announces, and goes on from where that read stops (docs/fuzzing.md): a fixed-size attribute
+// whose size field says otherwise, and a channel list whose closing empty name is not its last
+// byte, are errors naming what is wrong.
+TEST(JsonLoaderErrors, OpenExrAttributeSizesMustBeWhatOpenExrReads) {
+    TempDir tmp;
+    const std::string exr = (tmp.path / "sizes.exr").string();
+    const std::string good = writtenTinyExr(exr);
+    auto patchedSize = [&](const std::string& nameAndType, int32_t size) {
+        std::string bytes = good;
+        const size_t at = bytes.find(nameAndType);
+        EXPECT_NE(at, std::string::npos) << nameAndType;
+        std::memcpy(&bytes[at + nameAndType.size()], &size, 4);
+        std::ofstream(exr, std::ios::binary | std::ios::trunc) << bytes;
+    };
+    patchedSize(std::string("pixelAspectRatio\0float\0", 23), 8);
+    try {
+        readExr(exr);
+        ADD_FAILURE() << "a float attribute of 8 bytes was accepted";
+    } catch (const InputError& e) {
+        EXPECT_TRUE(contains(e.what(),
+                             "corrupt OpenEXR image: header attribute "
+                             "'pixelAspectRatio' (float) has 8 bytes, expected 4"))
+            << e.what();
+    }
+    // The 2 x 2 file's channel list holds B, G, R (18 bytes each) and the empty name: 55 bytes.
+    const std::string chlist("channels\0chlist\0", 16);
+    int32_t listBytes = 0;
+    std::memcpy(&listBytes, &good[good.find(chlist) + chlist.size()], 4);
+    ASSERT_EQ(listBytes, 55);
+    patchedSize(chlist, 56);
+    try {
+        readExr(exr);
+        ADD_FAILURE() << "a channel list ending a byte before its size was accepted";
+    } catch (const InputError& e) {
+        EXPECT_TRUE(contains(e.what(),
+                             "the channel list attribute ends 1 bytes before its "
+                             "size says"))
+            << e.what();
+    }
+    patchedSize(chlist, 54);
+    try {
+        readExr(exr);
+        ADD_FAILURE() << "a channel list without its closing empty name was accepted";
+    } catch (const InputError& e) {
+        EXPECT_TRUE(contains(e.what(),
+                             "the channel list attribute does not end with an empty "
+                             "channel name within its size"))
+            << e.what();
+    }
+    std::ofstream(exr, std::ios::binary | std::ios::trunc) << good;
+    EXPECT_NO_THROW(readExr(exr));
 }
 
 // Preview and string-vector attributes must hold what they announce (OpenEXR allocates it on
@@ -958,7 +1029,18 @@ TEST(JsonLoaderErrors, OpenExrPreviewAndStringVectorMustFitTheirAttribute) {
     } catch (const InputError& e) {
         EXPECT_TRUE(contains(e.what(),
                              "header attribute 'preview' (preview) announces a 60000 x "
-                             "60000 preview, more than its 12 bytes"))
+                             "60000 preview (14400000008 bytes) in 12 bytes"))
+            << e.what();
+    }
+    // Announcing less than the attribute holds: OpenEXR would read the rest as attributes.
+    withAttribute("preview", "preview", le32(1) + le32(1) + std::string(8, 'p'));
+    try {
+        readExr(exr);
+        ADD_FAILURE() << "a 1 x 1 preview in 16 bytes was accepted";
+    } catch (const InputError& e) {
+        EXPECT_TRUE(contains(e.what(),
+                             "header attribute 'preview' (preview) announces a 1 x 1 "
+                             "preview (12 bytes) in 16 bytes"))
             << e.what();
     }
     withAttribute("notes", "stringvector", le32(2) + "ab" + le32(1000000) + "c");

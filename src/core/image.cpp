@@ -52,11 +52,16 @@ void checkImageSize(const std::string& path, const char* format, int64_t w, int6
 
 namespace {
 
-/// Walks the attributes of the OpenEXR header(s) (OpenEXR file layout: magic, version, then
-/// per header name\0 type\0 int32 size, value; an empty name ends a header, an empty header
-/// the headers of a multi-part file): each attribute's announced size must fit in the rest of
-/// the file. OpenEXR allocates what an attribute announces before reading it (found by
-/// fuzz_exr_image: a 647-byte file announcing a 1.6 GB attribute). Throws InputError.
+/// A name read from a file, as an error message shows it: its first 32 characters, each
+/// unprintable one as '?', and "..." when it is longer.
+std::string shownName(const std::string& name) {
+    std::string shown;
+    for (char c : name.substr(0, 32))
+        shown += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
+    if (name.size() > 32) shown += "...";
+    return shown;
+}
+
 /// An OpenEXR chlist attribute: per channel a name (NUL-terminated), int32 pixel type, uint8
 /// pLinear, 3 reserved bytes, int32 xSampling and ySampling; an empty name ends it. Throws
 /// InputError for a type other than uint, half, float, or a sampling other than 1 x 1.
@@ -69,7 +74,17 @@ void checkExrChannels(const std::string& path, const std::string& list) {
     };
     while (at < list.size()) {
         const size_t end = list.find('\0', at);
-        if (end == at) return;  // the empty name that ends the list
+        if (end == at) {  // the empty name that ends the list
+            // OpenEXR reads a channel list up to that name, whatever the attribute's size: a
+            // list that ends before the attribute does would have it read the rest of the
+            // attribute as the next attributes (found by fuzz_exr_image, docs/fuzzing.md).
+            if (at + 1 != list.size())
+                throw InputError(path, "corrupt OpenEXR image: the channel list attribute ends " +
+                                           std::to_string(list.size() - at - 1) +
+                                           " bytes before its size says (truncated or corrupt "
+                                           "file?)");
+            return;
+        }
         // A name or entry running past the attribute: OpenEXR would read on into the next
         // attributes as channel data.
         if (end == std::string::npos || end + 1 + 16 > list.size())
@@ -80,10 +95,7 @@ void checkExrChannels(const std::string& path, const std::string& list) {
         const int32_t type = int32At(end + 1);
         const int32_t xs = int32At(end + 9), ys = int32At(end + 13);
         if (type < 0 || type > 2 || xs != 1 || ys != 1) {
-            std::string shown;
-            for (char c : name.substr(0, 32))
-                shown += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
-            if (name.size() > 32) shown += "...";
+            const std::string shown = shownName(name);
             throw InputError(path, "OpenEXR channel '" + shown + "' has pixel type " +
                                        std::to_string(type) + " and sampling " +
                                        std::to_string(xs) + " x " + std::to_string(ys) +
@@ -91,6 +103,10 @@ void checkExrChannels(const std::string& path, const std::string& list) {
         }
         at = end + 1 + 16;
     }
+    // No empty name inside the attribute: OpenEXR would read on past it for one.
+    throw InputError(path,
+                     "corrupt OpenEXR image: the channel list attribute does not end with an "
+                     "empty channel name within its size (truncated or corrupt file?)");
 }
 
 /// A preview or string vector attribute must hold what it announces (see checkExrHeader).
@@ -101,9 +117,7 @@ void checkExrAttribute(const std::string& path, const std::string& name, const s
         return uint32_t(uint8_t(value[i])) | (uint32_t(uint8_t(value[i + 1])) << 8) |
                (uint32_t(uint8_t(value[i + 2])) << 16) | (uint32_t(uint8_t(value[i + 3])) << 24);
     };
-    std::string shown;
-    for (char c : name.substr(0, 32))
-        shown += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
+    const std::string shown = shownName(name);
     auto corrupt = [&](const std::string& what) {
         throw InputError(path, "corrupt OpenEXR image: header attribute '" + shown + "' (" + type +
                                    ") " + what + " (truncated or corrupt file?)");
@@ -111,9 +125,10 @@ void checkExrAttribute(const std::string& path, const std::string& name, const s
     if (type == "preview") {
         if (value.size() < 8) corrupt("is shorter than its size fields");
         const uint64_t need = 8u + uint64_t(u32At(0)) * uint64_t(u32At(4)) * 4u;
-        if (need > value.size())
+        if (need != value.size())
             corrupt("announces a " + std::to_string(u32At(0)) + " x " + std::to_string(u32At(4)) +
-                    " preview, more than its " + std::to_string(value.size()) + " bytes");
+                    " preview (" + std::to_string(need) + " bytes) in " +
+                    std::to_string(value.size()) + " bytes");
         return;
     }
     // stringvector: (int32 length, characters) until the attribute ends
@@ -129,6 +144,44 @@ void checkExrAttribute(const std::string& path, const std::string& name, const s
     }
 }
 
+/// Bytes that OpenEXR (3.1) reads for an attribute of a fixed-size type, whatever the size
+/// the file announces (OpenEXR's Xdr layout of each type); 0 for other types.
+int exrFixedAttributeSize(const std::string& type) {
+    static const std::pair<const char*, int> kSizes[] = {{"box2i", 16},
+                                                         {"box2f", 16},
+                                                         {"chromaticities", 32},
+                                                         {"compression", 1},
+                                                         {"deepImageState", 1},
+                                                         {"double", 8},
+                                                         {"envmap", 1},
+                                                         {"float", 4},
+                                                         {"int", 4},
+                                                         {"keycode", 28},
+                                                         {"lineOrder", 1},
+                                                         {"m33f", 36},
+                                                         {"m33d", 72},
+                                                         {"m44f", 64},
+                                                         {"m44d", 128},
+                                                         {"rational", 8},
+                                                         {"tiledesc", 9},
+                                                         {"timecode", 8},
+                                                         {"v2i", 8},
+                                                         {"v2f", 8},
+                                                         {"v2d", 16},
+                                                         {"v3i", 12},
+                                                         {"v3f", 12},
+                                                         {"v3d", 24}};
+    for (const auto& [name, bytes] : kSizes)
+        if (type == name) return bytes;
+    return 0;
+}
+
+/// Walks the attributes of the OpenEXR header(s) (OpenEXR file layout: magic, version, then
+/// per header name\0 type\0 int32 size, value; an empty name ends a header, an empty header
+/// the headers of a multi-part file): each attribute's announced size must fit in the rest of
+/// the file. OpenEXR allocates what an attribute announces before reading it (found by
+/// fuzz_exr_image: a 647-byte file announcing a 1.6 GB attribute), and each must announce what
+/// OpenEXR will read for it (see below). Throws InputError.
 void checkExrHeader(const std::string& path) {
     std::error_code ec;
     const uint64_t fileBytes = std::filesystem::file_size(path, ec);
@@ -159,15 +212,39 @@ void checkExrHeader(const std::string& path) {
                                          (uint32_t(sz[2]) << 16) | (uint32_t(sz[3]) << 24));
             const uint64_t at = uint64_t(in.tellg());
             if (size < 0 || at + uint64_t(size) > fileBytes) {
-                std::string shown;
-                for (char c : name.substr(0, 32))
-                    shown += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
-                if (name.size() > 32) shown += "...";
+                const std::string shown = shownName(name);
                 throw InputError(path, "corrupt OpenEXR image: header attribute '" + shown +
                                            "' announces " + std::to_string(size) +
                                            " bytes, more than the " +
                                            std::to_string(fileBytes - at) +
                                            " bytes left in the file (truncated or corrupt file?)");
+            }
+            // OpenEXR reads an attribute of a known type by its type, not by its announced
+            // size, and goes on from where that read stops: a size other than what the type
+            // reads makes it parse the rest as other attributes, one of which may then announce
+            // gigabytes (found by fuzz_exr_image: 1.6-1.9 GB from 3 KB files, docs/fuzzing.md).
+            if (const int expected = exrFixedAttributeSize(type); expected != 0) {
+                if (size != expected) {
+                    const std::string shown = shownName(name);
+                    throw InputError(path, "corrupt OpenEXR image: header attribute '" + shown +
+                                               "' (" + type + ") has " + std::to_string(size) +
+                                               " bytes, expected " + std::to_string(expected) +
+                                               " (truncated or corrupt file?)");
+                }
+            } else if (type == "idmanifest") {
+                // Its reader's layout differs between OpenEXR releases (a 4- or 8-byte
+                // uncompressed size before size - 4 bytes), so its extent is not known here.
+                throw InputError(path,
+                                 "OpenEXR header attribute of type idmanifest is not "
+                                 "supported in images read as textures or environment "
+                                 "maps");
+            } else if (type == "floatvector" && size % 4 != 0) {
+                throw InputError(path,
+                                 "corrupt OpenEXR image: a floatvector header attribute "
+                                 "has " +
+                                     std::to_string(size) +
+                                     " bytes, not a whole number of floats (truncated or "
+                                     "corrupt file?)");
             }
             if (type == "chlist" || type == "preview" || type == "stringvector") {
                 // Attributes whose contents OpenEXR sizes allocations from when the file is
