@@ -27,6 +27,7 @@
 #include "scene/shapes.h"
 #include "scene/vdb_grid.h"
 #include "tests/support/render_stats.h"
+#include "tests/support/temp_file.h"
 
 using namespace ub;
 using namespace ub::test;
@@ -424,8 +425,7 @@ TEST(AlbedoGrid, ValidationMessages) {
 }
 
 TEST(AlbedoGrid, VdbFloatAndVec3GridsLoadAsChannels) {
-    const fs::path dir = fs::temp_directory_path() / "unibeam_albedo_grid_vdb";
-    fs::create_directories(dir);
+    const fs::path dir = ub::test::scratchFolder("albedo_grid_vdb");
     const std::string path = (dir / "albedo.vdb").string();
     DenseFloatGrid r(3, 2, 2, 0.25f), gr(3, 2, 2, 0.5f), b(3, 2, 2, 0.75f);
     r.at(2, 1, 1) = 1.0f;

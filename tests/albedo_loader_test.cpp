@@ -21,6 +21,7 @@
 #include "scene/scene.h"
 #include "scene/vdb_grid.h"
 #include "scene/vol_grid.h"
+#include "tests/support/temp_file.h"
 #include "tests/support/vol_file.h"
 
 using namespace ub;
@@ -37,8 +38,8 @@ bool contains(const std::string& s, const std::string& part) {
 struct ScratchDir {
     fs::path path;
     ScratchDir() {
-        path = fs::temp_directory_path() /
-               ("unibeam_albedo_loader_" +
+        path = ub::test::processScratchDir() /
+               ("albedo_loader_" +
                 std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
         fs::create_directories(path);
     }

@@ -26,6 +26,7 @@
 #include "render/integrator.h"
 #include "render/progressive.h"
 #include "scene/io/json_loader.h"
+#include "tests/support/temp_file.h"
 
 using namespace ub;
 
@@ -254,8 +255,7 @@ TEST(ContributionGuard, UpbpCountsPerTechniqueAndWritesThem) {
         ImageMetadata meta;
         for (const auto& [key, value] : rejectionAttributes(r.rejected)) meta[key] = value;
         const std::string path =
-            (std::filesystem::temp_directory_path() / ("unibeam_guard_" + techniques[t] + ".exr"))
-                .string();
+            (ub::test::processScratchDir() / ("guard_" + techniques[t] + ".exr")).string();
         writeExr(path, r.image, meta, r.layers);
         ImageMetadata back;
         Image read = readExr(path, &back);

@@ -16,6 +16,7 @@
 #include "scene/io/json_loader.h"
 #include "scene/scene.h"
 #include "scene/vdb_grid.h"
+#include "tests/support/temp_file.h"
 
 namespace ub {
 namespace {
@@ -30,10 +31,10 @@ bool contains(const std::string& s, const std::string& part) {
 struct TempDir {
     fs::path path;
     TempDir() {
-        path = fs::temp_directory_path() /
-               ("ub_medium_scene_" +
-                std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        path =
+            ub::test::processScratchDir() /
+            ("medium_scene_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+             "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
         fs::create_directories(path);
     }
     ~TempDir() {

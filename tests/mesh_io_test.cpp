@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "scene/shapes.h"
+#include "tests/support/temp_file.h"
 
 using namespace ub;
 
@@ -145,7 +146,7 @@ TEST(MeshIo, PlyBinaryTetrahedron) {
 
 TEST(MeshIo, ExtensionIsCaseInsensitive) {
     std::ifstream src(meshPath("triangle.obj"));
-    std::string copy = testing::TempDir() + "ub_mesh_io_TRIANGLE.OBJ";
+    std::string copy = (ub::test::processScratchDir() / "ub_mesh_io_TRIANGLE.OBJ").string();
     {
         std::ofstream dst(copy);
         dst << src.rdbuf();
@@ -240,7 +241,8 @@ namespace {
 
 /// Writes `text` (binary) as a temporary .ply file and returns its path.
 std::string tempPly(const std::string& name, const std::string& text) {
-    const std::string path = testing::TempDir() + "ub_mesh_io_" + name + ".ply";
+    const std::string path =
+        (ub::test::processScratchDir() / ("ub_mesh_io_" + name + ".ply")).string();
     std::ofstream out(path, std::ios::binary);
     out << text;
     return path;
@@ -392,7 +394,7 @@ TEST(MeshIo, ErrorPlyCountsTheFileCannotHold) {
 // channel k of "NAME", other scalars as 1-channel attributes; face values are repeated for
 // every triangle of a polygon's fan and follow the triangles when degenerate ones are dropped.
 TEST(MeshIo, PlyMeshAttributesFollowMitsubasNaming) {
-    const std::string path = ::testing::TempDir() + "unibeam_attributes.ply";
+    const std::string path = (ub::test::processScratchDir() / "unibeam_attributes.ply").string();
     std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 5\n"
                            "property float x\nproperty float y\nproperty float z\n"
                            "property uchar red\nproperty uchar green\nproperty uchar blue\n"

@@ -14,6 +14,7 @@
 #include "scene/io/mitsuba_spectra.h"
 #include "scene/texture.h"
 #include "tests/support/mitsuba_text.h"
+#include "tests/support/temp_file.h"
 #include "tests/support/vol_file.h"
 
 using namespace ub;
@@ -345,7 +346,7 @@ TEST(MitsubaInterop, BitmapFilterAndWrapModesMatchMitsuba) {
 // path (the main scene's folder), as Mitsuba resolves it.
 TEST(MitsubaInterop, PathInAnIncludedFileFallsBackToTheSearchPath) {
     namespace fs = std::filesystem;
-    const fs::path dir = fs::temp_directory_path() / "unibeam_interop_path";
+    const fs::path dir = ub::test::scratchFolder("interop_path");
     fs::create_directories(dir / "inc");
     fs::create_directories(dir / "common" / "meshes");
     std::ofstream(dir / "common" / "meshes" / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
@@ -372,8 +373,7 @@ TEST(MitsubaInterop, PathInAnIncludedFileFallsBackToTheSearchPath) {
 // the voxel containing local point q is found at world point to_world(q).
 TEST(MitsubaInterop, GridVolumeToWorldMapsTheUnitCube) {
     namespace fs = std::filesystem;
-    const fs::path dir = fs::temp_directory_path() / "unibeam_interop_grid";
-    fs::create_directories(dir);
+    const fs::path dir = ub::test::scratchFolder("interop_grid");
     std::vector<float> values;
     for (int i = 0; i < 8; ++i) values.push_back(1.0f + float(i));  // x fastest
     ub::test::writeBinaryFile((dir / "g.vol").string(), ub::test::volBytes(2, 2, 2, 1, values));

@@ -19,6 +19,7 @@
 #include "scene/io/scene_loader.h"
 #include "scene/light.h"
 #include "scene/texture.h"
+#include "tests/support/temp_file.h"
 
 using namespace ub;
 namespace fs = std::filesystem;
@@ -31,9 +32,7 @@ bool contains(const std::string& s, const std::string& part) {
 
 /// A scratch directory for files that scenes include or reference.
 std::string scratchDir(const std::string& name) {
-    fs::path d = fs::temp_directory_path() / ("unibeam_mitsuba_test_" + name);
-    fs::create_directories(d);
-    return d.string();
+    return ub::test::scratchFolder("mitsuba_test_" + name).string();
 }
 
 void writeFile(const std::string& path, const std::string& text) {

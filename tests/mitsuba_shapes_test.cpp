@@ -20,6 +20,7 @@
 #include "scene/io/mitsuba_spectra.h"
 #include "scene/shapes.h"
 #include "tests/support/mitsuba_text.h"
+#include "tests/support/temp_file.h"
 
 using namespace ub;
 namespace fs = std::filesystem;
@@ -470,8 +471,7 @@ TEST(MitsubaInstancing, BadReferencesAndMembersAreErrorsAtTheirLine) {
 }
 
 TEST(MitsubaInstancing, CliExitsTwoNamingFileAndLine) {
-    const fs::path dir = fs::temp_directory_path() / "unibeam_mitsuba_instancing_cli";
-    fs::create_directories(dir);
+    const fs::path dir = ub::test::scratchFolder("mitsuba_instancing_cli");
     const std::string text = scene(std::string(kGroup) + R"(<shape type="instance">
   <ref id="grup"/>
 </shape>

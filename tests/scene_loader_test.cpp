@@ -17,6 +17,7 @@
 #include "scene/io/json_loader.h"
 #include "scene/io/json_positions.h"
 #include "scene/scene_summary.h"
+#include "tests/support/temp_file.h"
 
 using namespace ub;
 namespace fs = std::filesystem;
@@ -69,10 +70,9 @@ const char* kPoint = R"json({"type": "point", "position": [0, 0, 3], "intensity"
 struct TempDir {
     fs::path path;
     TempDir() {
-        path = fs::temp_directory_path() /
-               ("unibeam_loader_test_" +
-                std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        path = ub::test::processScratchDir() /
+               ("loader_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+                "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
         fs::create_directories(path);
     }
     ~TempDir() {

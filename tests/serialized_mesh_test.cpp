@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "scene/io/mitsuba_loader.h"
+#include "tests/support/temp_file.h"
 
 using namespace ub;
 namespace fs = std::filesystem;
@@ -114,8 +115,7 @@ Bytes file(const std::vector<ShapeSpec>& shapes) {
 }
 
 std::string writeTemp(const std::string& name, const Bytes& data) {
-    fs::path d = fs::temp_directory_path() / "unibeam_serialized_test";
-    fs::create_directories(d);
+    const fs::path d = ub::test::scratchFolder("serialized_test");
     std::string path = (d / name).string();
     std::ofstream(path, std::ios::binary) << data;
     return path;

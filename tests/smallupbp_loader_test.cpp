@@ -15,6 +15,7 @@
 #include "render/integrator.h"
 #include "scene/io/scene_loader.h"
 #include "scene/io/smallupbp_boundary.h"
+#include "tests/support/temp_file.h"
 
 namespace fs = std::filesystem;
 using namespace ub;
@@ -41,7 +42,7 @@ const char* const kCameraAbove =
 class TinyScene {
   public:
     explicit TinyScene(const std::string& name)
-        : dir_(fs::temp_directory_path() / ("unibeam_upbp_" + name)) {
+        : dir_(ub::test::processScratchDir() / ("upbp_" + name)) {
         fs::remove_all(dir_);
         fs::create_directories(dir_);
         mtl =

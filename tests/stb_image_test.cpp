@@ -122,7 +122,8 @@ TEST(StbImage, TruncatedCorruptAndUnknownFilesAreErrors) {
     EXPECT_NE(e.find("empty.tga"), std::string::npos) << e;
     e = errorOf(writeTemp("pic.gif", "GIF89a"));
     EXPECT_NE(e.find("unsupported image format '.gif'"), std::string::npos) << e;
-    e = errorOf((fs::temp_directory_path() / "unibeam_stb_image_test" / "missing.bmp").string());
+    e = errorOf(
+        (ub::test::processScratchDir() / "unibeam_stb_image_test" / "missing.bmp").string());
     EXPECT_NE(e.find("image file does not exist"), std::string::npos) << e;
 }
 

@@ -17,6 +17,7 @@
 #include "scene/bsdf.h"
 #include "scene/scene.h"
 #include "scene/shapes.h"
+#include "tests/support/temp_file.h"
 
 using namespace ub;
 
@@ -39,7 +40,7 @@ bool sameRgb(const Rgb& a, const Rgb& b, float tol = 1e-6f) {
 }
 
 std::string tempPath(const std::string& name) {
-    return (std::filesystem::temp_directory_path() / ("unibeam_texture_test_" + name)).string();
+    return (ub::test::processScratchDir() / ("texture_test_" + name)).string();
 }
 
 /// Writes a 16-bit grey + alpha PNG with libpng directly (writePng only writes 8-bit RGB).

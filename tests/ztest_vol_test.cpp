@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/ztest.h"
 #include "scene/vol_grid.h"
+#include "tests/support/temp_file.h"
 #include "tests/support/vol_file.h"
 
 using namespace ub;
@@ -163,7 +164,7 @@ TEST(ZTest, RejectsMismatchedSizesAndBadValues) {
 namespace {
 
 std::string writeVol(const std::string& name, const std::string& bytes) {
-    fs::path p = fs::temp_directory_path() / ("unibeam_vol_test_" + name + ".vol");
+    const fs::path p = ub::test::processScratchDir() / ("vol_test_" + name + ".vol");
     std::ofstream(p, std::ios::binary) << bytes;
     return p.string();
 }
