@@ -62,6 +62,13 @@ std::string shownName(const std::string& name) {
     return shown;
 }
 
+/// Throws the InputError of a header attribute that does not hold what it should.
+[[noreturn]] void throwCorruptExrAttribute(const std::string& path, const std::string& name,
+                                           const std::string& type, const std::string& what) {
+    throw InputError(path, "corrupt OpenEXR image: header attribute '" + shownName(name) + "' (" +
+                               type + ") " + what + " (truncated or corrupt file?)");
+}
+
 /// An OpenEXR chlist attribute: per channel a name (NUL-terminated), int32 pixel type, uint8
 /// pLinear, 3 reserved bytes, int32 xSampling and ySampling; an empty name ends it. Throws
 /// InputError for a type other than uint, half, float, or a sampling other than 1 x 1.
@@ -117,10 +124,8 @@ void checkExrAttribute(const std::string& path, const std::string& name, const s
         return uint32_t(uint8_t(value[i])) | (uint32_t(uint8_t(value[i + 1])) << 8) |
                (uint32_t(uint8_t(value[i + 2])) << 16) | (uint32_t(uint8_t(value[i + 3])) << 24);
     };
-    const std::string shown = shownName(name);
     auto corrupt = [&](const std::string& what) {
-        throw InputError(path, "corrupt OpenEXR image: header attribute '" + shown + "' (" + type +
-                                   ") " + what + " (truncated or corrupt file?)");
+        throwCorruptExrAttribute(path, name, type, what);
     };
     if (type == "preview") {
         if (value.size() < 8) corrupt("is shorter than its size fields");
@@ -224,13 +229,10 @@ void checkExrHeader(const std::string& path) {
             // reads makes it parse the rest as other attributes, one of which may then announce
             // gigabytes (found by fuzz_exr_image: 1.6-1.9 GB from 3 KB files, docs/fuzzing.md).
             if (const int expected = exrFixedAttributeSize(type); expected != 0) {
-                if (size != expected) {
-                    const std::string shown = shownName(name);
-                    throw InputError(path, "corrupt OpenEXR image: header attribute '" + shown +
-                                               "' (" + type + ") has " + std::to_string(size) +
-                                               " bytes, expected " + std::to_string(expected) +
-                                               " (truncated or corrupt file?)");
-                }
+                if (size != expected)
+                    throwCorruptExrAttribute(path, name, type,
+                                             "has " + std::to_string(size) + " bytes, expected " +
+                                                 std::to_string(expected));
             } else if (type == "idmanifest") {
                 // Its reader's layout differs between OpenEXR releases (a 4- or 8-byte
                 // uncompressed size before size - 4 bytes), so its extent is not known here.
@@ -239,12 +241,9 @@ void checkExrHeader(const std::string& path) {
                                  "supported in images read as textures or environment "
                                  "maps");
             } else if (type == "floatvector" && size % 4 != 0) {
-                throw InputError(path,
-                                 "corrupt OpenEXR image: a floatvector header attribute "
-                                 "has " +
-                                     std::to_string(size) +
-                                     " bytes, not a whole number of floats (truncated or "
-                                     "corrupt file?)");
+                throwCorruptExrAttribute(
+                    path, name, type,
+                    "has " + std::to_string(size) + " bytes, not a whole number of floats");
             }
             if (type == "chlist" || type == "preview" || type == "stringvector") {
                 // Attributes whose contents OpenEXR sizes allocations from when the file is
