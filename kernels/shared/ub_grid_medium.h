@@ -9,7 +9,10 @@
  * The voxel fetch: a type ub_grid_accessor and
  *   float ub_grid_probe(UB_PRIVATE ub_grid_accessor* acc, int i, int j, int k,
  *                       UB_PRIVATE int* inLeaf);
- * returning the density of voxel (i, j, k) and whether a leaf node holds it. OpenCL C: defined
+ * returning the density of voxel (i, j, k) and whether a leaf node holds it, and
+ *   float ub_grid_leaf_value(UB_PRIVATE const ub_grid_accessor* acc, ub_uint offset);
+ * returning voxel `offset` (x * 64 + y * 8 + z within the leaf) of the leaf that the last probe
+ * found (only called after a probe that set *inLeaf). OpenCL C: defined
  * below over CNanoVDB.h's read accessor (libnanovdb-dev; embedded with the kernels). Host:
  * src/estimators/grid_access.h defines them over NanoVDB's C++ accessor and then includes
  * this header.
@@ -36,6 +39,9 @@ UB_INLINE float ub_grid_probe(UB_PRIVATE ub_grid_accessor* acc, int i, int j, in
     const float v = cnanovdb_readaccessor_getValueF(acc, &c);
     *inLeaf = acc->mNode[0] != 0;
     return v;
+}
+UB_INLINE float ub_grid_leaf_value(UB_PRIVATE const ub_grid_accessor* acc, ub_uint offset) {
+    return ((const __global cnanovdb_node0F*)acc->mNode[0])->mVoxels[offset];
 }
 #elif !defined(UB_HOST_GRID_ACCESSOR)
 #error "include src/estimators/grid_access.h, which defines the host's grid accessor"
@@ -131,6 +137,47 @@ UB_INLINE float ub_grid_walk(ub_grid_info g, UB_PRIVATE ub_grid_accessor* acc, u
     for (;;) {
         int inLeaf = 0;
         const float density = ub_grid_probe(acc, v[0], v[1], v[2], &inLeaf);
+        if (inLeaf) {
+            /* In a leaf every step of the loop below is one voxel, and the other axes' voxel
+             * indices are clamped to themselves: only the crossed axis changes. So the walk
+             * stays here until it leaves the leaf, reads the leaf's values by offset instead
+             * of probing, and recomputes only the crossed axis's boundary parameter, with the
+             * same operations: the same pieces, bit for bit (tests/medium_test.cpp). */
+            int leafLo[3], ended = 0;
+            float tb[3], dens = density;
+            for (int a = 0; a < 3; ++a) {
+                leafLo[a] = v[a] & ~7;
+                tb[a] = step[a] == 0 ? INFINITY
+                                     : ((float)(step[a] > 0 ? v[a] + 1 : v[a]) - P[a]) * invD[a];
+            }
+            for (;;) {
+                float tNext = tExit;
+                int axis = -1;
+                for (int a = 0; a < 3; ++a) {
+                    const int nearer = tb[a] < tNext;
+                    axis = nearer ? a : axis;
+                    tNext = nearer ? tb[a] : tNext;
+                }
+                tNext = ub_fmax(tNext, t);
+                if (tNext > t) UB_GRID_PIECE(t, tNext, g.densityScale * dens)
+                if (axis < 0) {
+                    ended = 1; /* reached tExit inside this voxel */
+                    break;
+                }
+                t = tNext;
+                v[axis] += step[axis];
+                if (v[axis] < g.lo[axis] || v[axis] >= g.hi[axis]) {
+                    ended = 1;
+                    break;
+                }
+                if ((v[axis] & ~7) != leafLo[axis]) break; /* the next voxel is past the leaf */
+                tb[axis] = ((float)(step[axis] > 0 ? v[axis] + 1 : v[axis]) - P[axis]) * invD[axis];
+                dens = ub_grid_leaf_value(
+                    acc, (ub_uint)((v[0] & 7) << 6 | (v[1] & 7) << 3 | (v[2] & 7)));
+            }
+            if (ended) break;
+            continue;
+        }
         const int dim = inLeaf ? 1 : 8;
         int blockLo[3];
         for (int a = 0; a < 3; ++a) blockLo[a] = inLeaf ? v[a] : (v[a] & ~7);

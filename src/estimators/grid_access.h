@@ -12,13 +12,18 @@
 
 struct ub_grid_accessor {
     decltype(std::declval<const nanovdb::FloatGrid&>().getAccessor()) acc;
+    const nanovdb::NanoLeaf<float>* leaf = nullptr;  ///< what the last probe found
 };
 
 static inline float ub_grid_probe(ub_grid_accessor* a, int i, int j, int k, int* inLeaf) {
     const nanovdb::Coord ijk(i, j, k);
-    const auto* leaf = a->acc.probeLeaf(ijk);
-    *inLeaf = leaf != nullptr;
-    return leaf ? leaf->getValue(ijk) : a->acc.getValue(ijk);
+    a->leaf = a->acc.probeLeaf(ijk);
+    *inLeaf = a->leaf != nullptr;
+    return a->leaf ? a->leaf->getValue(ijk) : a->acc.getValue(ijk);
+}
+
+static inline float ub_grid_leaf_value(const ub_grid_accessor* a, uint32_t offset) {
+    return a->leaf->getValue(offset);
 }
 
 #define UB_HOST_GRID_ACCESSOR 1

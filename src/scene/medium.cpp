@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -26,6 +27,56 @@ void checkG(float g) {
 /// Leaf nodes of the default NanoVDB float tree are 8^3 voxels; a voxel whose block has no
 /// leaf has the value of the enclosing tile (or the background) over the whole block.
 constexpr int kLeafDim = 8;
+
+enum class LeafWalk { kLeft, kEnded, kStopped };
+
+/// forEachPiece's walk through the voxels of one leaf of a grey grid, from voxel v at t, until
+/// it leaves the leaf (kLeft: v and *t are the next voxel and where it starts), reaches tExit
+/// or the grid's box (kEnded), or a visit returns false (kStopped). In a leaf every step of
+/// forEachPiece's general loop is one voxel, and its other axes' voxel indices are clamped
+/// to themselves, so only the crossed axis changes: this loop reads the leaf's values by
+/// offset instead of probing the accessor, and recomputes only the crossed axis's boundary
+/// parameter, with the general loop's operations. Same pieces, bit for bit: tests/
+/// medium_test.cpp compares them with the kernels' walk (kernels/shared/ub_grid_medium.h, which
+/// has the same loop) and with brute-force boundaries. Measured in docs/performance.md
+/// (session 43).
+template <typename Leaf, typename Visit>
+LeafWalk walkLeaf(const Leaf& leaf, const Vec3& P, const float invD[3], const int step[3],
+                  const int lo[3], const int hi[3], float tExit, float densityScale,
+                  const Rgb& albedo, int v[3], float* t, Visit& visit) {
+    constexpr float kNever = std::numeric_limits<float>::infinity();
+    int leafLo[3];
+    float tb[3];
+    for (int a = 0; a < 3; ++a) {
+        leafLo[a] = v[a] & ~(kLeafDim - 1);
+        tb[a] = step[a] == 0 ? kNever : (float(step[a] > 0 ? v[a] + 1 : v[a]) - P[a]) * invD[a];
+    }
+    for (;;) {
+        const uint32_t offset = uint32_t((v[0] & (kLeafDim - 1)) << 6 |
+                                         (v[1] & (kLeafDim - 1)) << 3 | (v[2] & (kLeafDim - 1)));
+        const float density = leaf.getValue(offset);
+        // The general loop's choice: the first axis whose boundary is strictly nearer than
+        // tExit and the axes before it.
+        float tNext = tExit;
+        int axis = -1;
+        for (int a = 0; a < 3; ++a) {
+            const bool nearer = tb[a] < tNext;
+            axis = nearer ? a : axis;
+            tNext = nearer ? tb[a] : tNext;
+        }
+        tNext = std::max(tNext, *t);
+        if (tNext > *t) {
+            const Rgb sigmaT = Rgb(density) * densityScale;
+            if (!visit(*t, tNext, sigmaT, albedo * sigmaT)) return LeafWalk::kStopped;
+        }
+        if (axis < 0) return LeafWalk::kEnded;
+        *t = tNext;
+        v[axis] += step[axis];
+        if (v[axis] < lo[axis] || v[axis] >= hi[axis]) return LeafWalk::kEnded;
+        if ((v[axis] & ~(kLeafDim - 1)) != leafLo[axis]) return LeafWalk::kLeft;
+        tb[axis] = (float(step[axis] > 0 ? v[axis] + 1 : v[axis]) - P[axis]) * invD[axis];
+    }
+}
 
 /// Calls visit(ta, tb, sigmaT, sigmaS) for consecutive pieces [ta, tb) of constant
 /// coefficients covering [0, tMax] in order, until visit returns false. Zero-length pieces
@@ -84,6 +135,13 @@ bool forEachPiece(const Medium& m, const Vec3& origin, const Vec3& dir, float tM
     for (;;) {
         const nanovdb::Coord ijk(v[0], v[1], v[2]);
         const auto* leaf = acc.probeLeaf(ijk);
+        if (leaf && !rgb) {
+            const LeafWalk w = walkLeaf(*leaf, P, invD, step, lo, hi, tExit, m.densityScale,
+                                        m.albedo, v, &t, visit);
+            if (w == LeafWalk::kStopped) return false;
+            if (w == LeafWalk::kEnded) break;
+            continue;  // v is the first voxel past the leaf
+        }
         Rgb density(leaf ? leaf->getValue(ijk) : acc.getValue(ijk));
         bool inLeaf = leaf != nullptr;
         if (rgb) {  // a voxel step wherever any channel has a leaf; elsewhere all are constant
