@@ -23,6 +23,7 @@
 #define UB_GRID_MEDIUM_H
 
 #include "ub_beam_table.h"
+#include "ub_grid_dda.h"
 #include "ub_medium_homogeneous.h"
 
 #ifdef __OPENCL_C_VERSION__
@@ -147,17 +148,11 @@ UB_INLINE float ub_grid_walk(ub_grid_info g, UB_PRIVATE ub_grid_accessor* acc, u
             float tb[3], dens = density;
             for (int a = 0; a < 3; ++a) {
                 leafLo[a] = v[a] & ~7;
-                tb[a] = step[a] == 0 ? INFINITY
-                                     : ((float)(step[a] > 0 ? v[a] + 1 : v[a]) - P[a]) * invD[a];
+                tb[a] = step[a] == 0 ? INFINITY : ub_dda_exit(v[a], step[a], P[a], invD[a]);
             }
             for (;;) {
-                float tNext = tExit;
-                int axis = -1;
-                for (int a = 0; a < 3; ++a) {
-                    const int nearer = tb[a] < tNext;
-                    axis = nearer ? a : axis;
-                    tNext = nearer ? tb[a] : tNext;
-                }
+                float tNext;
+                const int axis = ub_dda_nearest(tb, tExit, &tNext);
                 tNext = ub_fmax(tNext, t);
                 if (tNext > t) UB_GRID_PIECE(t, tNext, g.densityScale * dens)
                 if (axis < 0) {
@@ -171,7 +166,7 @@ UB_INLINE float ub_grid_walk(ub_grid_info g, UB_PRIVATE ub_grid_accessor* acc, u
                     break;
                 }
                 if ((v[axis] & ~7) != leafLo[axis]) break; /* the next voxel is past the leaf */
-                tb[axis] = ((float)(step[axis] > 0 ? v[axis] + 1 : v[axis]) - P[axis]) * invD[axis];
+                tb[axis] = ub_dda_exit(v[axis], step[axis], P[axis], invD[axis]);
                 dens = ub_grid_leaf_value(
                     acc, (ub_uint)((v[0] & 7) << 6 | (v[1] & 7) << 3 | (v[2] & 7)));
             }

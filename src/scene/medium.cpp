@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "kernels/shared/ub_grid_dda.h"
 #include "kernels/shared/ub_medium_homogeneous.h"
 #include "scene/albedo_grid.h"
 #include "scene/medium_trilinear.h"
@@ -49,21 +50,14 @@ LeafWalk walkLeaf(const Leaf& leaf, const Vec3& P, const float invD[3], const in
     float tb[3];
     for (int a = 0; a < 3; ++a) {
         leafLo[a] = v[a] & ~(kLeafDim - 1);
-        tb[a] = step[a] == 0 ? kNever : (float(step[a] > 0 ? v[a] + 1 : v[a]) - P[a]) * invD[a];
+        tb[a] = step[a] == 0 ? kNever : ub_dda_exit(v[a], step[a], P[a], invD[a]);
     }
     for (;;) {
         const uint32_t offset = uint32_t((v[0] & (kLeafDim - 1)) << 6 |
                                          (v[1] & (kLeafDim - 1)) << 3 | (v[2] & (kLeafDim - 1)));
         const float density = leaf.getValue(offset);
-        // The general loop's choice: the first axis whose boundary is strictly nearer than
-        // tExit and the axes before it.
-        float tNext = tExit;
-        int axis = -1;
-        for (int a = 0; a < 3; ++a) {
-            const bool nearer = tb[a] < tNext;
-            axis = nearer ? a : axis;
-            tNext = nearer ? tb[a] : tNext;
-        }
+        float tNext;
+        const int axis = ub_dda_nearest(tb, tExit, &tNext);  // the general loop's choice
         tNext = std::max(tNext, *t);
         if (tNext > *t) {
             const Rgb sigmaT = Rgb(density) * densityScale;
@@ -74,7 +68,7 @@ LeafWalk walkLeaf(const Leaf& leaf, const Vec3& P, const float invD[3], const in
         v[axis] += step[axis];
         if (v[axis] < lo[axis] || v[axis] >= hi[axis]) return LeafWalk::kEnded;
         if ((v[axis] & ~(kLeafDim - 1)) != leafLo[axis]) return LeafWalk::kLeft;
-        tb[axis] = (float(step[axis] > 0 ? v[axis] + 1 : v[axis]) - P[axis]) * invD[axis];
+        tb[axis] = ub_dda_exit(v[axis], step[axis], P[axis], invD[axis]);
     }
 }
 
