@@ -150,6 +150,11 @@ TEST(NestedMedia, GlassOfMilkInFogHasTheRightMediumEverywhere) {
         scene->traceMedia(ray, &stack, &trace, &hit);
         ASSERT_TRUE(trace.hitSurface);
         ASSERT_FALSE(trace.overflow);
+        // The real hit comes back to be completed where a path reaches it.
+        EXPECT_TRUE(hit.detailPending);
+        EXPECT_NEAR(hit.pos.y, e.hitY, 1e-4f);
+        scene->completeHit(trace.hitRay, &hit);
+        EXPECT_FALSE(hit.detailPending);
         EXPECT_NEAR(hit.pos.y, e.hitY, 1e-4f);
         ASSERT_EQ(trace.count, int(e.media.size()));
         for (int k = 0; k < trace.count; ++k) EXPECT_EQ(trace.segments[k].mediumId, e.media[k]);

@@ -51,6 +51,7 @@ TEST(NestedMedia, ShadowRaysReachAnAreaLightJustBeyondAnImaginaryBoundary) {
         Hit hit;
         fog->traceMedia(r, &stack, &trace, &hit);
         if (!trace.hitSurface || hit.materialId < 0) continue;
+        fog->completeHit(trace.hitRay, &hit);
         Vec3 dirToLight;
         float dist = 0, pdfW = 0, emissionPdfW = 0, cosLight = 0;
         Rgb le = light.illuminate(fog->sceneSphere, hit.pos, rng.uniform2(), &dirToLight, &dist,

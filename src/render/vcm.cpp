@@ -559,6 +559,7 @@ bool VertexCM::traceToVertex(Rng& rng, SubPath& state, PathVertex* v, bool* esca
         *escaped = true;
         return false;
     }
+    scene_.completeHit(trace.hitRay, &v->hit);
     v->pos = v->hit.pos;
     return true;
 }

@@ -214,6 +214,7 @@ Rgb VolPathTracer::tracePixel(int x, int y, int iteration) const {
         }
 
         // ---- Surface vertex ----
+        scene_.completeHit(trace.hitRay, &hit);
         if (hit.lightId >= 0 && pathLength >= minLength) {
             const Light& light = scene_.lights[size_t(hit.lightId)];
             float directPdfA = 0.0f, emissionPdfW = 0.0f;

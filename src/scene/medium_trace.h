@@ -18,6 +18,7 @@
 #include <string>
 
 #include "core/vec.h"
+#include "scene/camera.h"
 
 namespace ub {
 
@@ -53,6 +54,8 @@ struct MediumTrace {
     /// sampling with the same numbers scatters inside it, at the same distance as on the
     /// whole chain. hitSurface is false and the trace did not escape.
     bool truncated = false;
+    /// The ray that met the real hit (hitSurface): Scene::completeHit's argument.
+    Ray hitRay;
 };
 
 /// Transmittance of a segment chain a -> b and its distance pdfs (products over segments).

@@ -690,6 +690,12 @@ void Scene::commit() {
 }
 
 bool Scene::intersect(const Ray& ray, Hit* hit) const {
+    if (!intersectNearest(ray, hit)) return false;
+    completeHit(ray, hit);
+    return true;
+}
+
+bool Scene::intersectNearest(const Ray& ray, Hit* hit) const {
     if (!impl_->committed) throw std::logic_error("Scene::intersect called before commit()");
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -703,31 +709,40 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
 
     const uint32_t id = rh.hit.geomID;
-    const ShapeGeom& g = impl_->geoms[id];
     hit->dist = rh.ray.tfar;
     hit->shapeId = id;
     hit->primId = rh.hit.primID;
     hit->materialId = shapes[id].materialId;
     hit->lightId = shapes[id].lightId;
     hit->attribute = Rgb(0.0f);
+    hit->baryU = rh.hit.u;
+    hit->baryV = rh.hit.v;
+    hit->pos = ray.org + rh.ray.tfar * ray.dir;
+    hit->detailPending = true;
+    return true;
+}
 
+void Scene::completeHit(const Ray& ray, Hit* hit) const {
+    if (!hit->detailPending) return;
+    hit->detailPending = false;
+    const ShapeGeom& g = impl_->geoms[hit->shapeId];
     if (g.sdf) {
         // The hit point is not projected onto the level set (as Mitsuba): its error is the
         // root finder's 1e-5 along the ray, below the origin offset of the next ray.
-        hit->pos = ray.org + rh.ray.tfar * ray.dir;
-        g.sdf->normals(rh.hit.primID, hit->pos, &hit->geoNormal, &hit->shadingNormal);
+        hit->pos = ray.org + hit->dist * ray.dir;
+        g.sdf->normals(hit->primId, hit->pos, &hit->geoNormal, &hit->shadingNormal);
         hit->uv = Vec2(0.0f, 0.0f);  // no parameterisation, as in Mitsuba
         hit->tangent = Vec3(0.0f);
         if (needsTangent(hit->materialId)) {
             hit->tangent = Frame(hit->shadingNormal).s;  // any: the shape has no dp/du
         }
-        return true;
+        return;
     }
     if (g.isSphere) {
         // Re-project the hit onto the sphere (double precision) so that the point
         // lies within an ulp or two of the surface.
         const Vec3& c = g.sphere->center;
-        double t = rh.ray.tfar;
+        double t = hit->dist;
         double px = double(ray.org.x) + t * ray.dir.x - c.x;
         double py = double(ray.org.y) + t * ray.dir.y - c.y;
         double pz = double(ray.org.z) + t * ray.dir.z - c.z;
@@ -751,14 +766,14 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
             hit->tangent = shadingTangent(hit->shadingNormal, dpdu);
             if (perturbs(hit->materialId)) perturbShadingNormal(hit, dpdu, dpdv);
         }
-        return true;
+        return;
     }
 
-    const uint32_t* tri = g.indices + 3 * size_t(rh.hit.primID);
+    const uint32_t* tri = g.indices + 3 * size_t(hit->primId);
     const Vec3 p0 = impl_->vertex(g, tri[0]), p1 = impl_->vertex(g, tri[1]),
                p2 = impl_->vertex(g, tri[2]);
     // Embree's barycentrics: p = (1-u-v) p0 + u p1 + v p2.
-    const float b1 = rh.hit.u, b2 = rh.hit.v, b0 = 1.0f - b1 - b2;
+    const float b1 = hit->baryU, b2 = hit->baryV, b0 = 1.0f - b1 - b2;
     hit->pos = b0 * p0 + b1 * p1 + b2 * p2;
     Vec3 ng = cross(p1 - p0, p2 - p0);
     float ngLen = length(ng);
@@ -786,7 +801,7 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
         float rgb[3];
         for (int k = 0; k < c; ++k)
             rgb[k] = a.perFace
-                         ? value(rh.hit.primID, k)
+                         ? value(hit->primId, k)
                          : b0 * value(tri[0], k) + b1 * value(tri[1], k) + b2 * value(tri[2], k);
         hit->attribute = c == 1 ? Rgb(rgb[0]) : Rgb(rgb[0], rgb[1], rgb[2]);
     }
@@ -812,7 +827,6 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
         hit->tangent = shadingTangent(hit->shadingNormal, dpdu);
         if (perturbs(hit->materialId)) perturbShadingNormal(hit, dpdu, dpdv);
     }
-    return true;
 }
 
 bool Scene::perturbs(int materialId) const {

@@ -69,6 +69,11 @@ struct Hit {
     uint32_t primId = 0;
     int materialId = -1;
     int lightId = -1;  ///< index into Scene::lights if the shape is emissive, else -1
+    /// Set by Scene::intersectNearest: only dist, shapeId, primId, materialId, lightId and the
+    /// ray point pos = org + dist dir are set; Scene::completeHit fills in the rest (from
+    /// Embree's barycentrics below) and clears it.
+    bool detailPending = false;
+    float baryU = 0.0f, baryV = 0.0f;  ///< Embree's: p = (1-u-v) p0 + u p1 + v p2
 };
 
 /// How the medium of a path changes where it crosses a medium boundary.
@@ -194,6 +199,15 @@ class Scene {
     // ---- queries (thread-safe after commit) ----
     /// Closest hit along ray in (ray.tMin, ray.tMax). Returns false on a miss.
     bool intersect(const Ray& ray, Hit* hit) const;
+    /// The same hit, with only what tells where it is and what it is (Hit::detailPending):
+    /// a medium walk whose path scatters before the surface needs no more. The rest (point on
+    /// the triangle, normals, uv, tangent, attribute) reads the mesh's indices and vertices,
+    /// two dependent cache misses that were half of intersect()'s own time (perf, the
+    /// bunny's bb1d camera pass).
+    bool intersectNearest(const Ray& ray, Hit* hit) const;
+    /// Completes a hit of intersectNearest along the same ray (nothing if already complete):
+    /// the same values as intersect() gives.
+    void completeHit(const Ray& ray, Hit* hit) const;
     /// True if anything blocks the open segment between the two points. Each end is
     /// offset along its geometric normal (pass a zero vector for points not on a
     /// surface, e.g. the camera or a point light) towards the other end.
@@ -267,7 +281,9 @@ class Scene {
     /// Traces ray to the next real surface (or to infinity), recording the medium segments
     /// it crosses; imaginary and skipped boundaries update *stack and create no vertex.
     /// On return *stack is the stack on the incoming side of the real hit, *hit the hit
-    /// (valid if trace->hitSurface; hit->dist is the distance from the last crossing).
+    /// (valid if trace->hitSurface; hit->dist is the distance from the last crossing), still
+    /// to be completed (Scene::completeHit with trace->hitRay) where the path reaches it. The
+    /// last segment ends at the ray's point at hit->dist.
     ///
     /// lookahead (optional): a copy of the generator that will sample free flight along the
     /// chain (render/medium_walk.h: two numbers per medium segment, channel then distance).

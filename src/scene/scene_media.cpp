@@ -377,7 +377,7 @@ void Scene::traceMedia(const Ray& ray, MediumStack* stack, MediumTrace* trace, H
             rc.tMax = std::min(r.tMax, r.tMin + cut + margin);
         }
         Hit h;
-        if (!intersect(rc, &h)) {
+        if (!intersectNearest(rc, &h)) {
             // Escaped, or cut: then sampling stops in this segment.
             seg.length = kMediumFarDistance;
             trace->distance = kInf;
@@ -385,14 +385,21 @@ void Scene::traceMedia(const Ray& ray, MediumStack* stack, MediumTrace* trace, H
             ++trace->count;
             return;
         }
-        seg.length = length(h.pos - segStart);
-        trace->distance += seg.length;
         ++trace->count;
         if (realFor(h.shapeId, stack->priority())) {
+            // The path may scatter before it: the hit is completed where it is reached. The
+            // segment ends at the ray's point (h.pos before completion), which differs from
+            // the triangle's point by the rounding of the two.
+            seg.length = length(h.pos - segStart);
+            trace->distance += seg.length;
             trace->hitSurface = true;
+            trace->hitRay = rc;
             *hit = h;
             return;
         }
+        completeHit(rc, &h);
+        seg.length = length(h.pos - segStart);
+        trace->distance += seg.length;
         seg.crossingShape = int32_t(h.shapeId);
         seg.crossingEntering = dot(r.dir, h.geoNormal) < 0.0f ? 1 : 0;
         if (!crossBoundary(h.shapeId, h.geoNormal, r.dir, stack)) {
