@@ -695,44 +695,10 @@ bool Scene::intersect(const Ray& ray, Hit* hit) const {
     return true;
 }
 
-namespace {
-
-/// intersectNearest's context: Embree's first, so the filter reaches the shapes through the
-/// context pointer it is given.
-struct NearestContext {
-    RTCIntersectContext embree;
-    const ShapeGeom* geoms;
-    size_t geomCount;
-};
-
-/// Called by Embree at each triangle hit it accepts on its way to the nearest (usually one or
-/// two a ray). It accepts the hit and prefetches the triangle's vertices and normals, which
-/// completeHit reads: their loads, two dependent cache misses after the traversal (Embree
-/// traverses its own copy of the triangles), then overlap the rest of the traversal.
-void prefetchHitFilter(const RTCFilterFunctionNArguments* args) {
-    if (args->N != 1 || args->valid[0] == 0) return;
-    const auto* c = reinterpret_cast<const NearestContext*>(args->context);
-    const unsigned geomID = RTCHitN_geomID(args->hit, 1, 0);
-    if (geomID >= c->geomCount) return;
-    const ShapeGeom& g = c->geoms[geomID];
-    if (!g.indices) return;
-    const uint32_t* tri = g.indices + 3 * size_t(RTCHitN_primID(args->hit, 1, 0));
-    for (int k = 0; k < 3; ++k) {
-        __builtin_prefetch(g.vertices + 3 * size_t(tri[k]));
-        if (!g.normals.empty()) __builtin_prefetch(&g.normals[tri[k]]);
-    }
-}
-
-}  // namespace
-
 bool Scene::intersectNearest(const Ray& ray, Hit* hit) const {
     if (!impl_->committed) throw std::logic_error("Scene::intersect called before commit()");
-    NearestContext c;
-    rtcInitIntersectContext(&c.embree);
-    c.embree.filter = prefetchHitFilter;
-    c.geoms = impl_->geoms.data();
-    c.geomCount = impl_->geoms.size();
-    RTCIntersectContext& ctx = c.embree;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
     RTCRayHit rh;
     rh.ray = embreeRay(ray.org, ray.dir, ray.tMin, ray.tMax);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
