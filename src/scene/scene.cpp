@@ -714,7 +714,6 @@ bool Scene::intersectNearest(const Ray& ray, Hit* hit) const {
     hit->primId = rh.hit.primID;
     hit->materialId = shapes[id].materialId;
     hit->lightId = shapes[id].lightId;
-    hit->attribute = Rgb(0.0f);
     hit->baryU = rh.hit.u;
     hit->baryV = rh.hit.v;
     hit->pos = ray.org + rh.ray.tfar * ray.dir;
@@ -725,6 +724,7 @@ bool Scene::intersectNearest(const Ray& ray, Hit* hit) const {
 void Scene::completeHit(const Ray& ray, Hit* hit) const {
     if (!hit->detailPending) return;
     hit->detailPending = false;
+    hit->attribute = Rgb(0.0f);
     const ShapeGeom& g = impl_->geoms[hit->shapeId];
     if (g.sdf) {
         // The hit point is not projected onto the level set (as Mitsuba): its error is the

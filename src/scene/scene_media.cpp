@@ -386,20 +386,20 @@ void Scene::traceMedia(const Ray& ray, MediumStack* stack, MediumTrace* trace, H
             return;
         }
         ++trace->count;
-        if (realFor(h.shapeId, stack->priority())) {
-            // The path may scatter before it: the hit is completed where it is reached. The
-            // segment ends at the ray's point (h.pos before completion), which differs from
-            // the triangle's point by the rounding of the two.
-            seg.length = length(h.pos - segStart);
-            trace->distance += seg.length;
+        // A crossing is completed now (its point and normal spawn the next ray); a real hit
+        // where the path reaches it, since the path may scatter before. Its segment ends at
+        // the ray's point (h.pos before completion), which differs from the triangle's point
+        // by the rounding of the two.
+        const bool real = realFor(h.shapeId, stack->priority());
+        if (!real) completeHit(rc, &h);
+        seg.length = length(h.pos - segStart);
+        trace->distance += seg.length;
+        if (real) {
             trace->hitSurface = true;
             trace->hitRay = rc;
             *hit = h;
             return;
         }
-        completeHit(rc, &h);
-        seg.length = length(h.pos - segStart);
-        trace->distance += seg.length;
         seg.crossingShape = int32_t(h.shapeId);
         seg.crossingEntering = dot(r.dir, h.geoNormal) < 0.0f ? 1 : 0;
         if (!crossBoundary(h.shapeId, h.geoNormal, r.dir, stack)) {
