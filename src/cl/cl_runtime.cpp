@@ -15,6 +15,7 @@
 #include <string>
 
 #include "cl/embedded_kernels.h"
+#include "cl/library_pages.h"
 #include "core/file_status.h"
 #include "estimators/bvh.h"
 #include "estimators/hash_grid.h"
@@ -187,6 +188,9 @@ std::vector<ClDeviceDescription> listClDevices(std::string* error) {
     }
     std::vector<cl_platform_id> platforms(np);
     clGetPlatformIDs(np, platforms.data(), nullptr);
+    // The first call loaded the driver: LLVM's text read at load time goes back at once, so
+    // that it does not stay resident beside the scene (cl/library_pages.h).
+    releaseLibraryText(openClCompilerLibraries());
     for (cl_uint p = 0; p < np; ++p) {
         cl_uint nd = 0;
         if (clGetDeviceIDs(platforms[p], CL_DEVICE_TYPE_ALL, 0, nullptr, &nd) != CL_SUCCESS)
@@ -346,6 +350,9 @@ ClRuntime::ClRuntime(int platform, int device, const std::string& cacheDir,
     surf_ = clCreateKernel(program_, "ub_surf_estimate", &err);
     check(err, "clCreateKernel(ub_surf_estimate)");
     checkLayout();
+    // The program is built and its kernels have run (the probe): what building touched of
+    // LLVM's text goes back too (cl/library_pages.h).
+    releasedLibraryKb_ = releaseLibraryText(openClCompilerLibraries());
 }
 
 namespace {

@@ -81,6 +81,9 @@ class ClRuntime {
     /// How the program was obtained: "built", "built, cached as FILE", "from cache FILE", or
     /// why the cache was not used.
     const std::string& programNote() const { return programNote_; }
+    /// Resident kilobytes of the OpenCL compiler's text (LLVM, Clang) given back once the
+    /// program was ready (cl/library_pages.h).
+    size_t releasedLibraryKb() const { return releasedLibraryKb_; }
 
     /// The estimators as kernels (kernels/pp3d.cl, kernels/beams.cl; pb2d, bp2d and bb1d for
     /// homogeneous media only): (*out)[i] is query i's estimate, as the host twin computes it
@@ -152,6 +155,7 @@ class ClRuntime {
 
     ClDeviceDescription desc_;
     std::string programNote_;
+    size_t releasedLibraryKb_ = 0;
     cl_context context_ = nullptr;
     cl_command_queue queue_ = nullptr;
     cl_program program_ = nullptr;
