@@ -234,14 +234,20 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
                                __global float* out) {
     uint i = get_global_id(0);
     if (i >= queryCount) return;
-    ub_query_point q = queries[i];
+    /* The walk reads the query's position and medium only; the record is read where a part is
+     * tested. Copying the 64-byte record first kept it in private memory through the walk, whose
+     * node tests PoCL then compiled with spills: the candle's bp2d kernel, whose walks visit a
+     * few nodes and test about four parts each, ran 415-440 us a pass against 380-400 us now
+     * (queue profiling, docs/performance.md, session 45). */
+    __global const ub_query_point* qg = queries + i;
     ub_query_medium qm;
     qm.ready = 0;
-    ub_float3 p = ub_f3_from(q.pos);
+    ub_float3 p = ub_make_float3(qg->pos[0], qg->pos[1], qg->pos[2]);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    UB_BVH_WALK_BEGIN(nodes, roots[q.mediumId], ub_bvh_contains_global(n, p)) {
+    UB_BVH_WALK_BEGIN(nodes, roots[qg->mediumId], ub_bvh_contains_global(n, p)) {
         ub_beam_part part = parts[k];
         float t = 0.0f;
+        ub_query_point q = *qg;
         if (!ub_bp2d_pair(q, part, radius * radius, minLength, maxLength, &t)) continue;
         ub_query_medium_load(&qm, media, grids, gridData, q.mediumId);
         ub_beam pb = beams[part.beam];
