@@ -11,13 +11,17 @@
 // query counts of the last iteration and the image mean (a sanity check). Not run by ctest.
 //
 // Usage: bench_upbp [--runs N] [--sets s1,s2,...] [--backends host,opencl] [--resolution WxH]
-//                   [--radius-of media|scene] [--rays cut,whole] [--replay K] [SCENE ...]
+//                   [--radius-of media|scene] [--rays cut,whole] [--replay K] [--cl-profile]
+//                   [SCENE ...]
 //   --replay K: after the timed iterations of an OpenCL run, the last iteration's estimate pass
 //   of each estimator of the set (surf, pp3d, pb2d, bp2d, bb1d) runs K more times on the host
 //   twin and K times as the kernel, alternately, on the same photons, beams and queries
 //   (VertexCM::replayEstimate); prints the median estimate times, queries per second, the
 //   ratio host / OpenCL and how far the two estimates' image sums differ. Ratios from one
 //   process and alternating runs are what docs/performance.md quotes for issue #11.
+//   --cl-profile: the OpenCL queue profiles its commands (RenderOptions::clProfile), and the
+//   replay also prints the median of each kernel's time on the device and of its latency from
+//   submission to start, which separate the kernel from its launch.
 //   --rays: with "whole" the bidirectional engine traces every ray through media to the next
 //   surface instead of cutting it where free-flight sampling stops (RenderOptions::
 //   cutRaysAtFlight; same image); both listed: an A/B in one run. Default: cut.
@@ -64,13 +68,14 @@ double median(std::vector<double> v) {
 }
 
 /// --replay: the estimators' host twins against their kernels on the last iteration's records.
-void replayEstimates(VertexCM& vcm, const std::string& set, int replays, int width, int height) {
+void replayEstimates(VertexCM& vcm, const std::string& set, int replays, int width, int height,
+                     bool clProfile) {
     const UpbpTechniques& t = vcm.upbpTechniques();
     const std::pair<const char*, bool> techniques[] = {
         {"surf", t.surf}, {"pp3d", t.pp3d}, {"pb2d", t.pb2d}, {"bp2d", t.bp2d}, {"bb1d", t.bb1d}};
     for (const auto& [name, on] : techniques) {
         if (!on) continue;
-        std::vector<double> host, device;
+        std::vector<double> host, device, kernel, latency;
         size_t queries = 0;
         Rgb sumHost(0.0f), sumDevice(0.0f);
         for (int k = 0; k < replays; ++k)
@@ -78,6 +83,10 @@ void replayEstimates(VertexCM& vcm, const std::string& set, int replays, int wid
                 Image img(width, height);
                 const VertexCM::EstimateTiming timing = vcm.replayEstimate(name, onDevice, &img);
                 (onDevice ? device : host).push_back(timing.estimates);
+                if (onDevice && timing.deviceKernel >= 0.0) {
+                    kernel.push_back(timing.deviceKernel);
+                    latency.push_back(timing.deviceStartLatency);
+                }
                 queries = timing.queries;
                 (onDevice ? sumDevice : sumHost) = img.mean();
             }
@@ -96,11 +105,17 @@ void replayEstimates(VertexCM& vcm, const std::string& set, int replays, int wid
             "relative\n",
             name, set.c_str(), queries, h, double(queries) / h, d, double(queries) / d, h / d,
             replays, scale > 0.0 ? diff / scale : diff);
+        if (clProfile && !kernel.empty())
+            std::printf(
+                "    replay %-5s %-16s OpenCL kernel %.3f ms on the device, %.1f us from "
+                "submission to start (medians, queue profiling)\n",
+                name, set.c_str(), median(kernel) * 1e3, median(latency) * 1e6);
     }
 }
 
 int runOne(const std::string& path, const std::string& set, int runs, int width, int height,
-           const std::string& backend, bool sceneRadius, bool cutRays, int replays) {
+           const std::string& backend, bool sceneRadius, bool cutRays, int replays,
+           bool clProfile) {
     std::vector<Diagnostic> warnings;
     std::unique_ptr<Scene> scene = loadScene(path, &warnings);
     scene->camera = scene->camera.resized(width, height, scene->settings.keepHorizontalFov);
@@ -126,6 +141,7 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
     opt.beamPaths = 4000;
     opt.backend = backend;
     opt.cutRaysAtFlight = cutRays;
+    opt.clProfile = clProfile;
     std::unique_ptr<Integrator> integrator = makeIntegrator(*scene, opt);
     Image img;
     integrator->renderIteration(0, img);
@@ -149,7 +165,7 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
         if (!vcm || !vcm->hasDeviceEstimates())
             std::printf("    replay: this run has no OpenCL estimate pass\n");
         else
-            replayEstimates(*vcm, set, replays, width, height);
+            replayEstimates(*vcm, set, replays, width, height, clProfile);
     }
     std::fflush(stdout);
     return 0;
@@ -159,7 +175,7 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
 
 int main(int argc, char** argv) {
     int runs = 3, width = 256, height = 256, replays = 0;
-    bool sceneRadius = false;
+    bool sceneRadius = false, clProfile = false;
     std::vector<std::string> backends = {"host"}, rays = {"cut"};
     std::vector<std::string> scenes,
         sets = {"upbp:bpt", "upbp:pp3d", "upbp:pb2d", "upbp:bp2d", "upbp:bb1d", "upbp"};
@@ -169,6 +185,8 @@ int main(int argc, char** argv) {
             runs = std::max(1, std::atoi(argv[++i]));
         } else if (a == "--replay" && i + 1 < argc) {
             replays = std::max(1, std::atoi(argv[++i]));
+        } else if (a == "--cl-profile") {
+            clProfile = true;
         } else if (a == "--sets" && i + 1 < argc) {
             sets = splitList(argv[++i]);
         } else if (a == "--backends" && i + 1 < argc) {
@@ -196,7 +214,7 @@ int main(int argc, char** argv) {
             std::printf(
                 "usage: bench_upbp [--runs N] [--sets s1,s2,...] [--backends host,opencl] "
                 "[--resolution WxH] [--radius-of media|scene] [--rays cut,whole] [--replay K] "
-                "[SCENE ...]\n");
+                "[--cl-profile] [SCENE ...]\n");
             return 0;
         } else if (!a.empty() && a[0] == '-') {
             std::fprintf(stderr, "bench_upbp: unknown option '%s' (or missing value; --help)\n",
@@ -228,7 +246,7 @@ int main(int argc, char** argv) {
                     if (pid == 0) {
                         try {
                             std::_Exit(runOne(scene, set, runs, width, height, backend, sceneRadius,
-                                              ray == "cut", replays));
+                                              ray == "cut", replays, clProfile));
                         } catch (const std::exception& e) {
                             std::fprintf(stderr, "bench_upbp: %s %s: %s\n", scene.c_str(),
                                          set.c_str(), e.what());

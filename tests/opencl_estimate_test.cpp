@@ -278,6 +278,46 @@ TEST(OpenClEstimate, ReplayedEstimatesEqualTheIterationsLayers) {
     EXPECT_THROW(vcm->replayEstimate("bpt", false, &scratch), std::invalid_argument);
 }
 
+// Queue profiling (RenderOptions::clProfile, bench_upbp --cl-profile): a replayed pass on the
+// device reports its kernel's device time and its start latency, the host twin and a render
+// without profiling report none, and the image is the same bit for bit with and without it.
+TEST(OpenClEstimate, QueueProfilingReportsKernelTimes) {
+    auto scene = infiniteFog(24);
+    Image plain, profiled;
+    std::vector<VertexCM::EstimateTiming> device, host;
+    for (bool profile : {false, true}) {
+        RenderOptions opt = fogUpbpOptions("opencl", "upbp:bpt+pp3d+bb1d");
+        opt.clProfile = profile;
+        auto integrator = makeIntegrator(*scene, opt);
+        auto* vcm = dynamic_cast<VertexCM*>(integrator.get());
+        ASSERT_NE(vcm, nullptr);
+        ASSERT_TRUE(vcm->hasDeviceEstimates());
+        Image& img = profile ? profiled : plain;
+        vcm->renderIteration(1, img);
+        for (const char* tech : {"pp3d", "bb1d"}) {
+            Image replay(img.width, img.height);
+            device.push_back(vcm->replayEstimate(tech, true, &replay));
+            host.push_back(vcm->replayEstimate(tech, false, &replay));
+        }
+    }
+    ASSERT_EQ(plain.pixels.size(), profiled.pixels.size());
+    for (size_t i = 0; i < plain.pixels.size(); ++i)
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(plain.pixels[i][c], profiled.pixels[i][c]) << i;
+    for (size_t k = 0; k < device.size(); ++k) {
+        EXPECT_EQ(host[k].deviceKernel, -1.0);
+        EXPECT_EQ(host[k].deviceStartLatency, -1.0);
+        if (k < 2) {  // without profiling
+            EXPECT_EQ(device[k].deviceKernel, -1.0);
+            EXPECT_EQ(device[k].deviceStartLatency, -1.0);
+        } else {
+            EXPECT_GT(device[k].deviceKernel, 0.0);
+            EXPECT_GE(device[k].deviceStartLatency, 0.0);
+            // The kernel runs within the pass that launched it.
+            EXPECT_LE(device[k].deviceKernel, device[k].estimates);
+        }
+    }
+}
+
 // The same in a NanoVDB medium (the bundled smoke plume, nearest filtering): the beam
 // kernels track through the grid with CNanoVDB.h (kernels/shared/ub_grid_medium.h), the
 // host twins through their tabulated pieces (estimators/beam_medium.h), the kernels through

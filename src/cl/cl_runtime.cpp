@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdio>
 #include <cstdlib>
@@ -266,6 +267,7 @@ ClRuntime::ClRuntime(int platform, int device, const std::string& cacheDir,
     cl_int err = CL_SUCCESS;
     context_ = clCreateContext(nullptr, 1, &dev, nullptr, nullptr, &err);
     check(err, "clCreateContext");
+    deviceId_ = dev;
     queue_ = clCreateCommandQueue(context_, dev, 0, &err);
     check(err, "clCreateCommandQueue");
     // One program of the three files. No contraction of a * b + c into fma anywhere in it: the
@@ -427,6 +429,16 @@ void ClRuntime::checkLayout() {
                           std::to_string(host[i]) + " on the host");
 }
 
+void ClRuntime::enableProfiling() {
+    if (profiling_) return;
+    cl_int err = CL_SUCCESS;
+    cl_command_queue q = clCreateCommandQueue(context_, deviceId_, CL_QUEUE_PROFILING_ENABLE, &err);
+    check(err, "clCreateCommandQueue(CL_QUEUE_PROFILING_ENABLE)");
+    clReleaseCommandQueue(queue_);
+    queue_ = q;
+    profiling_ = true;
+}
+
 ClRuntime::~ClRuntime() {
     for (cl_kernel k : {pp3d_, pb2d_, bp2d_, bb1d_, surf_})
         if (k) clReleaseKernel(k);
@@ -473,6 +485,7 @@ void ClRuntime::runEstimate(cl_kernel kernel, const char* name, const std::vecto
     // (estimators/volume_estimate.cpp) hand it over zeroed and sized already, and a second
     // fill was a few percent of the millisecond passes (docs/performance.md, session 36).
     out->resize(count);
+    lastTiming_ = KernelTiming();
     if (count == 0) return;
     // The lookups (and the media) are uploaded once; the queries go in batches that fit the
     // device's largest allocation and what its global memory leaves after the lookups. A
@@ -536,6 +549,7 @@ void ClRuntime::runEstimate(cl_kernel kernel, const char* name, const std::vecto
         MemList batchMems;
         cl_int err = CL_SUCCESS;
         const char* step = "clCreateBuffer(queries)";
+        cl_event launch = nullptr;  // with profiling only
         const cl_mem_flags queryFlags =
             CL_MEM_READ_ONLY | (desc_.type == "CPU" ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR);
         cl_mem q = clCreateBuffer(context_, queryFlags, n * querySize,
@@ -561,7 +575,7 @@ void ClRuntime::runEstimate(cl_kernel kernel, const char* name, const std::vecto
                 err = failLaunchesForTest_ > 0
                           ? (--failLaunchesForTest_, CL_OUT_OF_RESOURCES)
                           : clEnqueueNDRangeKernel(queue_, kernel, 1, nullptr, &global, &local, 0,
-                                                   nullptr, nullptr);
+                                                   nullptr, profiling_ ? &launch : nullptr);
                 if (err == CL_SUCCESS && inPlace) {
                     // The map is enqueued without waiting: where the device maps the results in
                     // place (PoCL), map, unmap and kernel are waited for once, by clFinish. A
@@ -589,6 +603,23 @@ void ClRuntime::runEstimate(cl_kernel kernel, const char* name, const std::vecto
                                               host.data(), 0, nullptr, nullptr);
                 }
             }
+        }
+        if (launch) {
+            // The event's times, once the batch is done (the map or read above waited for it).
+            cl_ulong submit = 0, start = 0, end = 0;
+            if (err == CL_SUCCESS &&
+                clGetEventProfilingInfo(launch, CL_PROFILING_COMMAND_SUBMIT, sizeof(submit),
+                                        &submit, nullptr) == CL_SUCCESS &&
+                clGetEventProfilingInfo(launch, CL_PROFILING_COMMAND_START, sizeof(start), &start,
+                                        nullptr) == CL_SUCCESS &&
+                clGetEventProfilingInfo(launch, CL_PROFILING_COMMAND_END, sizeof(end), &end,
+                                        nullptr) == CL_SUCCESS) {
+                lastTiming_.kernelSeconds =
+                    std::max(0.0, lastTiming_.kernelSeconds) + double(end - start) * 1e-9;
+                lastTiming_.startLatencySeconds =
+                    std::max(0.0, lastTiming_.startLatencySeconds) + double(start - submit) * 1e-9;
+            }
+            clReleaseEvent(launch);
         }
         if (outOfResources(err) && batch > 64) {
             batch = std::max<size_t>(64, batch / 2);  // retry this range in smaller batches

@@ -132,6 +132,19 @@ class ClRuntime {
     /// Bytes of the resident grid-media buffers.
     size_t gridMediaBytes() const { return gridMediaBytes_; }
 
+    /// Queue profiling (CL_QUEUE_PROFILING_ENABLE; bench_upbp --cl-profile): the queue is
+    /// created again with it, and each estimate records what the device reports of its
+    /// launches. Throws ClError.
+    void enableProfiling();
+    /// The last estimate's kernel time on the device (CL_PROFILING_COMMAND_START to _END,
+    /// summed over its batches) and its latency from submission to start (summed likewise),
+    /// in seconds; both -1 without profiling or queries.
+    struct KernelTiming {
+        double kernelSeconds = -1.0, startLatencySeconds = -1.0;
+    };
+    const KernelTiming& lastKernelTiming() const { return lastTiming_; }
+    void clearKernelTiming() { lastTiming_ = KernelTiming(); }
+
     /// Batches launched so far, and retries with a smaller batch after the device ran out of
     /// resources (runEstimate).
     size_t batches() const { return batches_; }
@@ -157,7 +170,10 @@ class ClRuntime {
     std::string programNote_;
     size_t releasedLibraryKb_ = 0;
     cl_context context_ = nullptr;
+    cl_device_id deviceId_ = nullptr;
     cl_command_queue queue_ = nullptr;
+    bool profiling_ = false;
+    KernelTiming lastTiming_;
     cl_program program_ = nullptr;
     cl_kernel pp3d_ = nullptr, pb2d_ = nullptr, bp2d_ = nullptr, bb1d_ = nullptr, surf_ = nullptr;
     cl_mem gridInfoMem_ = nullptr, gridDataMem_ = nullptr;  ///< setGridMedia()

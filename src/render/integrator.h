@@ -48,6 +48,9 @@ struct RenderOptions {
     size_t maxMemoryBytes = 0;
     int clPlatform = -1, clDevice = -1;  ///< OpenCL device (-1, -1: the first one)
     std::string clCache;  ///< OpenCL program cache folder ("": the user's cache, "-": none)
+    /// OpenCL queue profiling, for bench_upbp --cl-profile (VertexCM::replayEstimate reports
+    /// the kernels' device times); the images are the same either way.
+    bool clProfile = false;
     /// Cut rays through homogeneous media where free-flight sampling will stop
     /// (Scene::traceMedia's look-ahead) in vpt and the bidirectional engine (vlt, vbpt, vcm,
     /// upbp). The image is the same either way; tests and benchmarks turn it off to compare.

@@ -200,6 +200,7 @@ VertexCM::VertexCM(const Scene& scene, const RenderOptions& options)
                 cl_ = std::make_unique<ClRuntime>(options.clPlatform, options.clDevice,
                                                   options.clCache,
                                                   clBsdfTypesOption(scene.materials));
+                if (options.clProfile) cl_->enableProfiling();
                 beamKernels_ = prepareDeviceMedia(scene, cl_.get(),
                                                   upbp_.pb2d || upbp_.photonBeams(), &deviceMedia_);
                 const bool beamKernels = beamKernels_ || (!upbp_.pb2d && !upbp_.photonBeams());
@@ -475,6 +476,7 @@ VertexCM::EstimateTiming VertexCM::replayEstimate(const std::string& technique, 
         throw std::invalid_argument("replayEstimate: '" + technique +
                                     "' is not an estimator this render runs");
     EstimateTiming timing;
+    if (cl_) cl_->clearKernelTiming();
     if (one.surf) {
         const auto t0 = std::chrono::steady_clock::now();
         std::vector<Rgb> perQuery;
@@ -482,6 +484,10 @@ VertexCM::EstimateTiming VertexCM::replayEstimate(const std::string& technique, 
         timing.estimates =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         timing.queries = surfaceQueries_.size();
+        if (onDevice) {
+            timing.deviceKernel = cl_->lastKernelTiming().kernelSeconds;
+            timing.deviceStartLatency = cl_->lastKernelTiming().startLatencySeconds;
+        }
         const uint32_t width = uint32_t(out->width);
         for (size_t i = 0; i < surfaceQueries_.size(); ++i) {
             const uint32_t pixel = surfaceQueries_[i].pixel;
@@ -492,6 +498,10 @@ VertexCM::EstimateTiming VertexCM::replayEstimate(const std::string& technique, 
     VolumeEstimateStats stats;
     estimateVolume(volumeInput(one, onDevice ? cl_.get() : nullptr, onDevice && beamKernels_), out,
                    nullptr, &stats);
+    if (onDevice) {
+        timing.deviceKernel = cl_->lastKernelTiming().kernelSeconds;
+        timing.deviceStartLatency = cl_->lastKernelTiming().startLatencySeconds;
+    }
     timing.lookups = stats.buildSeconds;
     timing.estimates = stats.estimateSeconds;
     timing.queries = one.pp3d || one.bp2d ? queryPoints_.size() : queryBeams_.size();

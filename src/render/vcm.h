@@ -105,6 +105,9 @@ class VertexCM : public Integrator {
     struct EstimateTiming {
         double lookups = 0, estimates = 0;
         size_t queries = 0;
+        /// On the device with RenderOptions::clProfile: the kernel's time on the device and
+        /// its latency from submission to start (ClRuntime::lastKernelTiming); else -1.
+        double deviceKernel = -1, deviceStartLatency = -1;
     };
     /// UPBP: runs the last iteration's estimate pass again for one technique ("surf", "pp3d",
     /// "pb2d", "bp2d" or "bb1d", which the render must run) over the same photons, beams and
