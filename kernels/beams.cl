@@ -269,7 +269,7 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
  * the pairs it accepted, in the same order (the sum is the walk order's). */
 static void ub_bb1d_flush(__global const ub_beam* beams, __global const ub_beam_part* parts,
                           __global const ub_beam_piece* beamPieces, __global const uint* beamRanges,
-                          ub_query_medium* qm, const ub_beam* qb, ub_beam_piece* table,
+                          ub_query_medium* qm, __global const ub_beam* qb, ub_beam_piece* table,
                           ub_uint* tableState, ub_mis_constants mis, float radius,
                           float normalization, uint minLength, uint maxLength, const uint* pending,
                           int np, float* sum) {
@@ -328,10 +328,17 @@ __kernel void ub_bb1d_estimate(
     __global float* out) {
     uint i = get_global_id(0);
     if (i >= queryCount) return;
-    ub_beam qb = queries[i];
+    /* The query beam is read in place (its flush reads the record from global memory):
+     * copying the 96-byte record into private memory first kept it on the stack through the
+     * walk, as bp2d's query did (docs/performance.md, session 45): the bunny's bb1d replay
+     * 0.963-0.970 -> 0.988-1.011 of the host twin, three alternating rounds. */
+    __global const ub_beam* qg = queries + i;
     ub_query_medium qm;
     qm.ready = 0;
-    ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
+    ub_float3 o = ub_make_float3(qg->origin[0], qg->origin[1], qg->origin[2]),
+              d = ub_make_float3(qg->dir[0], qg->dir[1], qg->dir[2]);
+    const float qLength = qg->length;
+    const uint qMedium = qg->mediumId;
     ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
     ub_beam_piece table[UB_QUERY_PIECES];
     ub_uint tableState = UB_TABLE_UNBUILT;
@@ -353,8 +360,8 @@ __kernel void ub_bb1d_estimate(
                 for (; near != 0u; near &= near - 1u) {
                     pending[np++] = tileParts[b * 4u + (31u - clz(near & (0u - near)))];
                     if (np == UB_BB1D_PENDING) {
-                        ub_query_medium_load(&qm, media, grids, gridData, qb.mediumId);
-                        ub_bb1d_flush(beams, tileItemParts, beamPieces, beamRanges, &qm, &qb, table,
+                        ub_query_medium_load(&qm, media, grids, gridData, qMedium);
+                        ub_bb1d_flush(beams, tileItemParts, beamPieces, beamRanges, &qm, qg, table,
                                       &tableState, mis, radius, normalization, minLength, maxLength,
                                       pending, np, sum);
                         np = 0;
@@ -364,16 +371,15 @@ __kernel void ub_bb1d_estimate(
             }
         }
         if (np > 0) {
-            ub_query_medium_load(&qm, media, grids, gridData, qb.mediumId);
-            ub_bb1d_flush(beams, tileItemParts, beamPieces, beamRanges, &qm, &qb, table,
-                          &tableState, mis, radius, normalization, minLength, maxLength, pending,
-                          np, sum);
+            ub_query_medium_load(&qm, media, grids, gridData, qMedium);
+            ub_bb1d_flush(beams, tileItemParts, beamPieces, beamRanges, &qm, qg, table, &tableState,
+                          mis, radius, normalization, minLength, maxLength, pending, np, sum);
             np = 0;
         }
     } else {
         /* A leaf's candidates four at a time by their lines first, as the host twin does
          * (src/estimators/bb1d_estimator.cpp), gathered and handled UB_BB1D_PENDING at a time. */
-        UB_BVH_LEAVES_BEGIN(nodes, roots[qb.mediumId], ub_bvh_meets_global(n, o, invD, qb.length))
+        UB_BVH_LEAVES_BEGIN(nodes, roots[qMedium], ub_bvh_meets_global(n, o, invD, qLength))
         for (uint b = leafFirst / 4u; b * 4u < leafEnd; ++b) {
             /* two blocks at once where the leaf has both (ub_beam_lines_near8_global) */
             uint near;
@@ -388,10 +394,10 @@ __kernel void ub_bb1d_estimate(
             for (; near != 0u; near &= near - 1u) {
                 pending[np++] = b * 4u + (31u - clz(near & (0u - near)));
                 if (np == UB_BB1D_PENDING) {
-                    ub_query_medium_load(&qm, media, grids, gridData, qb.mediumId);
-                    ub_bb1d_flush(beams, parts, beamPieces, beamRanges, &qm, &qb, table,
-                                  &tableState, mis, radius, normalization, minLength, maxLength,
-                                  pending, np, sum);
+                    ub_query_medium_load(&qm, media, grids, gridData, qMedium);
+                    ub_bb1d_flush(beams, parts, beamPieces, beamRanges, &qm, qg, table, &tableState,
+                                  mis, radius, normalization, minLength, maxLength, pending, np,
+                                  sum);
                     np = 0;
                 }
             }
@@ -400,8 +406,8 @@ __kernel void ub_bb1d_estimate(
         UB_BVH_LEAVES_END
     }
     if (np > 0) {
-        ub_query_medium_load(&qm, media, grids, gridData, qb.mediumId);
-        ub_bb1d_flush(beams, parts, beamPieces, beamRanges, &qm, &qb, table, &tableState, mis,
+        ub_query_medium_load(&qm, media, grids, gridData, qMedium);
+        ub_bb1d_flush(beams, parts, beamPieces, beamRanges, &qm, qg, table, &tableState, mis,
                       radius, normalization, minLength, maxLength, pending, np, sum);
     }
     ub_store_f3(out, i, sum[0], sum[1], sum[2]);
