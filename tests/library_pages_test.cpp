@@ -61,10 +61,7 @@ CompilerPages compilerPages() {
     EXPECT_TRUE(in.good());
     CompilerPages c;
     for (const SmapsMapping& m : parseSmaps(in)) {
-        bool listed = false;
-        for (const std::string& lib : openClCompilerLibraries())
-            listed = listed || m.path.find(lib) != std::string::npos;
-        if (!listed) continue;
+        if (!mapsLibrary(m, openClCompilerLibraries())) continue;
         ++c.mapped;
         (releasableLibraryText(m, openClCompilerLibraries()) ? c.releasableKb : c.otherKb) +=
             std::max(0L, m.rssKb);

@@ -47,15 +47,19 @@ std::vector<SmapsMapping> parseSmaps(std::istream& in) {
     return out;
 }
 
+bool mapsLibrary(const SmapsMapping& m, const std::vector<std::string>& libraries) {
+    const std::string name = m.path.substr(m.path.rfind('/') + 1);  // whole path if no '/'
+    for (const std::string& lib : libraries)
+        if (!name.empty() && name.find(lib) != std::string::npos) return true;
+    return false;
+}
+
 bool releasableLibraryText(const SmapsMapping& m, const std::vector<std::string>& libraries) {
-    if (m.path.empty() || m.end <= m.begin) return false;
-    const std::string name = m.path.substr(m.path.rfind('/') + 1);
-    bool listed = false;
-    for (const std::string& lib : libraries) listed = listed || name.find(lib) != std::string::npos;
+    if (m.end <= m.begin) return false;
     // Every count must have been read, and be zero: a private page that was ever written
     // (Private_Dirty, Anonymous) would lose the write.
-    return listed && m.perms == "r-xp" && m.privateDirtyKb == 0 && m.sharedDirtyKb == 0 &&
-           m.anonymousKb == 0;
+    return mapsLibrary(m, libraries) && m.perms == "r-xp" && m.privateDirtyKb == 0 &&
+           m.sharedDirtyKb == 0 && m.anonymousKb == 0;
 }
 
 size_t releaseLibraryText(const std::vector<std::string>& libraries) {

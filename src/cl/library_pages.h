@@ -39,6 +39,9 @@ struct SmapsMapping {
 /// lines). Lines of another form are ignored.
 std::vector<SmapsMapping> parseSmaps(std::istream& in);
 
+/// Whether a mapping is of one of `libraries`: its file name contains one of them.
+bool mapsLibrary(const SmapsMapping& m, const std::vector<std::string>& libraries);
+
 /// Whether a mapping may be released: its file name contains one of `libraries`, it is
 /// private, readable and executable and not writable, and it holds no dirty or anonymous page.
 bool releasableLibraryText(const SmapsMapping& m, const std::vector<std::string>& libraries);

@@ -484,27 +484,23 @@ VertexCM::EstimateTiming VertexCM::replayEstimate(const std::string& technique, 
         timing.estimates =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         timing.queries = surfaceQueries_.size();
-        if (onDevice) {
-            timing.deviceKernel = cl_->lastKernelTiming().kernelSeconds;
-            timing.deviceStartLatency = cl_->lastKernelTiming().startLatencySeconds;
-        }
         const uint32_t width = uint32_t(out->width);
         for (size_t i = 0; i < surfaceQueries_.size(); ++i) {
             const uint32_t pixel = surfaceQueries_[i].pixel;
             out->at(int(pixel % width), int(pixel / width)) += perQuery[i];
         }
-        return timing;
+    } else {
+        VolumeEstimateStats stats;
+        estimateVolume(volumeInput(one, onDevice ? cl_.get() : nullptr, onDevice && beamKernels_),
+                       out, nullptr, &stats);
+        timing.lookups = stats.buildSeconds;
+        timing.estimates = stats.estimateSeconds;
+        timing.queries = one.pp3d || one.bp2d ? queryPoints_.size() : queryBeams_.size();
     }
-    VolumeEstimateStats stats;
-    estimateVolume(volumeInput(one, onDevice ? cl_.get() : nullptr, onDevice && beamKernels_), out,
-                   nullptr, &stats);
     if (onDevice) {
         timing.deviceKernel = cl_->lastKernelTiming().kernelSeconds;
         timing.deviceStartLatency = cl_->lastKernelTiming().startLatencySeconds;
     }
-    timing.lookups = stats.buildSeconds;
-    timing.estimates = stats.estimateSeconds;
-    timing.queries = one.pp3d || one.bp2d ? queryPoints_.size() : queryBeams_.size();
     return timing;
 }
 
