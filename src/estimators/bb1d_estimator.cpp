@@ -57,6 +57,7 @@ struct Bb1dPass {
     const std::vector<BeamPart>& parts;
     const std::vector<ub_beam_keys4>& lines;
     const std::vector<BeamMedium>& photonMedia;
+    const std::vector<BeamMediumPrep>& queryMedia;  ///< by medium id
     const std::vector<ub_beam>& beams;
     const std::vector<ub_beam>& queries;
     const ScreenTiles& tiles;
@@ -150,17 +151,11 @@ void estimateBB1D(const VolumeEstimateInput& in, const Bvh& beamParts,
     if (!beamParts.leafOrdered())
         throw std::logic_error("bb1d given a BVH whose parts are not in leaf order");
     const float r = in.radius[UB_TECH_BB1D];
-    const Bb1dPass pass{in,
-                        beamParts,
-                        beamParts.nodes(),
-                        parts,
-                        lines,
-                        photonMedia,
-                        beams,
-                        queries,
-                        tiles,
-                        r,
-                        ub_bb1d_normalization(in.beamPathCount, r),
+    const std::vector<BeamMediumPrep> queryMedia = prepareBeamMedia(*in.scene);
+    const Bb1dPass pass{in,         beamParts, beamParts.nodes(),
+                        parts,      lines,     photonMedia,
+                        queryMedia, beams,     queries,
+                        tiles,      r,         ub_bb1d_normalization(in.beamPathCount, r),
                         out};
     const bool useWide = bb1dWideWalk();
     forEachQueryBlock(queries.size(), 16, out, pairs, [&](size_t begin, size_t end, size_t* found) {

@@ -11,16 +11,28 @@
 
 namespace ub {
 
-void BeamMedium::reset(const Scene& scene, const ub_beam& b) {
-    medium_ = &scene.media[b.mediumId];
-    beam_ = &b;
+namespace {
+BeamMediumPrep prepareBeamMedium(const Medium& m) {
+    BeamMediumPrep p;
+    p.medium = &m;
     // The table is grey (one extinction per piece): chromatic grids evaluate per pair.
-    tabulated_ = medium_->type == MediumType::kGrid && medium_->filter != GridFilter::kTrilinear &&
-                 !medium_->chromatic();
-    built_ = false;
-    pieces_.clear();
-    info_ = mediumInfo(*medium_);
-    contProb_ = ub_homogeneous_cont_prob(info_);
+    p.tabulated =
+        m.type == MediumType::kGrid && m.filter != GridFilter::kTrilinear && !m.chromatic();
+    p.info = mediumInfo(m);
+    p.contProb = ub_homogeneous_cont_prob(p.info);
+    return p;
+}
+}  // namespace
+
+std::vector<BeamMediumPrep> prepareBeamMedia(const Scene& scene) {
+    std::vector<BeamMediumPrep> prep;
+    prep.reserve(scene.media.size());
+    for (const Medium& m : scene.media) prep.push_back(prepareBeamMedium(m));
+    return prep;
+}
+
+void BeamMedium::reset(const Scene& scene, const ub_beam& b) {
+    reset(prepareBeamMedium(scene.media[b.mediumId]), b);
 }
 
 ub_grid_info gridInfo(const Medium& m, uint32_t gridOffset) {

@@ -24,11 +24,34 @@ namespace ub {
 class Scene;
 struct Medium;
 
+/// What BeamMedium needs of a medium, the same for every beam in it: prepared once per pass
+/// (prepareBeamMedia) rather than per query beam. Derived per query, it was 4% of bb1d's host
+/// pass on the bunny (docs/performance.md, session 46).
+struct BeamMediumPrep {
+    const Medium* medium = nullptr;
+    ub_medium_info info{};
+    float contProb = 0.0f;  ///< ub_homogeneous_cont_prob(info)
+    bool tabulated = false;
+};
+
+/// One BeamMediumPrep per medium of the scene, indexed by medium id.
+std::vector<BeamMediumPrep> prepareBeamMedia(const Scene& scene);
+
 class BeamMedium {
   public:
     /// Prepares for beam b; build() must follow before eval (query loops call it when they
     /// find the beam's first pair, so beams without pairs cost nothing).
     void reset(const Scene& scene, const ub_beam& b);
+    /// The same with its medium prepared (prep is prepareBeamMedia's entry for b.mediumId).
+    void reset(const BeamMediumPrep& prep, const ub_beam& b) {
+        medium_ = prep.medium;
+        beam_ = &b;
+        tabulated_ = prep.tabulated;
+        built_ = false;
+        pieces_.clear();
+        info_ = prep.info;
+        contProb_ = prep.contProb;
+    }
     void build();
     bool built() const { return built_; }
     /// The medium from the beam's piece start to distance t in [0, b.length] (after build()).

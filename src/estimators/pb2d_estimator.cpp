@@ -68,12 +68,14 @@ void estimatePB2D(const VolumeEstimateInput& in, const Bvh& photonSpheres,
     if (photons.empty() || queries.empty()) return;
     const float r = in.radius[UB_TECH_PB2D];
     const float normalization = ub_pb2d_normalization(in.lightPathCount, r);
+    const std::vector<BeamMediumPrep> queryMedia = prepareBeamMedia(*in.scene);
     forEachQuery(queries.size(), 16, out, pairs, [&](size_t i, size_t* found) {
         const ub_beam& qb = queries[i];
-        const float g = in.scene->media[qb.mediumId].g;
+        const BeamMediumPrep& prep = queryMedia[qb.mediumId];
+        const float g = prep.info.g;
         const ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
         BeamMedium queryMedium;  // tabulated when the first pair is found
-        queryMedium.reset(*in.scene, qb);
+        queryMedium.reset(prep, qb);
         Rgb sum(0.0f);
         // A leaf's photons four at a time (their keys as a structure of arrays); the pairs are
         // gathered in walk order, kPending at a time, their 80-byte records prefetched, then
