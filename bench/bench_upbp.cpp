@@ -12,7 +12,7 @@
 //
 // Usage: bench_upbp [--runs N] [--sets s1,s2,...] [--backends host,opencl] [--resolution WxH]
 //                   [--radius-of media|scene] [--rays cut,whole] [--replay K] [--cl-profile]
-//                   [SCENE ...]
+//                   [--ray-stats] [SCENE ...]
 //   --replay K: after the timed iterations of an OpenCL run, the last iteration's estimate pass
 //   of each estimator of the set (surf, pp3d, pb2d, bp2d, bb1d) runs K more times on the host
 //   twin and K times as the kernel, alternately, on the same photons, beams and queries
@@ -22,6 +22,9 @@
 //   --cl-profile: the OpenCL queue profiles its commands (RenderOptions::clProfile), and the
 //   replay also prints the median of each kernel's time on the device and of its latency from
 //   submission to start, which separate the kernel from its launch.
+//   --ray-stats: counts the Embree queries of the timed iterations and their time
+//   (scene/ray_stats.h): queries per iteration by kind, the mean time of one, and Embree's share
+//   of the iterations' thread time. Adds two time-stamp reads to each query.
 //   --rays: with "whole" the bidirectional engine traces every ray through media to the next
 //   surface instead of cutting it where free-flight sampling stops (RenderOptions::
 //   cutRaysAtFlight; same image); both listed: an A/B in one run. Default: cut.
@@ -32,6 +35,7 @@
 //   candle, mirrorballs, bunny (scenes/smallupbp/)
 #include <sys/resource.h>
 #include <sys/wait.h>
+#include <tbb/task_arena.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -46,6 +50,7 @@
 #include "render/integrator.h"
 #include "render/vcm.h"
 #include "scene/io/scene_loader.h"
+#include "scene/ray_stats.h"
 
 using namespace ub;
 
@@ -114,8 +119,8 @@ void replayEstimates(VertexCM& vcm, const std::string& set, int replays, int wid
 }
 
 int runOne(const std::string& path, const std::string& set, int runs, int width, int height,
-           const std::string& backend, bool sceneRadius, bool cutRays, int replays,
-           bool clProfile) {
+           const std::string& backend, bool sceneRadius, bool cutRays, int replays, bool clProfile,
+           bool rayStats) {
     std::vector<Diagnostic> warnings;
     std::unique_ptr<Scene> scene = loadScene(path, &warnings);
     scene->camera = scene->camera.resized(width, height, scene->settings.keepHorizontalFov);
@@ -146,12 +151,20 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
     Image img;
     integrator->renderIteration(0, img);
     std::vector<double> times;
+    if (rayStats) raystats::enable(true);
     for (int r = 0; r < runs; ++r) {
         const auto t0 = std::chrono::steady_clock::now();
         integrator->renderIteration(r + 1, img);
         times.push_back(
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
+    raystats::Totals rays;
+    if (rayStats) {
+        rays = raystats::totals();
+        raystats::enable(false);
+    }
+    double timedSeconds = 0.0;
+    for (double t : times) timedSeconds += t;
     std::sort(times.begin(), times.end());
     const Rgb mean = img.mean();
     std::printf("%-14s %-16s %-6s %9.3f s/it  mean %.4g %.4g %.4g\n",
@@ -160,6 +173,21 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
                 mean.y, mean.z);
     const std::string summary = integrator->iterationSummary();
     if (!summary.empty()) std::printf("    %s\n", summary.c_str());
+    if (rayStats) {
+        const int threads = tbb::this_task_arena::max_concurrency();
+        const double perIteration = 1.0 / double(runs);
+        std::printf(
+            "    Embree queries per iteration: %.0f nearest, %.0f any-hit, %.0f crossing "
+            "collections; %.0f ns each on average; %.4f s of thread time per iteration, %.0f%% "
+            "of the iterations' time on %d threads\n",
+            double(rays.calls[raystats::kNearest]) * perIteration,
+            double(rays.calls[raystats::kAnyHit]) * perIteration,
+            double(rays.calls[raystats::kCrossings]) * perIteration,
+            rays.allCalls() > 0 ? rays.seconds / double(rays.allCalls()) * 1e9 : 0.0,
+            rays.seconds * perIteration,
+            timedSeconds > 0.0 ? 100.0 * rays.seconds / (double(threads) * timedSeconds) : 0.0,
+            threads);
+    }
     if (replays > 0 && backend == "opencl") {
         auto* vcm = dynamic_cast<VertexCM*>(integrator.get());
         if (!vcm || !vcm->hasDeviceEstimates())
@@ -175,7 +203,7 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
 
 int main(int argc, char** argv) {
     int runs = 3, width = 256, height = 256, replays = 0;
-    bool sceneRadius = false, clProfile = false;
+    bool sceneRadius = false, clProfile = false, rayStats = false;
     std::vector<std::string> backends = {"host"}, rays = {"cut"};
     std::vector<std::string> scenes,
         sets = {"upbp:bpt", "upbp:pp3d", "upbp:pb2d", "upbp:bp2d", "upbp:bb1d", "upbp"};
@@ -187,6 +215,8 @@ int main(int argc, char** argv) {
             replays = std::max(1, std::atoi(argv[++i]));
         } else if (a == "--cl-profile") {
             clProfile = true;
+        } else if (a == "--ray-stats") {
+            rayStats = true;
         } else if (a == "--sets" && i + 1 < argc) {
             sets = splitList(argv[++i]);
         } else if (a == "--backends" && i + 1 < argc) {
@@ -214,7 +244,7 @@ int main(int argc, char** argv) {
             std::printf(
                 "usage: bench_upbp [--runs N] [--sets s1,s2,...] [--backends host,opencl] "
                 "[--resolution WxH] [--radius-of media|scene] [--rays cut,whole] [--replay K] "
-                "[--cl-profile] [SCENE ...]\n");
+                "[--cl-profile] [--ray-stats] [SCENE ...]\n");
             return 0;
         } else if (!a.empty() && a[0] == '-') {
             std::fprintf(stderr, "bench_upbp: unknown option '%s' (or missing value; --help)\n",
@@ -246,7 +276,7 @@ int main(int argc, char** argv) {
                     if (pid == 0) {
                         try {
                             std::_Exit(runOne(scene, set, runs, width, height, backend, sceneRadius,
-                                              ray == "cut", replays, clProfile));
+                                              ray == "cut", replays, clProfile, rayStats));
                         } catch (const std::exception& e) {
                             std::fprintf(stderr, "bench_upbp: %s %s: %s\n", scene.c_str(),
                                          set.c_str(), e.what());

@@ -49,6 +49,7 @@
 #include "core/error.h"
 #include "scene/bsdf.h"
 #include "scene/normal_perturbation.h"
+#include "scene/ray_stats.h"
 #include "scene/sdf_grid.h"
 
 namespace ub {
@@ -705,7 +706,7 @@ bool Scene::intersectNearest(const Ray& ray, Hit* hit) const {
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     if (!embreeRayValid(ray.org, ray.dir, ray.tMin, ray.tMax)) return false;  // e.g. NaN
-    rtcIntersect1(impl_->scene, &ctx, &rh);
+    raystats::timed(raystats::kNearest, [&] { rtcIntersect1(impl_->scene, &ctx, &rh); });
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
 
     const uint32_t id = rh.hit.geomID;
@@ -873,7 +874,7 @@ bool occludedRay(RTCScene scene, const Vec3& org, const Vec3& dir, float tMax) {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRay r = embreeRay(org, dir, 0.0f, tMax);
-    rtcOccluded1(scene, &ctx, &r);
+    raystats::timed(raystats::kAnyHit, [&] { rtcOccluded1(scene, &ctx, &r); });
     return r.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
 }
 
@@ -961,7 +962,7 @@ Scene::ShadowQuery Scene::shadowCrossings(const Vec3& org, const Vec3& dir, floa
     c.capacity = std::min(kMaxEntries, 2 * capacity);
     c.count = 0;
     RTCRay r = embreeRay(org, dir, 0.0f, tMax);
-    rtcOccluded1(impl_->scene, &c.embree, &r);
+    raystats::timed(raystats::kCrossings, [&] { rtcOccluded1(impl_->scene, &c.embree, &r); });
     if (r.tfar < 0.0f) return ShadowQuery::kBlocked;  // Embree sets tfar = -inf on a hit
     if (c.count > c.capacity) return ShadowQuery::kUnavailable;
     // By increasing t (ties by shape and triangle, so the order never depends on Embree's):
