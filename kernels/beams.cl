@@ -114,7 +114,7 @@ static void ub_query_medium_load(ub_query_medium* qm, __global const ub_medium_i
  * their path lengths read, whose loads then overlap their cache misses, then the pairs'
  * contributions in the same order, as the host twin does. */
 static void ub_pb2d_flush(__global const ub_photon_point* photons, ub_query_medium* qm,
-                          const ub_beam* qb, ub_beam_piece* table, ub_uint* tableState,
+                          __global const ub_beam* qb, ub_beam_piece* table, ub_uint* tableState,
                           ub_mis_constants mis, float normalization, uint minLength, uint maxLength,
                           const uint* pending, const float* t, int np, float* sum) {
     uint lengths[UB_PB2D_PENDING];
@@ -143,13 +143,17 @@ __kernel void ub_pb2d_estimate(
     __global float* out) {
     uint i = get_global_id(0);
     if (i >= queryCount) return;
-    ub_beam qb = queries[i];
+    /* The query beam is read in place (its flush reads the record from global memory), as
+     * bb1d's and bp2d's queries are: copied into private memory it stayed on the stack through
+     * the walk (docs/performance.md, session 46). */
+    __global const ub_beam* qg = queries + i;
     ub_query_medium qm;
     qm.ready = 0;
-    ub_float3 o = ub_f3_from(qb.origin), d = ub_f3_from(qb.dir);
+    ub_float3 o = ub_make_float3(qg->origin[0], qg->origin[1], qg->origin[2]),
+              d = ub_make_float3(qg->dir[0], qg->dir[1], qg->dir[2]);
     ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
-    const float qLength = qb.length, r2 = radius * radius;
-    const uint qMedium = qb.mediumId;
+    const float qLength = qg->length, r2 = radius * radius;
+    const uint qMedium = qg->mediumId;
     ub_beam_piece table[UB_QUERY_PIECES];
     ub_uint tableState = UB_TABLE_UNBUILT;
     /* A leaf's photons four at a time by their keys, as the host twin does
@@ -177,7 +181,7 @@ __kernel void ub_pb2d_estimate(
                     pendingT[np++] = t[lane];
                     if (np == UB_PB2D_PENDING) {
                         ub_query_medium_load(&qm, media, grids, gridData, qMedium);
-                        ub_pb2d_flush(photons, &qm, &qb, table, &tableState, mis, normalization,
+                        ub_pb2d_flush(photons, &qm, qg, table, &tableState, mis, normalization,
                                       minLength, maxLength, pending, pendingT, np, sum);
                         np = 0;
                     }
@@ -205,7 +209,7 @@ __kernel void ub_pb2d_estimate(
                 pendingT[np++] = t[lane];
                 if (np == UB_PB2D_PENDING) {
                     ub_query_medium_load(&qm, media, grids, gridData, qMedium);
-                    ub_pb2d_flush(photons, &qm, &qb, table, &tableState, mis, normalization,
+                    ub_pb2d_flush(photons, &qm, qg, table, &tableState, mis, normalization,
                                   minLength, maxLength, pending, pendingT, np, sum);
                     np = 0;
                 }
@@ -216,7 +220,7 @@ __kernel void ub_pb2d_estimate(
     }
     if (np > 0) {
         ub_query_medium_load(&qm, media, grids, gridData, qMedium);
-        ub_pb2d_flush(photons, &qm, &qb, table, &tableState, mis, normalization, minLength,
+        ub_pb2d_flush(photons, &qm, qg, table, &tableState, mis, normalization, minLength,
                       maxLength, pending, pendingT, np, sum);
     }
     ub_store_f3(out, i, sum[0], sum[1], sum[2]);
