@@ -710,11 +710,6 @@ bool Scene::intersectNearest(const Ray& ray, Hit* hit) const {
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
 
     const uint32_t id = rh.hit.geomID;
-    // The triangle's indices are completeHit's first read, and a cache miss (a third of its
-    // time with the vertex read that depends on it, perf on mirrorballs): asked for now, they
-    // arrive while the caller samples the segment.
-    if (const uint32_t* tri = impl_->geoms[id].indices)
-        __builtin_prefetch(tri + 3 * size_t(rh.hit.primID));
     hit->dist = rh.ray.tfar;
     hit->shapeId = id;
     hit->primId = rh.hit.primID;
@@ -725,17 +720,6 @@ bool Scene::intersectNearest(const Ray& ray, Hit* hit) const {
     hit->pos = ray.org + rh.ray.tfar * ray.dir;
     hit->detailPending = true;
     return true;
-}
-
-void Scene::prefetchHitDetail(const Hit& hit) const {
-    if (!hit.detailPending) return;
-    const ShapeGeom& g = impl_->geoms[hit.shapeId];
-    if (!g.indices) return;
-    const uint32_t* tri = g.indices + 3 * size_t(hit.primId);
-    for (int k = 0; k < 3; ++k) {
-        __builtin_prefetch(g.vertices + 3 * size_t(tri[k]));
-        if (!g.normals.empty()) __builtin_prefetch(&g.normals[tri[k]]);
-    }
 }
 
 void Scene::completeHit(const Ray& ray, Hit* hit) const {

@@ -208,10 +208,6 @@ class Scene {
     /// Completes a hit of intersectNearest along the same ray (nothing if already complete):
     /// the same values as intersect() gives.
     void completeHit(const Ray& ray, Hit* hit) const;
-    /// Asks the cache for what completeHit will read of a pending triangle hit (its vertices
-    /// and normals; intersectNearest asked for its indices), so that the reads overlap the work
-    /// done before the path reaches the surface. Changes nothing.
-    void prefetchHitDetail(const Hit& hit) const;
     /// True if anything blocks the open segment between the two points. Each end is
     /// offset along its geometric normal (pass a zero vector for points not on a
     /// surface, e.g. the camera or a point light) towards the other end.

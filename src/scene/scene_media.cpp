@@ -398,7 +398,6 @@ void Scene::traceMedia(const Ray& ray, MediumStack* stack, MediumTrace* trace, H
             trace->hitSurface = true;
             trace->hitRay = rc;
             *hit = h;
-            prefetchHitDetail(h);  // completed where the path reaches the surface
             return;
         }
         seg.crossingShape = int32_t(h.shapeId);
