@@ -213,14 +213,20 @@ void buildLists(const Camera& camera, float sceneRadius, size_t n, float r,
         if (pl.kind == Placement::kTiles)
             for (uint32_t y = pl.y0; y <= pl.y1; ++y) rowParts[rowNext[y]++] = i;
     }
-    // Counts per list, then block ranges (each list padded to whole blocks).
+    // Counts per list, then block ranges (each list padded to whole blocks). Each entry's
+    // tiles in its row are kept for the fill (x0 > x1: none): computing the hull's span twice
+    // was half of the lists' time (bb1d on the bunny and mirrorballs, docs/performance.md,
+    // session 46).
     std::vector<uint32_t> count(tileCount + 1, 0u);
     count[tileCount] = uint32_t(common.size());
+    std::vector<uint32_t> spanX0(rowParts.size()), spanX1(rowParts.size());
     tbb::parallel_for(uint32_t(0), s.tilesY, [&](uint32_t y) {
         for (uint32_t k = rowStart[y]; k < rowStart[y + 1]; ++k) {
-            uint32_t x0, x1;
-            if (rowTiles(place[rowParts[k]], y, &x0, &x1))
-                for (uint32_t x = x0; x <= x1; ++x) ++count[y * s.tilesX + x];
+            uint32_t x0 = 1, x1 = 0;
+            if (!rowTiles(place[rowParts[k]], y, &x0, &x1)) x0 = 1, x1 = 0;
+            spanX0[k] = x0;
+            spanX1[k] = x1;
+            for (uint32_t x = x0; x <= x1; ++x) ++count[y * s.tilesX + x];
         }
     });
     size_t entries = 0;
@@ -239,9 +245,8 @@ void buildLists(const Camera& camera, float sceneRadius, size_t n, float r,
         for (uint32_t x = 0; x < s.tilesX; ++x) next[x] = out->start[y * s.tilesX + x] * 4;
         for (uint32_t k = rowStart[y]; k < rowStart[y + 1]; ++k) {
             const uint32_t i = rowParts[k];
-            uint32_t x0, x1;
-            if (rowTiles(place[i], y, &x0, &x1))
-                for (uint32_t x = x0; x <= x1; ++x) put(next[x]++, i);
+            if (spanX0[k] > spanX1[k]) continue;
+            for (uint32_t x = spanX0[k]; x <= spanX1[k]; ++x) put(next[x]++, i);
         }
     });
     for (size_t k = 0; k < common.size(); ++k)
