@@ -149,8 +149,7 @@ __kernel void ub_pb2d_estimate(
     __global const ub_beam* qg = queries + i;
     ub_query_medium qm;
     qm.ready = 0;
-    ub_float3 o = ub_make_float3(qg->origin[0], qg->origin[1], qg->origin[2]),
-              d = ub_make_float3(qg->dir[0], qg->dir[1], qg->dir[2]);
+    ub_float3 o = ub_f3_from_global(qg->origin), d = ub_f3_from_global(qg->dir);
     ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
     const float qLength = qg->length, r2 = radius * radius;
     const uint qMedium = qg->mediumId;
@@ -246,7 +245,7 @@ __kernel void ub_bp2d_estimate(__global const ub_beam* beams, __global const ub_
     __global const ub_query_point* qg = queries + i;
     ub_query_medium qm;
     qm.ready = 0;
-    ub_float3 p = ub_make_float3(qg->pos[0], qg->pos[1], qg->pos[2]);
+    ub_float3 p = ub_f3_from_global(qg->pos);
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     UB_BVH_WALK_BEGIN(nodes, roots[qg->mediumId], ub_bvh_contains_global(n, p)) {
         ub_beam_part part = parts[k];
@@ -339,8 +338,7 @@ __kernel void ub_bb1d_estimate(
     __global const ub_beam* qg = queries + i;
     ub_query_medium qm;
     qm.ready = 0;
-    ub_float3 o = ub_make_float3(qg->origin[0], qg->origin[1], qg->origin[2]),
-              d = ub_make_float3(qg->dir[0], qg->dir[1], qg->dir[2]);
+    ub_float3 o = ub_f3_from_global(qg->origin), d = ub_f3_from_global(qg->dir);
     const float qLength = qg->length;
     const uint qMedium = qg->mediumId;
     ub_float3 invD = ub_make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);

@@ -587,7 +587,7 @@ TEST(Upbp, TabulatedBeamMediumEqualsTheWalk) {
         b.length = 2.0f * rng.uniform();
         b.mediumId = 0;
         BeamMedium bm;
-        bm.reset(*scene, b);
+        bm.reset(prepareBeamMedia(*scene)[0], b);
         bm.build();
         for (int k = 0; k < 10; ++k) {
             const float t = k == 0 ? 0.0f : (k == 9 ? b.length : b.length * rng.uniform());

@@ -33,6 +33,10 @@ UB_INLINE ub_float3 ub_make_float3(float x, float y, float z) {
 UB_INLINE ub_float3 ub_f3_from(const float v[3]) {
     return ub_make_float3(v[0], v[1], v[2]);
 }
+/* The same for a record read in place from global memory (the beam kernels' queries). */
+UB_INLINE ub_float3 ub_f3_from_global(UB_GLOBAL const float v[3]) {
+    return ub_make_float3(v[0], v[1], v[2]);
+}
 UB_INLINE ub_float3 ub_f3_add(ub_float3 a, ub_float3 b) {
     return ub_make_float3(a.x + b.x, a.y + b.y, a.z + b.z);
 }

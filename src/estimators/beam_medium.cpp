@@ -11,28 +11,19 @@
 
 namespace ub {
 
-namespace {
-BeamMediumPrep prepareBeamMedium(const Medium& m) {
-    BeamMediumPrep p;
-    p.medium = &m;
-    // The table is grey (one extinction per piece): chromatic grids evaluate per pair.
-    p.tabulated =
-        m.type == MediumType::kGrid && m.filter != GridFilter::kTrilinear && !m.chromatic();
-    p.info = mediumInfo(m);
-    p.contProb = ub_homogeneous_cont_prob(p.info);
-    return p;
-}
-}  // namespace
-
 std::vector<BeamMediumPrep> prepareBeamMedia(const Scene& scene) {
-    std::vector<BeamMediumPrep> prep;
-    prep.reserve(scene.media.size());
-    for (const Medium& m : scene.media) prep.push_back(prepareBeamMedium(m));
+    std::vector<BeamMediumPrep> prep(scene.media.size());
+    for (size_t i = 0; i < prep.size(); ++i) {
+        const Medium& m = scene.media[i];
+        BeamMediumPrep& p = prep[i];
+        p.medium = &m;
+        // The table is grey (one extinction per piece): chromatic grids evaluate per pair.
+        p.tabulated =
+            m.type == MediumType::kGrid && m.filter != GridFilter::kTrilinear && !m.chromatic();
+        p.info = mediumInfo(m);
+        p.contProb = ub_homogeneous_cont_prob(p.info);
+    }
     return prep;
-}
-
-void BeamMedium::reset(const Scene& scene, const ub_beam& b) {
-    reset(prepareBeamMedium(scene.media[b.mediumId]), b);
 }
 
 ub_grid_info gridInfo(const Medium& m, uint32_t gridOffset) {

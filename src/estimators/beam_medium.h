@@ -39,10 +39,9 @@ std::vector<BeamMediumPrep> prepareBeamMedia(const Scene& scene);
 
 class BeamMedium {
   public:
-    /// Prepares for beam b; build() must follow before eval (query loops call it when they
-    /// find the beam's first pair, so beams without pairs cost nothing).
-    void reset(const Scene& scene, const ub_beam& b);
-    /// The same with its medium prepared (prep is prepareBeamMedia's entry for b.mediumId).
+    /// Prepares for beam b in its medium (prep: prepareBeamMedia's entry for b.mediumId);
+    /// build() must follow before eval (query loops call it when they find the beam's first
+    /// pair, so beams without pairs cost nothing).
     void reset(const BeamMediumPrep& prep, const ub_beam& b) {
         medium_ = prep.medium;
         beam_ = &b;

@@ -222,8 +222,11 @@ void buildLists(const Camera& camera, float sceneRadius, size_t n, float r,
     std::vector<uint32_t> spanX0(rowParts.size()), spanX1(rowParts.size());
     tbb::parallel_for(uint32_t(0), s.tilesY, [&](uint32_t y) {
         for (uint32_t k = rowStart[y]; k < rowStart[y + 1]; ++k) {
-            uint32_t x0 = 1, x1 = 0;
-            if (!rowTiles(place[rowParts[k]], y, &x0, &x1)) x0 = 1, x1 = 0;
+            uint32_t x0 = 0, x1 = 0;
+            if (!rowTiles(place[rowParts[k]], y, &x0, &x1)) {
+                x0 = 1;  // no tile
+                x1 = 0;
+            }
             spanX0[k] = x0;
             spanX1[k] = x1;
             for (uint32_t x = x0; x <= x1; ++x) ++count[y * s.tilesX + x];

@@ -166,8 +166,9 @@ void estimateVolume(const VolumeEstimateInput& in, Image* image, std::array<Imag
     }
     // The medium along every photon beam, tabulated once (estimators/beam_medium.h).
     std::vector<BeamMedium> photonMedia(t.photonBeams() ? beams.size() : 0);
+    const std::vector<BeamMediumPrep> beamMedia = prepareBeamMedia(*in.scene);
     tbb::parallel_for(size_t(0), photonMedia.size(), [&](size_t i) {
-        photonMedia[i].reset(*in.scene, beams[i]);
+        photonMedia[i].reset(beamMedia[beams[i].mediumId], beams[i]);
         photonMedia[i].build();
     });
     // The beam kernels read the tables flattened (empty in homogeneous media).
