@@ -375,6 +375,7 @@ UB_INLINE ub_float3 ub_bsdf_eval_rough_plastic(UB_PRIVATE const ub_bsdf* b,
  * clearcoat_gloss, roughness), k = sampling rates (diffuse, main specular, clearcoat). */
 UB_INLINE ub_principled ub_bsdf_principled(UB_PRIVATE const ub_bsdf* b) {
     ub_principled p;
+    UB_UNROLL
     for (int c = 0; c < 3; ++c) p.base[c] = b->diffuse[c];
     p.alphaX = b->alpha;
     p.alphaY = b->alphaV;
@@ -410,6 +411,7 @@ UB_INLINE ub_float3 ub_bsdf_eval_principled(UB_PRIVATE const ub_bsdf* b, ub_floa
  * transmission sampling rates in plasticBase (Bsdf::packShared). */
 UB_INLINE ub_principled_thin ub_bsdf_principled_thin(UB_PRIVATE const ub_bsdf* b) {
     ub_principled_thin p;
+    UB_UNROLL
     for (int c = 0; c < 3; ++c) p.base[c] = b->diffuse[c];
     p.roughness = b->eta[2];
     p.anisotropic = b->exponent;

@@ -42,6 +42,7 @@ typedef struct {
  * t0 = 0 and t1 = b.length, in the screen tiles). */
 UB_INLINE ub_beam_part ub_beam_part_of(ub_beam b, ub_uint beam, float t0, float t1) {
     ub_beam_part p;
+    UB_UNROLL
     for (int c = 0; c < 3; ++c) {
         p.origin[c] = b.origin[c];
         p.dir[c] = b.dir[c];
@@ -96,6 +97,7 @@ UB_INLINE void ub_beam_keys4_set(UB_PRIVATE ub_beam_keys4* k, int j, ub_beam_par
 UB_INLINE ub_uint ub_beam_lines_near4(UB_PRIVATE const ub_beam_keys4* k, ub_float3 o, ub_float3 d,
                                       float radiusSqr) {
     ub_uint mask = 0u;
+    UB_UNROLL
     for (int j = 0; j < 4; ++j) {
         ub_float3 oB = ub_make_float3(k->ox[j], k->oy[j], k->oz[j]);
         ub_float3 dB = ub_make_float3(k->dx[j], k->dy[j], k->dz[j]);
@@ -121,6 +123,7 @@ UB_INLINE ub_uint ub_block_lanes(ub_uint block, ub_uint first, ub_uint end) {
 /* Bit c set when child c exists and its box contains p. */
 UB_INLINE ub_uint ub_bvh_contains(UB_PRIVATE const ub_bvh_node* n, ub_float3 p) {
     ub_uint mask = 0u;
+    UB_UNROLL
     for (int c = 0; c < 4; ++c) {
         int in = p.x >= n->loX[c] && p.x <= n->hiX[c] && p.y >= n->loY[c] && p.y <= n->hiY[c] &&
                  p.z >= n->loZ[c] && p.z <= n->hiZ[c] && n->count[c] != UB_BVH_NONE;
@@ -159,6 +162,7 @@ UB_INLINE int ub_bvh_box_meets(float loX, float loY, float loZ, float hiX, float
 UB_INLINE ub_uint ub_bvh_meets(UB_PRIVATE const ub_bvh_node* n, ub_float3 o, ub_float3 invD,
                                float len) {
     ub_uint mask = 0u;
+    UB_UNROLL
     for (int c = 0; c < 4; ++c) {
         int in = ub_bvh_box_meets(n->loX[c], n->loY[c], n->loZ[c], n->hiX[c], n->hiY[c], n->hiZ[c],
                                   o, invD, len) &&

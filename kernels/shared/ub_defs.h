@@ -48,6 +48,13 @@ typedef uint ub_uint;
 #define ub_rint(x) rint(x)
 #define ub_erf(x) erf(x)
 #define ub_erfc(x) erfc(x)
+/* Before a loop of a fixed small count (colour channels, a BVH node's four children, a
+ * query's eight hash cells): unroll it. PoCL 3.1 left such loops rolled, with their arrays
+ * on the stack: the pb2d kernel's MIS sum over four techniques and its homogeneous segment's
+ * three channels ran as loops through memory (perf annotate), and the candle's pb2d pass went
+ * from 0.94 to 0.99-1.01 of its host twin with them unrolled (docs/performance.md, session
+ * 47). Host compilers unroll these already (UB_UNROLL is empty there). */
+#define UB_UNROLL _Pragma("unroll")
 #else
 #include <cmath>
 #include <cstdint>
@@ -71,6 +78,7 @@ typedef uint32_t ub_uint;
 #define ub_rint(x) std::rint(x)
 #define ub_erf(x) std::erf(x)
 #define ub_erfc(x) std::erfc(x)
+#define UB_UNROLL /* host compilers unroll these loops themselves */
 #endif
 
 /* A record aligned to a cache line (typedef struct UB_CACHE_ALIGNED {...} name;): a 128-byte

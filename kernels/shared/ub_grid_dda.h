@@ -19,6 +19,7 @@ UB_INLINE float ub_dda_exit(int v, int step, float P, float invD) {
 UB_INLINE int ub_dda_nearest(UB_PRIVATE const float* tb, float tExit, UB_PRIVATE float* tNext) {
     int axis = -1;
     *tNext = tExit;
+    UB_UNROLL
     for (int a = 0; a < 3; ++a) {
         const int nearer = tb[a] < *tNext;
         axis = nearer ? a : axis;

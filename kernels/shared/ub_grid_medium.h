@@ -83,6 +83,7 @@ UB_INLINE float ub_grid_walk(ub_grid_info g, UB_PRIVATE ub_grid_accessor* acc, u
     *sigmaTLast = bgT;
     if (!(tMax > 0.0f)) return 0.0f;
     float P[3], D[3];
+    UB_UNROLL
     for (int r = 0; r < 3; ++r) {
         P[r] = g.worldToCell[4 * r] * o.x + g.worldToCell[4 * r + 1] * o.y +
                g.worldToCell[4 * r + 2] * o.z + g.worldToCell[4 * r + 3];
@@ -92,6 +93,7 @@ UB_INLINE float ub_grid_walk(ub_grid_info g, UB_PRIVATE ub_grid_accessor* acc, u
     /* Slab test against the cell box [lo, hi). */
     float tEnter = 0.0f, tExit = tMax, invD[3];
     int step[3];
+    UB_UNROLL
     for (int a = 0; a < 3; ++a) {
         step[a] = D[a] > 0.0f ? 1 : (D[a] < 0.0f ? -1 : 0);
         if (step[a] == 0) {
@@ -130,6 +132,7 @@ UB_INLINE float ub_grid_walk(ub_grid_info g, UB_PRIVATE ub_grid_accessor* acc, u
     }
     if (tEnter > 0.0f) UB_GRID_PIECE(0.0f, tEnter, bgT)
     int v[3];
+    UB_UNROLL
     for (int a = 0; a < 3; ++a) {
         int c = (int)ub_floor(P[a] + D[a] * tEnter);
         v[a] = c < g.lo[a] ? g.lo[a] : (c > g.hi[a] - 1 ? g.hi[a] - 1 : c);
@@ -146,6 +149,7 @@ UB_INLINE float ub_grid_walk(ub_grid_info g, UB_PRIVATE ub_grid_accessor* acc, u
              * same operations: the same pieces, bit for bit (tests/medium_test.cpp). */
             int leafLo[3], ended = 0;
             float tb[3], dens = density;
+            UB_UNROLL
             for (int a = 0; a < 3; ++a) {
                 leafLo[a] = v[a] & ~7;
                 tb[a] = step[a] == 0 ? INFINITY : ub_dda_exit(v[a], step[a], P[a], invD[a]);
@@ -175,9 +179,11 @@ UB_INLINE float ub_grid_walk(ub_grid_info g, UB_PRIVATE ub_grid_accessor* acc, u
         }
         const int dim = inLeaf ? 1 : 8;
         int blockLo[3];
+        UB_UNROLL
         for (int a = 0; a < 3; ++a) blockLo[a] = inLeaf ? v[a] : (v[a] & ~7);
         float tNext = tExit;
         int axis = -1;
+        UB_UNROLL
         for (int a = 0; a < 3; ++a) {
             if (step[a] == 0) continue;
             const int boundary = step[a] > 0 ? blockLo[a] + dim : blockLo[a];
@@ -191,6 +197,7 @@ UB_INLINE float ub_grid_walk(ub_grid_info g, UB_PRIVATE ub_grid_accessor* acc, u
         if (tNext > t) UB_GRID_PIECE(t, tNext, g.densityScale * density)
         if (axis < 0) break; /* reached tExit inside this block */
         t = tNext;
+        UB_UNROLL
         for (int b = 0; b < 3; ++b) {
             if (b == axis) continue;
             int c = (int)ub_floor(P[b] + D[b] * t);

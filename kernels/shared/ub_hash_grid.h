@@ -43,6 +43,7 @@ UB_INLINE void ub_hash_block_base(ub_hash_grid g, ub_float3 q, UB_PRIVATE int* b
     d[0] = (q.x - g.lo[0]) * g.invCellSize;
     d[1] = (q.y - g.lo[1]) * g.invCellSize;
     d[2] = (q.z - g.lo[2]) * g.invCellSize;
+    UB_UNROLL
     for (int a = 0; a < 3; ++a) {
         float f = ub_floor(d[a]);
         base[a] = (int)f - (d[a] - f < 0.5f ? 1 : 0);
@@ -53,6 +54,7 @@ UB_INLINE int ub_hash_buckets(ub_hash_grid g, ub_float3 q, UB_PRIVATE ub_uint* b
     int base[3];
     ub_hash_block_base(g, q, base);
     int nb = 0;
+    UB_UNROLL
     for (int k = 0; k < 8; ++k) {
         ub_uint b =
             ub_hash_cell(g, base[0] + (k & 1), base[1] + ((k >> 1) & 1), base[2] + (k >> 2));
@@ -108,6 +110,7 @@ UB_INLINE int ub_hash_buckets8(ub_hash_grid g, ub_float3 q, UB_PRIVATE ub_uint* 
     ub_uint hs[8];
     vstore8(h, 0, hs);
     int nb = 0;
+    UB_UNROLL
     for (int k = 0; k < 8; ++k) {
         ub_uint seen = ub_lane_mask8(h == (uint8)(hs[k])) & ((1u << k) - 1u);
         buckets[nb] = hs[k];

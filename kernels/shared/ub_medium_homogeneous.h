@@ -31,6 +31,7 @@ UB_INLINE ub_segment_eval ub_homogeneous_segment_of(ub_medium_info m, UB_PRIVATE
                                                     float contProb) {
     ub_segment_eval e;
     float stop = 0.0f, pass = 0.0f;
+    UB_UNROLL
     for (int a = 0; a < 3; ++a) {
         e.transmittance[a] = T[a];
         e.sigmaS[a] = m.sigmaS[a];
@@ -59,6 +60,7 @@ UB_INLINE void ub_homogeneous_segment_pair(ub_medium_info m, float contProb, flo
                                            UB_PRIVATE ub_segment_eval* e0,
                                            UB_PRIVATE ub_segment_eval* e1) {
     float T[6];
+    UB_UNROLL
     for (int a = 0; a < 3; ++a) {
         T[a] = ub_exp(-(m.sigmaT[a] * t0));
         T[3 + a] = ub_exp(-(m.sigmaT[a] * t1));

@@ -180,6 +180,7 @@ UB_INLINE float ub_mis_weight_volume(ub_mis_constants c, ub_mis_partials l, ub_m
     float own = etas.eta[tech];
     if (!(own > 0.0f)) return 0.0f;
     float other = 0.0f;
+    UB_UNROLL
     for (ub_uint t = 0u; t < 4u; ++t)
         if (t != tech) other += etas.eta[t];
     return ub_mis_weight_merge_tech(c, l, e, cameraDirPdfW, cameraRevPdfW, own, other);

@@ -43,6 +43,7 @@ UB_INLINE ub_uint ub_pb2d_near4(UB_PRIVATE const ub_photon_keys4* k, ub_float3 o
                                 ub_float3 dir, float length, ub_uint mediumId, float radiusSqr,
                                 UB_PRIVATE float* t) {
     ub_uint mask = 0u;
+    UB_UNROLL
     for (int j = 0; j < 4; ++j) {
         ub_photon_key key;
         key.pos[0] = k->px[j];

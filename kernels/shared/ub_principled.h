@@ -151,6 +151,7 @@ UB_INLINE float ub_principled_diffuse_lobe(float ci, float co, float cd, float r
 /* The sheen's colour: 1 blended towards base / luminance by sheenTint (Burley 2012, B.2). */
 UB_INLINE void ub_principled_sheen_colour(const float base[3], float lum, float sheenTint,
                                           UB_PRIVATE float tint[3]) {
+    UB_UNROLL
     for (int c = 0; c < 3; ++c) {
         float ct = lum > 0.0f ? base[c] / lum : 1.0f;
         tint[c] = 1.0f + (ct - 1.0f) * sheenTint;
@@ -239,6 +240,7 @@ UB_INLINE ub_float3 ub_principled_value(UB_PRIVATE const ub_principled* p, ub_fl
         float r0 = (etaIT - 1.0f) / (etaIT + 1.0f);
         r0 *= r0;
         float spec[3];
+        UB_UNROLL
         for (int c = 0; c < 3; ++c) {
             float fp;
             if (front) {

@@ -45,6 +45,7 @@ UB_INLINE int ub_principled_thin_probs(UB_PRIVATE const ub_principled_thin* p,
     pr[3] = p->rateDiffTrans * (1.0f - st) * dt;
     float total = pr[0] + pr[1] + pr[2] + pr[3];
     if (!(total > 0.0f)) return 0;
+    UB_UNROLL
     for (int k = 0; k < 4; ++k) pr[k] /= total;
     return 1;
 }
@@ -106,6 +107,7 @@ UB_INLINE ub_float3 ub_principled_thin_value(UB_PRIVATE const ub_principled_thin
             float r0 = (etaIT - 1.0f) / (etaIT + 1.0f);
             r0 *= r0;
             float spec[3];
+            UB_UNROLL
             for (int c = 0; c < 3; ++c) {
                 float tint = lum > 0.0f ? p->base[c] / lum : 1.0f;
                 float fs = ub_principled_schlick(tint * r0, ih, p->eta);
