@@ -18,7 +18,10 @@
 //   twin and K times as the kernel, alternately, on the same photons, beams and queries
 //   (VertexCM::replayEstimate); prints the median estimate times, queries per second, the
 //   ratio host / OpenCL and how far the two estimates' image sums differ. Ratios from one
-//   process and alternating runs are what docs/performance.md quotes for issue #11.
+//   process and alternating runs are what docs/performance.md quotes for issue #11. Last, the
+//   run's median iteration with the replayed host passes in place of the kernels' (the other
+//   passes are the same code on both backends): the whole iteration's host / OpenCL ratio
+//   without the noise between separate processes.
 //   --cl-profile: the OpenCL queue profiles its commands (RenderOptions::clProfile), and the
 //   replay also prints the median of each kernel's time on the device and of its latency from
 //   submission to start, which separate the kernel from its launch.
@@ -73,8 +76,9 @@ double median(std::vector<double> v) {
 }
 
 /// --replay: the estimators' host twins against their kernels on the last iteration's records.
+/// Adds each estimator's median host and OpenCL pass times to *hostSum and *deviceSum.
 void replayEstimates(VertexCM& vcm, const std::string& set, int replays, int width, int height,
-                     bool clProfile) {
+                     bool clProfile, double* hostSum, double* deviceSum) {
     const UpbpTechniques& t = vcm.upbpTechniques();
     const std::pair<const char*, bool> techniques[] = {
         {"surf", t.surf}, {"pp3d", t.pp3d}, {"pb2d", t.pb2d}, {"bp2d", t.bp2d}, {"bb1d", t.bb1d}};
@@ -100,6 +104,8 @@ void replayEstimates(VertexCM& vcm, const std::string& set, int replays, int wid
             std::printf("    replay %-5s %-16s no queries\n", name, set.c_str());
             continue;
         }
+        *hostSum += h;
+        *deviceSum += d;
         const double scale = std::max({double(sumHost.x), double(sumHost.y), double(sumHost.z)});
         const double diff = std::max({std::abs(double(sumHost.x - sumDevice.x)),
                                       std::abs(double(sumHost.y - sumDevice.y)),
@@ -192,8 +198,19 @@ int runOne(const std::string& path, const std::string& set, int runs, int width,
         auto* vcm = dynamic_cast<VertexCM*>(integrator.get());
         if (!vcm || !vcm->hasDeviceEstimates())
             std::printf("    replay: this run has no OpenCL estimate pass\n");
-        else
-            replayEstimates(*vcm, set, replays, width, height, clProfile);
+        else {
+            double hostSum = 0.0, deviceSum = 0.0;
+            replayEstimates(*vcm, set, replays, width, height, clProfile, &hostSum, &deviceSum);
+            // The whole iteration with the host twins' passes in place of the kernels', from
+            // this process's alternating replays: the other passes are the same code on either
+            // backend, so this ratio is free of the noise between separate runs.
+            const double it = times[times.size() / 2], withHost = it - deviceSum + hostSum;
+            std::printf(
+                "    replay: estimate passes %.4f s on the host twins, %.4f s as kernels (medians "
+                "summed); this run's iteration of %.4f s would take %.4f s with the twins: "
+                "iteration host/OpenCL %.3f\n",
+                hostSum, deviceSum, it, withHost, it > 0.0 ? withHost / it : 0.0);
+        }
     }
     std::fflush(stdout);
     return 0;
