@@ -51,9 +51,10 @@ typedef uint ub_uint;
 /* Before a loop of a fixed small count (colour channels, a BVH node's four children, a
  * query's eight hash cells): unroll it. PoCL 3.1 left such loops rolled, with their arrays
  * on the stack: the pb2d kernel's MIS sum over four techniques and its homogeneous segment's
- * three channels ran as loops through memory (perf annotate), and the candle's pb2d pass went
- * from 0.94 to 0.99-1.01 of its host twin with them unrolled (docs/performance.md, session
- * 47). Host compilers unroll these already (UB_UNROLL is empty there). */
+ * three channels ran as loops through memory (perf annotate). Unrolled, the pp3d kernels took
+ * 0.69-0.93 of their time and several bp2d kernels 0.81-0.90; the candle's pb2d replay went
+ * from 0.94 to 0.93-1.01 of its host twin (docs/performance.md, session 47). Host compilers
+ * unroll these already (UB_UNROLL is empty there). */
 #define UB_UNROLL _Pragma("unroll")
 #else
 #include <cmath>
