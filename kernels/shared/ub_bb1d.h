@@ -42,9 +42,10 @@ UB_INLINE int ub_bb1d_pair(ub_beam qb, ub_beam_part part, float radiusSqr, ub_ui
     return ub_beam_part_holds(part, *tl, part.length);
 }
 
-UB_INLINE ub_float3 ub_bb1d_contribution(ub_mis_constants c, ub_beam pb, ub_beam qb,
-                                         ub_segment_eval sl, ub_segment_eval sc, float tl, float tc,
-                                         float sinTheta, float g, float normalization) {
+UB_INLINE_HOT ub_float3 ub_bb1d_contribution(ub_mis_constants c, ub_beam pb, ub_beam qb,
+                                             ub_segment_eval sl, ub_segment_eval sc, float tl,
+                                             float tc, float sinTheta, float g,
+                                             float normalization) {
     ub_beam_point lp = ub_beam_at(c, pb, sl, tl, 1u);
     ub_beam_point cp = ub_beam_at(c, qb, sc, tc, 0u);
     if (!lp.valid || !cp.valid) return ub_make_float3(0.0f, 0.0f, 0.0f);

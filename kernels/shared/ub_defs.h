@@ -3,8 +3,8 @@
  * Headers in kernels/shared/ are written in a C99 subset that compiles both
  * as OpenCL C 1.2 (on PoCL or any device) and as C++17 on the host, so host
  * tests exercise exactly the math the kernels run. Rules:
- *  - functions are UB_INLINE, take scalars or UB_* structs, never pointers to
- *    host memory unless marked UB_GLOBAL / UB_PRIVATE;
+ *  - functions are UB_INLINE (UB_INLINE_HOT: forced on the host), take scalars or UB_* structs,
+ * never pointers to host memory unless marked UB_GLOBAL / UB_PRIVATE;
  *  - math through the ub_* wrappers below (OpenCL has overloaded sqrt etc.,
  *    C++ uses std::);
  *  - fixed-size scalars only (float, uint32_t via ub_uint), no double.
@@ -16,6 +16,7 @@
  * are static inline so that each program or translation unit has its own copy. */
 #ifdef __OPENCL_C_VERSION__
 #define UB_INLINE static inline
+#define UB_INLINE_HOT static inline /* see the host's definition below */
 #define UB_GLOBAL __global
 #define UB_PRIVATE __private
 typedef uint ub_uint;
@@ -61,6 +62,13 @@ typedef uint ub_uint;
 #include <cstdint>
 #include <cstring>
 #define UB_INLINE static inline
+/* A function of a twin's inner loop that GCC keeps out of line for its size. It then copied
+ * its by-value records (two 96-byte beams, the MIS constants) for each call: bb1d's pair
+ * contribution was 5.8% of the bunny's `upbp:bb1d` samples on its own. Inlined, the host
+ * twin's pass took 0.95-0.96 of its time, against the kernel's pass in the same processes
+ * (bunny, mirrorballs; docs/performance.md, session 48). OpenCL compilers inline these
+ * already. */
+#define UB_INLINE_HOT static inline __attribute__((always_inline))
 #define UB_GLOBAL
 #define UB_PRIVATE
 typedef uint32_t ub_uint;
