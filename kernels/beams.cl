@@ -297,13 +297,17 @@ static void ub_bb1d_flush(__global const ub_beam* beams, __global const ub_beam_
         sins[nf] = sinTheta;
         ++nf;
     }
+    /* Both beams of each pair are in the query's medium: in a homogeneous one, the
+     * exponentials of all the pairs in one loop. */
+    float T[6 * UB_BB1D_PENDING];
+    if (qm->m.homogeneous) ub_homogeneous_transmittance_pairs(qm->m, tls, tcs, nf, T);
     for (int j = 0; j < nf; ++j) {
         uint beam = accepted[j];
         ub_beam pb = beams[beam];
         ub_segment_eval sl, sc;
         if (qm->m.homogeneous) {
-            /* Both beams are in the query's medium: their six exponentials side by side. */
-            ub_homogeneous_segment_pair(qm->m, qm->mCont, tls[j], tcs[j], &sl, &sc);
+            sl = ub_homogeneous_segment_of(qm->m, T + 6 * j, qm->mCont);
+            sc = ub_homogeneous_segment_of(qm->m, T + 6 * j + 3, qm->mCont);
         } else {
             sl = ub_photon_beam_segment(qm->m, qm->mCont, qm->gi, &qm->acc, pb, tls[j], beamPieces,
                                         beamRanges, beam);

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "kernels/shared/ub_defs.h"
+#include "kernels/shared/ub_medium_homogeneous.h"
 
 namespace {
 
@@ -384,4 +385,65 @@ __kernel void ub_exp_bits(__global uint* out) {
     }
     EXPECT_EQ(differ, 0);
     EXPECT_GT(compared, int(n / 2) + int(n / 3));
+}
+
+namespace {
+// Code compiled here and, as the text of the same tokens, in a kernel.
+#define UB_HOST_AND_DEVICE(text, ...) \
+    __VA_ARGS__                       \
+    const char* const text = #__VA_ARGS__;
+
+// Pair j of case i: distances from i and j, up to about 40 mean free paths; odd i: a grey medium.
+// Counts the transmittances where ub_homogeneous_transmittance_pairs and
+// ub_homogeneous_segment_cp differ (no NaN or -0 among them: != compares their bits).
+UB_HOST_AND_DEVICE(
+    kPairsSource, UB_INLINE ub_uint ub_pairs_mismatches(ub_uint i) {
+        ub_medium_info m;
+        m.sigmaT[0] = 0.7f;
+        m.sigmaT[1] = (i & 1u) ? 0.7f : 1.3f;
+        m.sigmaT[2] = (i & 1u) ? 0.7f : 0.05f;
+        m.sigmaS[0] = m.sigmaS[1] = m.sigmaS[2] = 0.5f;
+        m.g = 0.0f;
+        m.homogeneous = 1u;
+        int n = (int)(i % 32u) + 1;
+        float t0[32], t1[32], T[6 * 32];
+        for (int j = 0; j < n; ++j) {
+            t0[j] = (float)((i * 37u + (ub_uint)j * 11u) % 1000u) * 0.0571f;
+            t1[j] = (float)((i * 13u + (ub_uint)j * 29u) % 1000u) * 0.0313f;
+        }
+        ub_homogeneous_transmittance_pairs(m, t0, t1, n, T);
+        ub_uint bad = 0u;
+        for (int j = 0; j < n; ++j) {
+            ub_segment_eval e0 = ub_homogeneous_segment_cp(m, t0[j], 1.0f);
+            ub_segment_eval e1 = ub_homogeneous_segment_cp(m, t1[j], 1.0f);
+            for (int a = 0; a < 3; ++a) {
+                bad += T[6 * j + a] != e0.transmittance[a] ? 1u : 0u;
+                bad += T[6 * j + 3 + a] != e1.transmittance[a] ? 1u : 0u;
+            }
+        }
+        return bad;
+    })
+}  // namespace
+
+// ub_homogeneous_transmittance_pairs (bb1d's kernel: the exponentials of a flush's pairs in one
+// loop) gives the transmittances of ub_homogeneous_segment_cp at each pair's two distances, bit
+// for bit, for 1 to 32 pairs in a grey and a coloured medium, on the host and on the device.
+TEST(OpenClHeaders, TransmittancePairsEqualTheSegmentsOneByOne) {
+    const cl_uint n = 4096;
+    cl_uint hostBad = 0;
+    for (cl_uint i = 0; i < n; ++i) hostBad += ub_pairs_mismatches(i);
+    EXPECT_EQ(hostBad, 0u);
+    const std::string src = std::string(
+                                "#pragma OPENCL FP_CONTRACT OFF\n"
+                                "#include \"ub_medium_homogeneous.h\"\n") +
+                            kPairsSource + R"(
+__kernel void ub_pairs(__global uint* out) {
+    uint i = get_global_id(0);
+    out[i] = ub_pairs_mismatches(i);
+})";
+    std::vector<cl_uint> out(n, 1u);
+    ASSERT_NO_FATAL_FAILURE(runUintKernel(src, "ub_pairs", "", n, &out));
+    cl_uint deviceBad = 0;
+    for (cl_uint v : out) deviceBad += v;
+    EXPECT_EQ(deviceBad, 0u);
 }

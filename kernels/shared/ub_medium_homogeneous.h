@@ -53,20 +53,25 @@ UB_INLINE ub_segment_eval ub_homogeneous_segment_cp(ub_medium_info m, float t, f
     return ub_homogeneous_segment_of(m, T, contProb);
 }
 
-/* ub_homogeneous_segment_cp at t0 (*e0) and at t1 (*e1), the same values: the six exponentials
- * in one place, where a compiler can evaluate them as one vector (bb1d's kernel 2% faster with
- * both beams of a pair in one medium, docs/performance.md, session 38). */
-UB_INLINE void ub_homogeneous_segment_pair(ub_medium_info m, float contProb, float t0, float t1,
-                                           UB_PRIVATE ub_segment_eval* e0,
-                                           UB_PRIVATE ub_segment_eval* e1) {
-    float T[6];
-    UB_UNROLL
-    for (int a = 0; a < 3; ++a) {
-        T[a] = ub_exp(-(m.sigmaT[a] * t0));
-        T[3 + a] = ub_exp(-(m.sigmaT[a] * t1));
+/* The transmittances of n pairs of distances in one homogeneous medium: T[6 j + a] =
+ * exp(-sigma_t[a] t0[j]) and T[6 j + 3 + a] = exp(-sigma_t[a] t1[j]) (a = 0, 1, 2), those of
+ * ub_homogeneous_segment_cp at t0[j] and t1[j], the same bits, in one loop over the 6 n
+ * exponentials, which a vectorising compiler evaluates several at a time. In the bb1d kernel
+ * on PoCL (ub_exp_poly's arithmetic) the pass took 0.80 (bunny) and 0.87 (mirrorballs) of its
+ * time with the pairs' exponentials in this loop instead of six per pair (docs/performance.md,
+ * session 48). The host twin keeps ub_homogeneous_segment_cp per pair: this loop there, eight
+ * ub_exp_poly at a time with AVX, was no faster than glibc's expf per pair. */
+UB_INLINE void ub_homogeneous_transmittance_pairs(ub_medium_info m, UB_PRIVATE const float* t0,
+                                                  UB_PRIVATE const float* t1, int n,
+                                                  UB_PRIVATE float* T) {
+    for (int j = 0; j < n; ++j) {
+        UB_UNROLL
+        for (int a = 0; a < 3; ++a) {
+            T[6 * j + a] = -(m.sigmaT[a] * t0[j]);
+            T[6 * j + 3 + a] = -(m.sigmaT[a] * t1[j]);
+        }
     }
-    *e0 = ub_homogeneous_segment_of(m, T, contProb);
-    *e1 = ub_homogeneous_segment_of(m, T + 3, contProb);
+    for (int k = 0; k < 6 * n; ++k) T[k] = ub_exp(T[k]);
 }
 
 UB_INLINE float ub_homogeneous_cont_prob(ub_medium_info m) {
