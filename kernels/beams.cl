@@ -120,11 +120,16 @@ static void ub_pb2d_flush(__global const ub_photon_point* photons, ub_query_medi
     uint lengths[UB_PB2D_PENDING];
     for (int j = 0; j < np; ++j) UB_PREFETCH(photons + pending[j]);
     for (int j = 0; j < np; ++j) lengths[j] = photons[pending[j]].pathLength;
+    /* In a homogeneous medium, the pairs' exponentials in one loop (as bb1d's flush). */
+    float T[3 * UB_PB2D_PENDING];
+    if (qm->m.homogeneous) ub_homogeneous_transmittances(qm->m, t, np, T);
     for (int j = 0; j < np; ++j) {
         if (!ub_pb2d_length_ok(lengths[j], *qb, minLength, maxLength)) continue;
         ub_photon_point ph = photons[pending[j]];
-        ub_segment_eval s = ub_query_beam_segment(qm->m, qm->mCont, qm->gi, &qm->acc, *qb, t[j],
-                                                  table, UB_QUERY_PIECES, tableState);
+        ub_segment_eval s = qm->m.homogeneous
+                                ? ub_homogeneous_segment_of(qm->m, T + 3 * j, qm->mCont)
+                                : ub_query_beam_segment(qm->m, qm->mCont, qm->gi, &qm->acc, *qb,
+                                                        t[j], table, UB_QUERY_PIECES, tableState);
         ub_float3 c = ub_pb2d_contribution(mis, ph, *qb, s, t[j], qm->m.g, normalization);
         sum[0] += c.x;
         sum[1] += c.y;

@@ -394,8 +394,9 @@ namespace {
     const char* const text = #__VA_ARGS__;
 
 // Pair j of case i: distances from i and j, up to about 40 mean free paths; odd i: a grey medium.
-// Counts the transmittances where ub_homogeneous_transmittance_pairs and
-// ub_homogeneous_segment_cp differ (no NaN or -0 among them: != compares their bits).
+// Counts the transmittances where ub_homogeneous_transmittance_pairs or
+// ub_homogeneous_transmittances and ub_homogeneous_segment_cp differ (no NaN or -0 among them:
+// != compares their bits).
 UB_HOST_AND_DEVICE(
     kPairsSource, UB_INLINE ub_uint ub_pairs_mismatches(ub_uint i) {
         ub_medium_info m;
@@ -421,13 +422,19 @@ UB_HOST_AND_DEVICE(
                 bad += T[6 * j + 3 + a] != e1.transmittance[a] ? 1u : 0u;
             }
         }
+        ub_homogeneous_transmittances(m, t1, n, T);
+        for (int j = 0; j < n; ++j) {
+            ub_segment_eval e1 = ub_homogeneous_segment_cp(m, t1[j], 1.0f);
+            for (int a = 0; a < 3; ++a) bad += T[3 * j + a] != e1.transmittance[a] ? 1u : 0u;
+        }
         return bad;
     })
 }  // namespace
 
-// ub_homogeneous_transmittance_pairs (bb1d's kernel: the exponentials of a flush's pairs in one
-// loop) gives the transmittances of ub_homogeneous_segment_cp at each pair's two distances, bit
-// for bit, for 1 to 32 pairs in a grey and a coloured medium, on the host and on the device.
+// ub_homogeneous_transmittance_pairs and ub_homogeneous_transmittances (bb1d's and pb2d's kernels:
+// the exponentials of a flush's pairs in one loop) give the transmittances of
+// ub_homogeneous_segment_cp at each pair's distances, bit for bit, for 1 to 32 pairs in a grey and
+// a coloured medium, on the host and on the device.
 TEST(OpenClHeaders, TransmittancePairsEqualTheSegmentsOneByOne) {
     const cl_uint n = 4096;
     cl_uint hostBad = 0;
