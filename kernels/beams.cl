@@ -304,15 +304,18 @@ static void ub_bb1d_flush(__global const ub_beam* beams, __global const ub_beam_
     }
     /* Both beams of each pair are in the query's medium: in a homogeneous one, the
      * exponentials of all the pairs in one loop. */
-    float T[6 * UB_BB1D_PENDING];
-    if (qm->m.homogeneous) ub_homogeneous_transmittance_pairs(qm->m, tls, tcs, nf, T);
+    float Tl[3 * UB_BB1D_PENDING], Tc[3 * UB_BB1D_PENDING];
+    if (qm->m.homogeneous) {
+        ub_homogeneous_transmittances(qm->m, tls, nf, Tl);
+        ub_homogeneous_transmittances(qm->m, tcs, nf, Tc);
+    }
     for (int j = 0; j < nf; ++j) {
         uint beam = accepted[j];
         ub_beam pb = beams[beam];
         ub_segment_eval sl, sc;
         if (qm->m.homogeneous) {
-            sl = ub_homogeneous_segment_of(qm->m, T + 6 * j, qm->mCont);
-            sc = ub_homogeneous_segment_of(qm->m, T + 6 * j + 3, qm->mCont);
+            sl = ub_homogeneous_segment_of(qm->m, Tl + 3 * j, qm->mCont);
+            sc = ub_homogeneous_segment_of(qm->m, Tc + 3 * j, qm->mCont);
         } else {
             sl = ub_photon_beam_segment(qm->m, qm->mCont, qm->gi, &qm->acc, pb, tls[j], beamPieces,
                                         beamRanges, beam);

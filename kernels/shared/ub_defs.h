@@ -3,8 +3,9 @@
  * Headers in kernels/shared/ are written in a C99 subset that compiles both
  * as OpenCL C 1.2 (on PoCL or any device) and as C++17 on the host, so host
  * tests exercise exactly the math the kernels run. Rules:
- *  - functions are UB_INLINE (UB_INLINE_HOT: forced on the host), take scalars or UB_* structs,
- * never pointers to host memory unless marked UB_GLOBAL / UB_PRIVATE;
+ *  - functions are UB_INLINE (UB_INLINE_HOT: forced inline on the host), take
+ *    scalars or UB_* structs, never pointers to host memory unless marked
+ *    UB_GLOBAL / UB_PRIVATE;
  *  - math through the ub_* wrappers below (OpenCL has overloaded sqrt etc.,
  *    C++ uses std::);
  *  - fixed-size scalars only (float, uint32_t via ub_uint), no double.

@@ -53,31 +53,15 @@ UB_INLINE ub_segment_eval ub_homogeneous_segment_cp(ub_medium_info m, float t, f
     return ub_homogeneous_segment_of(m, T, contProb);
 }
 
-/* The transmittances of n pairs of distances in one homogeneous medium: T[6 j + a] =
- * exp(-sigma_t[a] t0[j]) and T[6 j + 3 + a] = exp(-sigma_t[a] t1[j]) (a = 0, 1, 2), those of
- * ub_homogeneous_segment_cp at t0[j] and t1[j], the same bits, in one loop over the 6 n
- * exponentials, which a vectorising compiler evaluates several at a time (PoCL's, eight wide:
- * ymm registers in the kernel's disassembly). In the bb1d kernel on PoCL (ub_exp_poly's
- * arithmetic) the pass took 0.80 (bunny) and 0.87 (mirrorballs) of its
- * time with the pairs' exponentials in this loop instead of six per pair (docs/performance.md,
- * session 48). The host twin keeps ub_homogeneous_segment_cp per pair: this loop there, eight
- * ub_exp_poly at a time with AVX, was no faster than glibc's expf per pair. */
-UB_INLINE void ub_homogeneous_transmittance_pairs(ub_medium_info m, UB_PRIVATE const float* t0,
-                                                  UB_PRIVATE const float* t1, int n,
-                                                  UB_PRIVATE float* T) {
-    for (int j = 0; j < n; ++j) {
-        UB_UNROLL
-        for (int a = 0; a < 3; ++a) {
-            T[6 * j + a] = -(m.sigmaT[a] * t0[j]);
-            T[6 * j + 3 + a] = -(m.sigmaT[a] * t1[j]);
-        }
-    }
-    for (int k = 0; k < 6 * n; ++k) T[k] = ub_exp(T[k]);
-}
-
-/* The same for n single distances (pb2d's pairs, each on the query beam): T[3 j + a] =
- * exp(-sigma_t[a] t[j]). The pb2d kernel took 0.94 (bunny), 0.98 (mirrorballs, the candle) of
- * its time with its flush's exponentials in this loop (docs/performance.md, session 48). */
+/* The transmittances of n distances in one homogeneous medium, T[3 j + a] = exp(-sigma_t[a] t[j])
+ * (a = 0, 1, 2): those of ub_homogeneous_segment_cp at t[j], the same bits, in one loop over the
+ * 3 n exponentials, which a vectorising compiler evaluates several at a time (PoCL's, eight
+ * wide: ymm registers in the kernel's disassembly). The bb1d and pb2d kernels compute a flush's
+ * pairs so (ub_exp_poly's arithmetic on PoCL): the bb1d kernel took 0.80 (bunny) and 0.87
+ * (mirrorballs) of its time, pb2d 0.94 (bunny) and 0.98 (mirrorballs, the candle), against
+ * ub_homogeneous_segment_cp pair by pair (docs/performance.md, session 48). The host twins keep
+ * that: this loop there, eight ub_exp_poly at a time with AVX, was no faster than glibc's expf
+ * per pair. */
 UB_INLINE void ub_homogeneous_transmittances(ub_medium_info m, UB_PRIVATE const float* t, int n,
                                              UB_PRIVATE float* T) {
     for (int j = 0; j < n; ++j) {
