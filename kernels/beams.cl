@@ -368,9 +368,10 @@ __kernel void ub_bb1d_estimate(
         for (int l = 0; l < 2; ++l) {
             uint end = tileStart[lists[l] + 1u];
             for (uint b = tileStart[lists[l]]; b < end; ++b) {
-                uint near = b + 1u < end
-                                ? ub_beam_lines_near8_global(tileLines + b, o, d, radius * radius)
-                                : ub_beam_lines_near4_global(tileLines + b, o, d, radius * radius);
+                uint near =
+                    b + 1u < end
+                        ? ub_beam_lines_near8_global(tileLines + b, o, d, qLength, radius * radius)
+                        : ub_beam_lines_near4_global(tileLines + b, o, d, qLength, radius * radius);
                 for (; near != 0u; near &= near - 1u) {
                     pending[np++] = tileParts[b * 4u + (31u - clz(near & (0u - near)))];
                     if (np == UB_BB1D_PENDING) {
@@ -398,11 +399,11 @@ __kernel void ub_bb1d_estimate(
             /* two blocks at once where the leaf has both (ub_beam_lines_near8_global) */
             uint near;
             if ((b + 1u) * 4u < leafEnd) {
-                uint m8 = ub_beam_lines_near8_global(lines + b, o, d, radius * radius);
+                uint m8 = ub_beam_lines_near8_global(lines + b, o, d, qLength, radius * radius);
                 near = (m8 & ub_block_lanes(b, leafFirst, leafEnd)) |
                        ((m8 >> 4) & ub_block_lanes(b + 1u, leafFirst, leafEnd)) << 4;
             } else {
-                near = ub_beam_lines_near4_global(lines + b, o, d, radius * radius) &
+                near = ub_beam_lines_near4_global(lines + b, o, d, qLength, radius * radius) &
                        ub_block_lanes(b, leafFirst, leafEnd);
             }
             for (; near != 0u; near &= near - 1u) {

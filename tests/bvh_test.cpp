@@ -358,7 +358,8 @@ ub_beam_part randomPartNear(Rng& rng, const Vec3& o, const Vec3& d, int k, bool 
 // ub_beam_part_holds) rejects too (the filter never drops a pair), and ub_block_lanes masks
 // exactly the block's lanes inside a leaf's range. Lines at every angle (parallel ones
 // included), separations around the radius, parts of beams of length 4 with ranges around the
-// closest points, last parts among them.
+// closest points, last parts among them, query beams of length 4 or ending around them (the
+// filter tests the query's range too).
 TEST(Bvh, BeamLineFilterEqualsTheSharedOneAndDropsNoPair) {
     Rng rng(31, 4);
     int near = 0, pairs = 0;
@@ -376,12 +377,14 @@ TEST(Bvh, BeamLineFilterEqualsTheSharedOneAndDropsNoPair) {
         }
         const ub_float3 oo = ub_make_float3(o.x, o.y, o.z), dd = ub_make_float3(d.x, d.y, d.z);
         const float r2 = 0.01f;
-        const uint32_t mask = ub_beam_lines_near4(&keys, oo, dd, r2);
-        ASSERT_EQ(beamLinesNear4(keys, oo, dd, r2), mask) << "case " << k;
+        // Query beams of length 4 (through the parts' region) or shorter, ending around it.
+        const float qLen = k % 3 == 0 ? 4.0f : 0.5f + 3.5f * rng.uniform();
+        const uint32_t mask = ub_beam_lines_near4(&keys, oo, dd, qLen, r2);
+        ASSERT_EQ(beamLinesNear4(keys, oo, dd, qLen, r2), mask) << "case " << k;
         for (int j = 0; j < 4; ++j) {
             float tA = 0, tB = 0, sinTheta = 0;
             const bool pair =
-                ub_beam_beam_near(oo, dd, 4.0f, oB[j], dB[j], 4.0f, r2, &tA, &tB, &sinTheta) &&
+                ub_beam_beam_near(oo, dd, qLen, oB[j], dB[j], 4.0f, r2, &tA, &tB, &sinTheta) &&
                 ub_beam_part_holds(parts[j], tB, parts[j].length);
             pairs += pair;
             near += (mask >> j) & 1u;
@@ -412,22 +415,22 @@ TEST(Bvh, BeamLineFilterEightWideEqualsTwoBlocks) {
         EXPECT_FALSE(bb1dWideWalk());
         const ub_beam_keys4 keys[2] = {};
         const ub_float3 o = ub_make_float3(0.0f, 0.0f, 0.0f), d = ub_make_float3(1.0f, 0.0f, 0.0f);
-        EXPECT_THROW(bb1dLinesNear8ForTests(keys, o, d, 0.01f), std::logic_error);
+        EXPECT_THROW(bb1dLinesNear8ForTests(keys, o, d, 4.0f, 0.01f), std::logic_error);
         return;
     }
     Rng rng(37, 5);
     int set = 0;
-    for (int k = 0; k < 20000; ++k) {
+    for (int k = 0; k < 25000; ++k) {
         const Vec3 o = randomIn(rng, -2.0f, 2.0f);
         const Vec3 d = sampleUniformSphere(rng.uniform2());
         ub_beam_keys4 keys[2] = {};
         for (int j = 0; j < 8; ++j)
             ub_beam_keys4_set(&keys[j / 4], j % 4, randomPartNear(rng, o, d, k, k % 13 == j));
         const ub_float3 oo = ub_make_float3(o.x, o.y, o.z), dd = ub_make_float3(d.x, d.y, d.z);
-        const float r2 = 0.01f;
-        const uint32_t two =
-            beamLinesNear4(keys[0], oo, dd, r2) | beamLinesNear4(keys[1], oo, dd, r2) << 4;
-        ASSERT_EQ(bb1dLinesNear8ForTests(keys, oo, dd, r2), two) << "case " << k;
+        const float r2 = 0.01f, qLen = k % 3 == 0 ? 4.0f : 0.5f + 3.5f * rng.uniform();
+        const uint32_t two = beamLinesNear4(keys[0], oo, dd, qLen, r2) |
+                             beamLinesNear4(keys[1], oo, dd, qLen, r2) << 4;
+        ASSERT_EQ(bb1dLinesNear8ForTests(keys, oo, dd, qLen, r2), two) << "case " << k;
         set += __builtin_popcount(two);
     }
     EXPECT_GT(set, 10000);  // lanes that passed: the comparison saw both answers

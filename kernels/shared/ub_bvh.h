@@ -84,8 +84,9 @@ UB_INLINE void ub_beam_keys4_set(UB_PRIVATE ub_beam_keys4* k, int j, ub_beam_par
     k->t1[j] = p.t1 < p.length ? p.t1 + 1e-5f * ub_fabs(p.t1) : INFINITY;
 }
 
-/* Bit j set when line j of the block passes within sqrt(radiusSqr) of the line o + t d and
- * the closest point of line j lies in part j's (widened) range, by the first two tests of
+/* Bit j set when line j of the block passes within sqrt(radiusSqr) of the line o + t d, the
+ * closest point of line j lies in part j's (widened) range, and the query's closest point in
+ * [0, queryLength] (widened by 1e-5 of the terms it is the difference of), by the first tests of
  * ub_beam_beam_near (not parallel; separation along d x d_j) and ub_beam_part_holds on its
  * parameter tB = num / sin2, the range compared against num without the division (sin2 >
  * 1e-7 wherever a bit is set; a division is the costliest operation of the test on GPUs, and
@@ -93,9 +94,12 @@ UB_INLINE void ub_beam_keys4_set(UB_PRIVATE ub_beam_keys4* k, int j, ub_beam_par
  * rejects. A
  * filter ahead of the pair test, which still decides; the lanes are the caller's to mask.
  * The range test drops the parts next to the one that holds a pair, which share its line:
- * 45% of the candidates the lines alone passed on mirrorballs, 29% on the bunny. */
+ * 45% of the candidates the lines alone passed on mirrorballs, 29% on the bunny. The query's
+ * range (its numerator the pair test's nA, the same operations) drops the lines that meet the
+ * query's line off the query beam: 23% of the candidates left on the bunny, 13% on mirrorballs,
+ * each a part record read (docs/performance.md, session 49). */
 UB_INLINE ub_uint ub_beam_lines_near4(UB_PRIVATE const ub_beam_keys4* k, ub_float3 o, ub_float3 d,
-                                      float radiusSqr) {
+                                      float queryLength, float radiusSqr) {
     ub_uint mask = 0u;
     UB_UNROLL
     for (int j = 0; j < 4; ++j) {
@@ -105,9 +109,14 @@ UB_INLINE ub_uint ub_beam_lines_near4(UB_PRIVATE const ub_beam_keys4* k, ub_floa
         float b = ub_f3_dot(d, dB);
         float sin2 = 1.0f - b * b;
         float sep = ub_f3_dot(w0, ub_f3_cross(d, dB));
-        float num = ub_f3_dot(dB, w0) - b * ub_f3_dot(d, w0);
+        float e = ub_f3_dot(dB, w0), dw = ub_f3_dot(d, w0);
+        float num = e - b * dw;
         int held = !(num < k->t0[j] * sin2 || num >= k->t1[j] * sin2);
-        mask |= (sin2 > 1e-7f && !(sep * sep > radiusSqr * sin2) && held) ? (1u << j) : 0u;
+        /* the query's side: its closest point's parameter (times sin2) in [0, queryLength] */
+        float qNum = b * e - dw, slack = 1e-5f * (ub_fabs(b * e) + ub_fabs(dw));
+        int onQuery = !(qNum < -slack || qNum > queryLength * sin2 * 1.0001f + slack);
+        mask |=
+            (sin2 > 1e-7f && !(sep * sep > radiusSqr * sin2) && held && onQuery) ? (1u << j) : 0u;
     }
     return mask;
 }
@@ -189,29 +198,32 @@ UB_INLINE ub_uint ub_bvh_meets_global(__global const ub_bvh_node* n, ub_float3 o
 
 /* The line filter of ub_beam_lines_near4 on T lanes (float4: one block; float8: two), its
  * comparisons as IT; LOAD(field) gives the lanes of a field of ub_beam_keys4. Sets `near`. */
-#define UB_BEAM_LINES_NEAR(T, IT, LOAD, o, d, radiusSqr, near)                    \
-    {                                                                             \
-        T ubOx = LOAD(ox), ubOy = LOAD(oy), ubOz = LOAD(oz);                      \
-        T ubDx = LOAD(dx), ubDy = LOAD(dy), ubDz = LOAD(dz);                      \
-        T ubB = d.x * ubDx + d.y * ubDy + d.z * ubDz;                             \
-        T ubSin2 = 1.0f - ubB * ubB;                                              \
-        T ubWx = o.x - ubOx, ubWy = o.y - ubOy, ubWz = o.z - ubOz;                \
-        T ubCx = d.y * ubDz - d.z * ubDy, ubCy = d.z * ubDx - d.x * ubDz,         \
-          ubCz = d.x * ubDy - d.y * ubDx;                                         \
-        T ubSep = ubWx * ubCx + ubWy * ubCy + ubWz * ubCz;                        \
-        T ubNum = (ubDx * ubWx + ubDy * ubWy + ubDz * ubWz) -                     \
-                  ubB * (d.x * ubWx + d.y * ubWy + d.z * ubWz);                   \
-        IT ubHeld = !(ubNum < LOAD(t0) * ubSin2 || ubNum >= LOAD(t1) * ubSin2);   \
-        near = (ubSin2 > 1e-7f) & !(ubSep * ubSep > radiusSqr * ubSin2) & ubHeld; \
+#define UB_BEAM_LINES_NEAR(T, IT, LOAD, o, d, queryLength, radiusSqr, near)                       \
+    {                                                                                             \
+        T ubOx = LOAD(ox), ubOy = LOAD(oy), ubOz = LOAD(oz);                                      \
+        T ubDx = LOAD(dx), ubDy = LOAD(dy), ubDz = LOAD(dz);                                      \
+        T ubB = d.x * ubDx + d.y * ubDy + d.z * ubDz;                                             \
+        T ubSin2 = 1.0f - ubB * ubB;                                                              \
+        T ubWx = o.x - ubOx, ubWy = o.y - ubOy, ubWz = o.z - ubOz;                                \
+        T ubCx = d.y * ubDz - d.z * ubDy, ubCy = d.z * ubDx - d.x * ubDz,                         \
+          ubCz = d.x * ubDy - d.y * ubDx;                                                         \
+        T ubSep = ubWx * ubCx + ubWy * ubCy + ubWz * ubCz;                                        \
+        T ubE = ubDx * ubWx + ubDy * ubWy + ubDz * ubWz;                                          \
+        T ubDw = d.x * ubWx + d.y * ubWy + d.z * ubWz;                                            \
+        T ubNum = ubE - ubB * ubDw;                                                               \
+        IT ubHeld = !(ubNum < LOAD(t0) * ubSin2 || ubNum >= LOAD(t1) * ubSin2);                   \
+        T ubQNum = ubB * ubE - ubDw, ubSlack = 1e-5f * (fabs(ubB * ubE) + fabs(ubDw));            \
+        IT ubOnQuery = !(ubQNum < -ubSlack || ubQNum > (queryLength)*ubSin2 * 1.0001f + ubSlack); \
+        near = (ubSin2 > 1e-7f) & !(ubSep * ubSep > radiusSqr * ubSin2) & ubHeld & ubOnQuery;     \
     }
 #define UB_KEYS_LOAD4(field) vload4(0, k->field)
 #define UB_KEYS_LOAD8(field) ((float8)(vload4(0, k[0].field), vload4(0, k[1].field)))
 
 /* The kernels' ub_beam_lines_near4: the four lines as float4 lanes, the same operations. */
 UB_INLINE ub_uint ub_beam_lines_near4_global(__global const ub_beam_keys4* k, ub_float3 o,
-                                             ub_float3 d, float radiusSqr) {
+                                             ub_float3 d, float queryLength, float radiusSqr) {
     int4 near;
-    UB_BEAM_LINES_NEAR(float4, int4, UB_KEYS_LOAD4, o, d, radiusSqr, near)
+    UB_BEAM_LINES_NEAR(float4, int4, UB_KEYS_LOAD4, o, d, queryLength, radiusSqr, near)
     return ub_lane_mask4(near);
 }
 
@@ -219,9 +231,9 @@ UB_INLINE ub_uint ub_beam_lines_near4_global(__global const ub_beam_keys4* k, ub
  * k[0]'s mask, bits 4-7 block k[1]'s. On PoCL's AVX2 CPU target a float8 is one register, so two
  * blocks cost about what one did (the host's beamLinesNear8, src/estimators/bb1d_walk.inc). */
 UB_INLINE ub_uint ub_beam_lines_near8_global(__global const ub_beam_keys4* k, ub_float3 o,
-                                             ub_float3 d, float radiusSqr) {
+                                             ub_float3 d, float queryLength, float radiusSqr) {
     int8 near;
-    UB_BEAM_LINES_NEAR(float8, int8, UB_KEYS_LOAD8, o, d, radiusSqr, near)
+    UB_BEAM_LINES_NEAR(float8, int8, UB_KEYS_LOAD8, o, d, queryLength, radiusSqr, near)
     return ub_lane_mask8(near);
 }
 

@@ -134,9 +134,9 @@ void setBb1dWideWalkForTests(bool allowed) {
 }
 
 uint32_t bb1dLinesNear8ForTests(const ub_beam_keys4* k, const ub_float3& o, const ub_float3& d,
-                                float radiusSqr) {
+                                float queryLength, float radiusSqr) {
 #if UB_BB1D_HAS_WIDE
-    if (cpuHasAvx()) return wide::beamLinesNear8(k, o, d, radiusSqr);
+    if (cpuHasAvx()) return wide::beamLinesNear8(k, o, d, queryLength, radiusSqr);
 #endif
     throw std::logic_error("bb1dLinesNear8ForTests: this CPU or build has no AVX walk");
 }

@@ -277,7 +277,7 @@ void Bvh::querySegmentLeaves(const Vec3& o, const Vec3& d, float len, uint32_t g
 /// ub_beam_lines_near4 (kernels/shared/ub_bvh.h) in SSE: the same operations in the same order
 /// per lane, so the same mask.
 inline uint32_t beamLinesNear4(const ub_beam_keys4& k, const ub_float3& o, const ub_float3& d,
-                               float radiusSqr) {
+                               float queryLength, float radiusSqr) {
 #if defined(__SSE2__)
     const __m128 oBx = _mm_loadu_ps(k.ox), oBy = _mm_loadu_ps(k.oy), oBz = _mm_loadu_ps(k.oz);
     const __m128 dBx = _mm_loadu_ps(k.dx), dBy = _mm_loadu_ps(k.dy), dBz = _mm_loadu_ps(k.dz);
@@ -301,13 +301,22 @@ inline uint32_t beamLinesNear4(const ub_beam_keys4& k, const ub_float3& o, const
     // either range test, as in the shared one).
     const __m128 held = _mm_andnot_ps(_mm_cmplt_ps(num, _mm_mul_ps(_mm_loadu_ps(k.t0), sin2)),
                                       _mm_cmpnge_ps(num, _mm_mul_ps(_mm_loadu_ps(k.t1), sin2)));
+    // The query's range: not qNum < -slack and not qNum > length sin2 1.0001 + slack.
+    const __m128 be = _mm_mul_ps(b, e), absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    const __m128 qNum = _mm_sub_ps(be, dw);
+    const __m128 slack = _mm_mul_ps(_mm_set1_ps(1e-5f),
+                                    _mm_add_ps(_mm_and_ps(be, absMask), _mm_and_ps(dw, absMask)));
+    const __m128 qHi = _mm_add_ps(
+        _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(queryLength), sin2), _mm_set1_ps(1.0001f)), slack);
+    const __m128 onQuery = _mm_andnot_ps(_mm_cmplt_ps(qNum, _mm_sub_ps(_mm_setzero_ps(), slack)),
+                                         _mm_cmpngt_ps(qNum, qHi));
     const __m128 near = _mm_and_ps(
         _mm_and_ps(_mm_cmpgt_ps(sin2, _mm_set1_ps(1e-7f)),
                    _mm_cmpngt_ps(_mm_mul_ps(sep, sep), _mm_mul_ps(_mm_set1_ps(radiusSqr), sin2))),
-        held);
+        _mm_and_ps(held, onQuery));
     return uint32_t(_mm_movemask_ps(near));
 #else
-    return ub_beam_lines_near4(&k, o, d, radiusSqr);
+    return ub_beam_lines_near4(&k, o, d, queryLength, radiusSqr);
 #endif
 }
 

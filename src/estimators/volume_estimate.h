@@ -156,7 +156,7 @@ void setBb1dWideWalkForTests(bool allowed);
 /// The AVX walk's test of blocks k[0] and k[1] (bits 0-3 and 4-7); throws where
 /// bb1dWideWalk() could never be true (no AVX).
 uint32_t bb1dLinesNear8ForTests(const ub_beam_keys4* k, const ub_float3& o, const ub_float3& d,
-                                float radiusSqr);
+                                float queryLength, float radiusSqr);
 /// Whether this CPU and build have the AVX walk (whatever setBb1dWideWalkForTests says).
 bool bb1dWideWalkAvailable();
 
